@@ -1,0 +1,70 @@
+// The case file's data model (docs/case-format.md). Units: m, mD, bar, cP, kg/m3;
+// z is depth, positive down. Everything here is validated by load_case().
+#pragma once
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "meshgen/core/vec3.hpp"
+
+namespace hm {
+
+/// Bad user input: the message names the key path and the reason, e.g.
+/// "wells[1].radius: must be > 0". Executables print it and exit with code 2.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ReservoirSpec {
+  std::vector<double> x, y, z;        ///< node coordinates, strictly increasing, >= 2 each
+  Vec3 permeability{100, 100, 10};    ///< kx, ky, kz (mD), > 0
+  double porosity = 0.2;              ///< in (0, 1]
+  double initial_pressure = 200;      ///< bar
+};
+
+enum class WellType { Producer, Injector };
+
+struct WellSpec {
+  std::string name;
+  WellType type = WellType::Producer;
+  std::vector<Vec3> trajectory;   ///< polyline, >= 2 distinct consecutive points
+  double radius = 0.1;            ///< wellbore radius r_w (m)
+  double drainage_radius = 8.0;   ///< outer radius of the radial grid (m), > radius
+  int rings = 6;                  ///< radial cells (geometric progression), >= 1
+  int sectors = 12;               ///< angular cells, >= 3 (raised when Gabriel needs it)
+  double segment_length = 4.0;    ///< target cell length along the trajectory (m), > 0
+  double bhp = 150;               ///< bottom-hole pressure (bar)
+};
+
+struct TransitionSpec {
+  double dilation = 1.5;                       ///< >= 1
+  bool optimize = true;
+  std::array<double, 3> gamma{0.05, 0.30, 0.40};  ///< 0 < G1 <= G2 <= G3 <= 0.5
+  double omega_o = 85;                         ///< degrees, in [80, 90]
+  double omega_p = 10;                         ///< degrees, in [0, 10]
+  double expansion = 1.1;                      ///< in (1, 1.1]
+};
+
+struct FluidSpec {
+  double viscosity = 1.0;          ///< cP, > 0
+  double density = 1000;           ///< kg/m3, > 0
+  double compressibility = 1e-8;   ///< 1/bar, >= 0
+};
+
+struct CaseSpec {
+  std::string name;                ///< [A-Za-z0-9_-]+
+  ReservoirSpec reservoir;
+  std::vector<WellSpec> wells;     ///< may be empty (then there is no cavity)
+  TransitionSpec transition;
+  FluidSpec fluid;
+};
+
+/// Parses and validates a YAML case file. Throws InputError (never anything else for
+/// bad content) with "key.path: reason". A missing or unreadable file is an InputError too.
+CaseSpec load_case(const std::string& path);
+/// Same, from YAML text (tests).
+CaseSpec parse_case(const std::string& yaml_text);
+
+}  // namespace hm

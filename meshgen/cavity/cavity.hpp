@@ -1,0 +1,65 @@
+// Cavities between the reservoir grid and the well blocks (paper 5.1).
+// A cavity is a set of deactivated reservoir cells (reservoir cells meeting a dilated
+// well block) minus the well blocks inside; its boundary is a closed surface of
+// constrained polygons: reservoir faces between an active and a deactivated cell, and
+// the outer faces of the well blocks. Wells whose deactivated regions touch share one
+// cavity.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "meshgen/case/case.hpp"
+#include "meshgen/grids/reservoir_grid.hpp"
+#include "meshgen/grids/well_block.hpp"
+
+namespace hm {
+
+enum class FaceSide : int32_t { Reservoir = 0, Well = 1 };
+
+/// One constrained polygon of a cavity boundary. Node ids are GLOBAL builder ids.
+struct ConstrainedFace {
+  std::vector<int32_t> nodes;  ///< oriented so that the right-hand normal points INTO the cavity
+  FaceSide side = FaceSide::Reservoir;
+  /// Reservoir side: the active reservoir cell outside (linear reservoir index) and the
+  /// deactivated cell inside. Well side: outside_cell = the local cell of the well block
+  /// (-1 for an end-cap polygon over the wellbore), inside_cell = -1.
+  int32_t outside_cell = -1;
+  int32_t inside_cell = -1;
+  int32_t well = -1;            ///< well side: which well
+  int32_t patch = kInteriorFace;  ///< kInteriorFace, or wellbore_patch(w) for an end cap (boundary face)
+};
+
+struct Cavity {
+  std::vector<int> wells;                 ///< wells whose blocks lie in this cavity
+  std::vector<int32_t> deactivated_cells; ///< reservoir linear cell indices, sorted
+  std::vector<ConstrainedFace> faces;     ///< the closed boundary surface
+  std::vector<int32_t> vertices;          ///< distinct global node ids of `faces`, sorted
+  double dilation_used = 0;               ///< largest local dilation used
+};
+
+struct CavitySet {
+  std::vector<Cavity> cavities;
+  std::vector<char> reservoir_active;  ///< per reservoir cell: 1 active, 0 deactivated
+  std::vector<std::string> notes;      ///< local dilation changes, Gabriel repairs
+  int gabriel_violations_remaining = 0;
+};
+
+/// Decides the deactivated cells (dilation, then the local enlargement that makes the
+/// cavity Gabriel across its reservoir and well sides), groups them into cavities with
+/// Boost.Graph connected components, and extracts each boundary. `reservoir_node_ids`
+/// and `well_node_ids[w]` map lattice/local node indices to builder ids.
+/// Throws InputError when a well block does not fit (e.g. pokes out of the reservoir).
+CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                         const std::vector<int32_t>& reservoir_node_ids,
+                         const std::vector<std::vector<int32_t>>& well_node_ids,
+                         const std::vector<Vec3>& node_coords);
+
+/// Closed 2-manifold check of a cavity boundary (OpenMesh): every edge in exactly two
+/// faces with opposite directions, every vertex's fan a single disk. Returns problems.
+std::vector<std::string> check_cavity_manifold(const Cavity& cavity, const std::vector<Vec3>& node_coords);
+
+/// Writes the boundary surface of a cavity as an .obj (OpenMesh); returns false on I/O failure.
+bool write_cavity_surface(const Cavity& cavity, const std::vector<Vec3>& node_coords, const std::string& path);
+
+}  // namespace hm

@@ -1,0 +1,197 @@
+#include "mesh_builder.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+namespace hm {
+
+namespace {
+void note(BuildReport& r, const std::string& what) {
+  r.ok = false;
+  if (r.problems.size() < 20) r.problems.push_back(what);
+}
+}  // namespace
+
+std::vector<int32_t> canonical_cycle(const std::vector<int32_t>& cycle, bool* reversed) {
+  const size_t n = cycle.size();
+  const size_t k = static_cast<size_t>(std::min_element(cycle.begin(), cycle.end()) - cycle.begin());
+  const int32_t next = cycle[(k + 1) % n], prev = cycle[(k + n - 1) % n];
+  std::vector<int32_t> out(n);
+  const bool rev = prev < next;
+  for (size_t i = 0; i < n; ++i) out[i] = rev ? cycle[(k + n - i) % n] : cycle[(k + i) % n];
+  if (reversed) *reversed = rev;
+  return out;
+}
+
+int32_t MeshBuilder::add_node(Vec3 p) {
+  nodes_.push_back(p);
+  return static_cast<int32_t>(nodes_.size() - 1);
+}
+
+int32_t MeshBuilder::add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs) {
+  const int32_t cell = static_cast<int32_t>(cells_.size());
+  for (const CellFace& cf : faces) {
+    // Drop repeated consecutive nodes (a conformity snap can merge two vertices).
+    std::vector<int32_t> cyc;
+    for (int32_t v : cf.nodes)
+      if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
+    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
+    std::vector<int32_t> sorted = cyc;
+    std::sort(sorted.begin(), sorted.end());
+    if (cyc.size() < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+      ++report_.degenerate_faces;
+      std::ostringstream os;
+      os << "cell " << cell << ": degenerate face with " << cyc.size() << " nodes";
+      note(report_, os.str());
+      continue;
+    }
+    bool reversed = false;
+    std::vector<int32_t> key = canonical_cycle(cyc, &reversed);
+    auto it = face_index_.find(key);
+    if (it == face_index_.end()) {
+      const int32_t f = static_cast<int32_t>(faces_.size());
+      face_index_.emplace(std::move(key), f);
+      face_nodes_.insert(face_nodes_.end(), cyc.begin(), cyc.end());
+      face_ptr_.push_back(static_cast<int32_t>(face_nodes_.size()));
+      FaceRecord rec;
+      rec.owner = cell;
+      rec.patch = cf.patch;
+      rec.uses = 1;
+      faces_.push_back(rec);
+      cell_faces_.push_back(f);
+      continue;
+    }
+    const int32_t f = it->second;
+    FaceRecord& rec = faces_[f];
+    ++rec.uses;
+    if (rec.uses > 2) {
+      ++report_.overused_faces;
+      std::ostringstream os;
+      os << "face " << f << " named by a third cell " << cell;
+      note(report_, os.str());
+      continue;
+    }
+    // The stored cycle is the owner's orientation: the neighbour must name it reversed.
+    bool stored_reversed = false;
+    std::vector<int32_t> stored(face_nodes_.begin() + face_ptr_[f], face_nodes_.begin() + face_ptr_[f + 1]);
+    canonical_cycle(stored, &stored_reversed);
+    if (stored_reversed == reversed) {
+      ++report_.misoriented_faces;
+      std::ostringstream os;
+      os << "face " << f << " named with the same orientation by cells " << rec.owner << " and " << cell;
+      note(report_, os.str());
+    }
+    rec.neighbour = cell;
+    cell_faces_.push_back(f);
+  }
+  cell_ptr_.push_back(static_cast<int32_t>(cell_faces_.size()));
+  cells_.push_back(attrs);
+  return cell;
+}
+
+PolyMesh MeshBuilder::finish(BuildReport* report) {
+  PolyMesh m;
+  // Compact nodes: keep only those referenced by a face, in their original order.
+  std::vector<int32_t> new_id(nodes_.size(), -1);
+  for (int32_t v : face_nodes_) new_id[v] = 0;
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    if (new_id[i] == 0) {
+      new_id[i] = static_cast<int32_t>(m.nodes.size());
+      m.nodes.push_back(nodes_[i]);
+    } else {
+      ++report_.removed_unused_nodes;
+    }
+  }
+  m.face_node_ptr = face_ptr_;
+  m.face_nodes.resize(face_nodes_.size());
+  for (size_t i = 0; i < face_nodes_.size(); ++i) m.face_nodes[i] = new_id[face_nodes_[i]];
+  const size_t nf = faces_.size();
+  m.face_owner.resize(nf);
+  m.face_neighbour.resize(nf);
+  m.face_patch.resize(nf);
+  for (size_t f = 0; f < nf; ++f) {
+    const FaceRecord& r = faces_[f];
+    m.face_owner[f] = r.owner;
+    m.face_neighbour[f] = r.neighbour;
+    if (r.neighbour >= 0) {
+      m.face_patch[f] = kInteriorFace;
+    } else if (r.patch == kInteriorFace) {
+      m.face_patch[f] = kUnmatchedFace;
+      ++report_.unmatched_faces;
+      std::ostringstream os;
+      os << "face " << f << " of cell " << r.owner << " has no neighbour but is not a boundary face";
+      note(report_, os.str());
+    } else {
+      m.face_patch[f] = r.patch;
+    }
+  }
+  m.cell_face_ptr = cell_ptr_;
+  m.cell_faces = cell_faces_;
+  const size_t nc = cells_.size();
+  m.cell_region.resize(nc);
+  m.cell_fv_center.resize(nc);
+  m.cell_ijk.resize(nc);
+  m.cell_perm.resize(nc);
+  m.cell_porosity.resize(nc);
+  m.cell_radial.resize(nc);
+  for (size_t c = 0; c < nc; ++c) {
+    m.cell_region[c] = cells_[c].region;
+    m.cell_fv_center[c] = cells_[c].fv_center;
+    m.cell_ijk[c] = cells_[c].ijk;
+    m.cell_perm[c] = cells_[c].perm;
+    m.cell_porosity[c] = cells_[c].porosity;
+    m.cell_radial[c] = cells_[c].radial;
+  }
+  if (report) *report = report_;
+  return m;
+}
+
+CsrReport check_csr_invariants(const PolyMesh& m) {
+  CsrReport r;
+  auto bad = [&](const std::string& s) {
+    r.ok = false;
+    if (r.problems.size() < 20) r.problems.push_back(s);
+  };
+  const int nf = m.n_faces(), nc = m.n_cells(), nn = m.n_nodes();
+  if (m.face_node_ptr.size() != static_cast<size_t>(nf) + 1 || m.face_node_ptr.front() != 0)
+    bad("face_node_ptr must have n_faces + 1 entries starting at 0");
+  if (m.cell_face_ptr.size() != static_cast<size_t>(nc) + 1 || m.cell_face_ptr.front() != 0)
+    bad("cell_face_ptr must have n_cells + 1 entries starting at 0");
+  if (m.face_neighbour.size() != static_cast<size_t>(nf) || m.face_patch.size() != static_cast<size_t>(nf))
+    bad("face_neighbour/face_patch sizes differ from n_faces");
+  if (m.cell_fv_center.size() != static_cast<size_t>(nc) || m.cell_ijk.size() != static_cast<size_t>(nc) ||
+      m.cell_perm.size() != static_cast<size_t>(nc) || m.cell_porosity.size() != static_cast<size_t>(nc) ||
+      m.cell_radial.size() != static_cast<size_t>(nc))
+    bad("per-cell arrays differ in size from n_cells");
+  if (!r.ok) return r;
+  if (m.face_node_ptr.back() != static_cast<int32_t>(m.face_nodes.size())) bad("face_node_ptr.back() != face_nodes.size()");
+  if (m.cell_face_ptr.back() != static_cast<int32_t>(m.cell_faces.size())) bad("cell_face_ptr.back() != cell_faces.size()");
+  if (!r.ok) return r;
+  for (int f = 0; f < nf; ++f) {
+    if (m.face_size(f) < 3) bad("face " + std::to_string(f) + " has fewer than 3 nodes");
+    for (const int32_t* v = m.face_begin(f); v != m.face_end(f); ++v)
+      if (*v < 0 || *v >= nn) bad("face " + std::to_string(f) + " has an out-of-range node id");
+    if (m.face_owner[f] < 0 || m.face_owner[f] >= nc) bad("face " + std::to_string(f) + " has an invalid owner");
+    if (m.face_neighbour[f] >= nc || m.face_neighbour[f] == m.face_owner[f])
+      bad("face " + std::to_string(f) + " has an invalid neighbour");
+    if ((m.face_neighbour[f] >= 0) != (m.face_patch[f] == kInteriorFace))
+      bad("face " + std::to_string(f) + ": patch must be kInteriorFace exactly when it has a neighbour");
+  }
+  std::vector<int> seen(nf, 0);
+  for (int c = 0; c < nc; ++c) {
+    if (m.cell_face_ptr[c + 1] - m.cell_face_ptr[c] < 4) bad("cell " + std::to_string(c) + " has fewer than 4 faces");
+    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) {
+      if (*f < 0 || *f >= nf) { bad("cell " + std::to_string(c) + " has an out-of-range face id"); continue; }
+      if (m.face_owner[*f] != c && m.face_neighbour[*f] != c)
+        bad("cell " + std::to_string(c) + " lists face " + std::to_string(*f) + " that is not its own");
+      ++seen[*f];
+    }
+  }
+  for (int f = 0; f < nf; ++f) {
+    const int want = m.face_neighbour[f] >= 0 ? 2 : 1;
+    if (seen[f] != want) bad("face " + std::to_string(f) + " listed by " + std::to_string(seen[f]) + " cells, expected " + std::to_string(want));
+  }
+  return r;
+}
+
+}  // namespace hm

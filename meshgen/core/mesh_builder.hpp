@@ -1,0 +1,70 @@
+// Assembles a PolyMesh from cells given as lists of oriented faces.
+// Faces are deduplicated by node identity (the cyclic node sequence, not coordinates):
+// the second cell that names a face must name it with the reversed cycle, which is
+// exactly the conformity condition. Several grids (reservoir, wells, transition) add
+// into one builder and so share nodes and faces.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "polymesh.hpp"
+
+namespace hm {
+
+/// One face of a cell as handed to the builder: node ids ordered so that the
+/// right-hand normal points OUT of the cell, and the patch it belongs to if it
+/// turns out to be a boundary face (kInteriorFace = "must be shared").
+struct CellFace {
+  std::vector<int32_t> nodes;
+  int32_t patch = kInteriorFace;
+};
+
+struct BuildReport {
+  bool ok = true;
+  int unmatched_faces = 0;      ///< faces declared interior that no second cell named
+  int overused_faces = 0;       ///< faces named by a third cell
+  int misoriented_faces = 0;    ///< second use with the same (not reversed) orientation
+  int degenerate_faces = 0;     ///< fewer than 3 distinct nodes
+  int removed_unused_nodes = 0; ///< nodes no face referenced (compacted away)
+  std::vector<std::string> problems;  ///< first problems, human readable
+};
+
+class MeshBuilder {
+ public:
+  int32_t add_node(Vec3 p);
+  Vec3 node(int32_t id) const { return nodes_[id]; }
+  int32_t n_nodes() const { return static_cast<int32_t>(nodes_.size()); }
+  /// Adds a cell; returns its id. Faces must be closed and outward oriented.
+  int32_t add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs);
+  /// Finishes: compacts unused nodes, fixes patches, returns the mesh. The report says
+  /// whether every face was used consistently; the mesh is returned either way so
+  /// that a caller can inspect it.
+  PolyMesh finish(BuildReport* report);
+
+ private:
+  struct FaceRecord {
+    int32_t owner = -1, neighbour = -1;
+    int32_t patch = kInteriorFace;
+    int uses = 0;
+  };
+  std::vector<Vec3> nodes_;
+  std::vector<int32_t> face_ptr_{0};
+  std::vector<int32_t> face_nodes_;
+  std::vector<FaceRecord> faces_;
+  std::map<std::vector<int32_t>, int32_t> face_index_;  // canonical cycle -> face id
+  std::vector<int32_t> cell_ptr_{0};
+  std::vector<int32_t> cell_faces_;
+  std::vector<CellAttributes> cells_;
+  BuildReport report_;
+};
+
+/// The canonical key of a face cycle: rotated to start at its smallest id, oriented so
+/// that the second entry is the smaller neighbour. `reversed` tells whether the
+/// orientation was flipped to get there.
+std::vector<int32_t> canonical_cycle(const std::vector<int32_t>& cycle, bool* reversed);
+
+/// Checks the CSR/ownership invariants listed in docs/mesh-layout.md.
+CsrReport check_csr_invariants(const PolyMesh& mesh);
+
+}  // namespace hm

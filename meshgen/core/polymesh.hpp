@@ -1,0 +1,89 @@
+// The one polyhedral mesh type of HybridMesh: a handful of flat arrays.
+// Every field is documented with its size and invariant in docs/mesh-layout.md.
+// Topology only (plus per-cell data); geometry lives in MeshGeometry (geometry.hpp).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vec3.hpp"
+
+namespace hm {
+
+/// Region code per cell (cell_region).
+enum Region : int32_t { kReservoir = 0, kTransition = 1, kWell = 2 };
+
+/// Patch code per face (face_patch).
+constexpr int32_t kInteriorFace = -1;   ///< shared by two cells
+constexpr int32_t kOuterBoundary = 0;   ///< on the reservoir box's outer boundary
+constexpr int32_t kUnmatchedFace = -2;  ///< builder: a face expected interior that found no partner (a bug)
+/// Wellbore of well w (0-based): the boundary faces r = r_w (and the capped ends) of that well.
+inline constexpr int32_t wellbore_patch(int well) { return 1 + well; }
+inline constexpr bool is_wellbore_patch(int32_t p) { return p >= 1; }
+inline constexpr int well_of_patch(int32_t p) { return p - 1; }
+
+/// Structured description of a radial well cell; well < 0 for every other cell.
+/// The exact radial half-transmissibility of ring faces needs these (docs/mesh-layout.md).
+struct RadialCellInfo {
+  int32_t well = -1;     ///< well index in the case file, -1 if not a radial cell
+  int32_t ring = -1;     ///< 0 = next to the wellbore
+  int32_t sector = -1;   ///< angular index
+  int32_t segment = -1;  ///< index along the trajectory
+  double r_in = 0, r_out = 0;  ///< radii of the inner and outer ring polygons (circumradii)
+  double r_center = 0;         ///< radius of the FV centre: sqrt(r_in * r_out)
+  double angle = 0;            ///< sector angle (rad)
+  double length = 0;           ///< cell length along the trajectory axis (m)
+};
+
+struct PolyMesh {
+  // ---- nodes
+  std::vector<Vec3> nodes;  ///< n_nodes coordinates (m; z = depth, positive down)
+
+  // ---- faces (CSR face -> nodes)
+  std::vector<int32_t> face_node_ptr{0};  ///< n_faces + 1, starts at 0, non-decreasing, >= 3 nodes per face
+  std::vector<int32_t> face_nodes;        ///< face_node_ptr.back() node ids; a face's cycle is oriented so
+                                          ///< that its right-hand normal points out of face_owner
+  std::vector<int32_t> face_owner;        ///< n_faces, a valid cell id
+  std::vector<int32_t> face_neighbour;    ///< n_faces, cell id or -1 on the boundary
+  std::vector<int32_t> face_patch;        ///< n_faces, kInteriorFace iff face_neighbour >= 0, else a patch code
+
+  // ---- cells (CSR cell -> faces)
+  std::vector<int32_t> cell_face_ptr{0};  ///< n_cells + 1
+  std::vector<int32_t> cell_faces;        ///< face ids; each face appears in exactly its owner's and neighbour's lists
+  std::vector<int32_t> cell_region;       ///< n_cells, a Region code
+  std::vector<Vec3> cell_fv_center;       ///< n_cells, the finite-volume centre (site), NOT the centroid
+  std::vector<std::array<int32_t, 3>> cell_ijk;  ///< n_cells, (i,j,k) of reservoir cells, {-1,-1,-1} otherwise
+  std::vector<Vec3> cell_perm;            ///< n_cells, diagonal permeability (kx, ky, kz) in mD
+  std::vector<double> cell_porosity;      ///< n_cells, porosity in [0, 1]
+  std::vector<RadialCellInfo> cell_radial;  ///< n_cells, radial structure of well cells
+
+  int n_nodes() const { return static_cast<int>(nodes.size()); }
+  int n_faces() const { return static_cast<int>(face_owner.size()); }
+  int n_cells() const { return static_cast<int>(cell_region.size()); }
+  int face_size(int f) const { return face_node_ptr[f + 1] - face_node_ptr[f]; }
+  const int32_t* face_begin(int f) const { return face_nodes.data() + face_node_ptr[f]; }
+  const int32_t* face_end(int f) const { return face_nodes.data() + face_node_ptr[f + 1]; }
+  const int32_t* cell_begin(int c) const { return cell_faces.data() + cell_face_ptr[c]; }
+  const int32_t* cell_end(int c) const { return cell_faces.data() + cell_face_ptr[c + 1]; }
+  /// +1 if cell c owns face f (outward normal), -1 if c is its neighbour.
+  int face_sign(int f, int c) const { return face_owner[f] == c ? 1 : -1; }
+};
+
+/// Per-cell attributes handed to the builder with each cell.
+struct CellAttributes {
+  int32_t region = kReservoir;
+  Vec3 fv_center;
+  std::array<int32_t, 3> ijk{-1, -1, -1};
+  Vec3 perm{0, 0, 0};
+  double porosity = 0;
+  RadialCellInfo radial;
+};
+
+/// Sorted, compacted statistics of CSR validity (see check_csr_invariants).
+struct CsrReport {
+  bool ok = true;
+  std::vector<std::string> problems;  ///< first problems found, human readable (at most 20)
+};
+
+}  // namespace hm

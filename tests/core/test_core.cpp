@@ -1,0 +1,123 @@
+#include <gtest/gtest.h>
+
+#include "meshgen/core/geometry.hpp"
+#include "meshgen/core/mesh_builder.hpp"
+
+using namespace hm;
+
+namespace {
+// Faces of the axis-aligned box [lo, hi] with node ids n[0..7] (bit 0 = x, bit 1 = y, bit 2 = z),
+// oriented outward.
+std::vector<CellFace> box_faces(const int32_t n[8]) {
+  return {{{n[0], n[2], n[3], n[1]}, kOuterBoundary}, {{n[4], n[5], n[7], n[6]}, kOuterBoundary},
+          {{n[0], n[1], n[5], n[4]}, kOuterBoundary}, {{n[2], n[6], n[7], n[3]}, kOuterBoundary},
+          {{n[0], n[4], n[6], n[2]}, kOuterBoundary}, {{n[1], n[3], n[7], n[5]}, kOuterBoundary}};
+}
+}  // namespace
+
+TEST(CanonicalCycle, RotationAndReversalGiveTheSameKey) {
+  bool r1 = false, r2 = false, r3 = false;
+  auto a = canonical_cycle({5, 2, 9, 7}, &r1);
+  auto b = canonical_cycle({9, 7, 5, 2}, &r2);
+  auto c = canonical_cycle({7, 9, 2, 5}, &r3);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a, c);
+  EXPECT_EQ(r1, r2);
+  EXPECT_NE(r1, r3);
+}
+
+TEST(MeshBuilder, TwoBoxesShareOneFaceAndAreClosedWithExactVolumes) {
+  MeshBuilder b;
+  int32_t id[3][2][2];
+  const double xs[3] = {0.0, 1.5, 4.0};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k) id[i][j][k] = b.add_node({xs[i], 2.0 * j, 0.7 * k});
+  for (int i = 0; i < 2; ++i) {
+    int32_t n[8];
+    for (int c = 0; c < 8; ++c) n[c] = id[i + (c & 1)][(c >> 1) & 1][(c >> 2) & 1];
+    auto faces = box_faces(n);
+    CellAttributes at;
+    at.fv_center = {0.5 * (xs[i] + xs[i + 1]), 1.0, 0.35};
+    b.add_cell(faces, at);
+  }
+  BuildReport rep;
+  PolyMesh m = b.finish(&rep);
+  ASSERT_TRUE(rep.ok) << (rep.problems.empty() ? "" : rep.problems[0]);
+  EXPECT_EQ(m.n_cells(), 2);
+  EXPECT_EQ(m.n_faces(), 11);
+  EXPECT_EQ(m.n_nodes(), 12);
+  EXPECT_TRUE(check_csr_invariants(m).ok);
+  int interior = 0;
+  for (int f = 0; f < m.n_faces(); ++f) interior += m.face_neighbour[f] >= 0;
+  EXPECT_EQ(interior, 1);
+  MeshGeometry g = compute_geometry(m);
+  EXPECT_NEAR(g.cell_volume[0], 1.5 * 2.0 * 0.7, 1e-14);
+  EXPECT_NEAR(g.cell_volume[1], 2.5 * 2.0 * 0.7, 1e-14);
+  for (int c = 0; c < 2; ++c) EXPECT_LT(norm(cell_area_sum(m, g, c)), 1e-14);
+  EXPECT_NEAR(g.cell_centroid[1].x, 2.75, 1e-14);
+}
+
+TEST(MeshBuilder, SameOrientationTwiceIsReportedNotAccepted) {
+  MeshBuilder b;
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c) n[c] = b.add_node({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  auto faces = box_faces(n);
+  b.add_cell(faces, {});
+  b.add_cell(faces, {});  // the same cell twice: every face reused with the same orientation
+  BuildReport rep;
+  b.finish(&rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.misoriented_faces, 6);
+}
+
+TEST(MeshBuilder, InteriorFaceWithoutPartnerIsUnmatched) {
+  MeshBuilder b;
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c) n[c] = b.add_node({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  auto faces = box_faces(n);
+  faces[0].patch = kInteriorFace;
+  b.add_cell(faces, {});
+  BuildReport rep;
+  PolyMesh m = b.finish(&rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.unmatched_faces, 1);
+  EXPECT_EQ(m.face_patch[0], kUnmatchedFace);
+}
+
+TEST(Geometry, NonPlanarFaceKeepsCellClosed) {
+  // Lift one top corner: the top face becomes non-planar; the cell must stay closed.
+  PolyMesh m;
+  {
+    MeshBuilder bb;
+    int32_t q[8];
+    for (int c = 0; c < 8; ++c) q[c] = bb.add_node({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1) + (c == 7 ? 0.3 : 0.0)});
+    bb.add_cell(box_faces(q), {});
+    BuildReport rep;
+    m = bb.finish(&rep);
+    ASSERT_TRUE(rep.ok);
+  }
+  MeshGeometry g = compute_geometry(m);
+  EXPECT_LT(norm(cell_area_sum(m, g, 0)), 1e-15);
+  EXPECT_GT(g.cell_volume[0], 1.0);
+  EXPECT_LT(g.cell_volume[0], 1.1);
+}
+
+TEST(CsrInvariants, DetectsBrokenPointers) {
+  MeshBuilder b;
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c) n[c] = b.add_node({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  b.add_cell(box_faces(n), {});
+  BuildReport rep;
+  PolyMesh m = b.finish(&rep);
+  ASSERT_TRUE(check_csr_invariants(m).ok);
+  PolyMesh broken = m;
+  broken.face_nodes[3] = 99;
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+  broken = m;
+  broken.face_neighbour[0] = 0;
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+  broken = m;
+  broken.cell_faces.pop_back();
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+}
