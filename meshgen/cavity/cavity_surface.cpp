@@ -1,0 +1,82 @@
+// The cavity boundary as an OpenMesh polygon mesh: manifold checks and .obj output.
+// GCC 12 reports a false -Wmaybe-uninitialized inside OpenMesh's property vectors.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "cavity.hpp"
+
+namespace hm {
+
+namespace {
+
+// Double-precision points: the .obj keeps the node coordinates exactly as meshed.
+struct DoubleTraits : public OpenMesh::DefaultTraits {
+  typedef OpenMesh::Vec3d Point;
+};
+using SurfaceMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
+
+// Builds the OpenMesh surface; faces OpenMesh refuses (non-manifold) are counted.
+SurfaceMesh to_openmesh(const Cavity& cavity, const std::vector<Vec3>& coords, int* refused) {
+  SurfaceMesh mesh;
+  std::map<int32_t, SurfaceMesh::VertexHandle> vh;
+  for (int32_t v : cavity.vertices) {
+    const Vec3 p = coords[v];
+    vh[v] = mesh.add_vertex(SurfaceMesh::Point(p.x, p.y, p.z));
+  }
+  *refused = 0;
+  for (const ConstrainedFace& f : cavity.faces) {
+    std::vector<SurfaceMesh::VertexHandle> handles;
+    for (int32_t v : f.nodes) handles.push_back(vh.at(v));
+    if (!mesh.add_face(handles).is_valid()) ++*refused;
+  }
+  return mesh;
+}
+
+}  // namespace
+
+std::vector<std::string> check_cavity_manifold(const Cavity& cavity, const std::vector<Vec3>& coords) {
+  std::vector<std::string> problems;
+  // Combinatorial closure: every directed edge appears once and its reverse once.
+  std::map<std::pair<int32_t, int32_t>, int> directed;
+  for (const ConstrainedFace& f : cavity.faces)
+    for (size_t i = 0; i < f.nodes.size(); ++i) ++directed[{f.nodes[i], f.nodes[(i + 1) % f.nodes.size()]}];
+  int open_edges = 0, overused = 0;
+  for (const auto& [e, n] : directed) {
+    if (n > 1) ++overused;
+    if (!directed.count({e.second, e.first})) ++open_edges;
+  }
+  if (open_edges) problems.push_back(std::to_string(open_edges) + " directed edges without their reverse (open surface)");
+  if (overused) problems.push_back(std::to_string(overused) + " directed edges used by more than one face (non-manifold)");
+  // OpenMesh refuses faces that would make a vertex or edge non-manifold.
+  int refused = 0;
+  SurfaceMesh mesh = to_openmesh(cavity, coords, &refused);
+  if (refused) problems.push_back(std::to_string(refused) + " faces refused by OpenMesh (non-manifold vertex or edge)");
+  int boundary_halfedges = 0;
+  for (auto he : mesh.halfedges())
+    if (mesh.is_boundary(he)) ++boundary_halfedges;
+  if (boundary_halfedges) problems.push_back(std::to_string(boundary_halfedges) + " boundary half-edges (surface not closed)");
+  for (auto v : mesh.vertices())
+    if (!mesh.is_manifold(v)) { problems.push_back("non-manifold vertex"); break; }
+  return problems;
+}
+
+bool write_cavity_surface(const Cavity& cavity, const std::vector<Vec3>& coords, const std::string& path) {
+  int refused = 0;
+  SurfaceMesh mesh = to_openmesh(cavity, coords, &refused);
+  // Temp file + rename: a failed write never leaves a complete-looking file. The temp
+  // name keeps the extension, which OpenMesh uses to pick the format.
+  const std::string tmp = path + ".tmp.obj";
+  OpenMesh::IO::Options opt;
+  if (!OpenMesh::IO::write_mesh(mesh, tmp, opt, 17)) {
+    std::remove(tmp.c_str());
+    return false;
+  }
+  return std::rename(tmp.c_str(), path.c_str()) == 0;
+}
+
+}  // namespace hm
