@@ -1,0 +1,470 @@
+// YAML case-file loader (docs/case-format.md). Every problem with the input becomes one
+// hm::InputError "key.path: reason"; yaml-cpp is only used to get a node tree, all
+// conversions are done here so that the accepted syntax and the messages are ours.
+#include "meshgen/case/case.hpp"
+
+#include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <utility>
+
+#include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/segment_distance.hpp"
+
+namespace hm {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& reason) { throw InputError(path + ": " + reason); }
+
+std::string key_path(const std::string& parent, const std::string& key) {
+  return parent.empty() ? key : parent + "." + key;
+}
+std::string index_path(const std::string& parent, size_t i) { return parent + "[" + std::to_string(i) + "]"; }
+
+// Length in bytes of the well-formed UTF-8 sequence starting at s[i], or 0 if it is not one.
+size_t utf8_sequence_length(const std::string& s, size_t i) {
+  const auto lead = static_cast<unsigned char>(s[i]);
+  size_t n = 0;
+  if (lead >= 0xC2 && lead <= 0xDF) n = 2;
+  else if (lead >= 0xE0 && lead <= 0xEF) n = 3;
+  else if (lead >= 0xF0 && lead <= 0xF4) n = 4;
+  else return 0;
+  if (i + n > s.size()) return 0;
+  for (size_t k = 1; k < n; ++k)
+    if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return 0;
+  return n;
+}
+
+// User text echoed in a message: one line, control bytes and malformed UTF-8 escaped,
+// long text cut (messages must stay a single readable line).
+std::string printable(const std::string& s, size_t max_chars = 40) {
+  std::string out;
+  size_t chars = 0;
+  for (size_t i = 0; i < s.size(); ++chars) {
+    if (chars == max_chars) return out + "...";
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x20 && c < 0x7F) {
+      out += s[i++];
+    } else if (const size_t n = c >= 0x80 ? utf8_sequence_length(s, i) : 0; n > 0) {
+      out += s.substr(i, n);
+      i += n;
+    } else {
+      static const char* hex = "0123456789abcdef";
+      out += c == '\n' ? std::string("\\n") : c == '\t' ? std::string("\\t")
+                                                         : std::string("\\x") + hex[c >> 4] + hex[c & 15];
+      ++i;
+    }
+  }
+  return out;
+}
+std::string quoted(const std::string& s, size_t max_chars = 40) { return "'" + printable(s, max_chars) + "'"; }
+
+// Shortest text that reads back as v (echoes user values as written).
+std::string fmt(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+// Computed values (distances): 6 significant digits.
+std::string fmt6(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 6);
+  return std::string(buf, r.ptr);
+}
+std::string fmt_count(double v) {
+  return v < 1e15 ? std::to_string(static_cast<long long>(v)) : fmt6(v);
+}
+
+// Decimal number grammar accepted for numbers: [-+]? (d+ .? d* | . d+) ([eE] [-+]? d+)?
+// (no hex, no .inf/.nan, no digit separators). Returns the text without a leading '+'.
+std::optional<std::string> decimal_text(const std::string& s) {
+  size_t i = 0;
+  if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+  const size_t mantissa_begin = i;
+  size_t digits = 0;
+  while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits;
+  if (i < s.size() && s[i] == '.') {
+    ++i;
+    while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++digits;
+  }
+  if (digits == 0 || i == mantissa_begin) return std::nullopt;
+  if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+    ++i;
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+    size_t exp_digits = 0;
+    while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) ++i, ++exp_digits;
+    if (exp_digits == 0) return std::nullopt;
+  }
+  if (i != s.size()) return std::nullopt;
+  return s[0] == '+' ? s.substr(1) : s;
+}
+
+bool is_integer_text(const std::string& s) {
+  size_t i = (!s.empty() && (s[0] == '+' || s[0] == '-')) ? 1 : 0;
+  if (i == s.size()) return false;
+  for (; i < s.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(s[i]))) return false;
+  return true;
+}
+
+// A quoted scalar ('5', "5", block scalars) or one tagged !!str is a string, never a number.
+bool is_string_scalar(const YAML::Node& n) { return n.Tag() == "!" || n.Tag() == "tag:yaml.org,2002:str"; }
+
+// What the user wrote, for "expected ..., got <describe>": numbers bare, other text quoted.
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Scalar:
+      if (!decimal_text(n.Scalar())) return quoted(n.Scalar());
+      return is_string_scalar(n) ? "a quoted string " + quoted(n.Scalar()) : printable(n.Scalar());
+    default: return "null";
+  }
+}
+
+double read_number(const YAML::Node& n, const std::string& path) {
+  if (!n.IsScalar() || is_string_scalar(n)) fail(path, "expected a number, got " + describe(n));
+  const auto text = decimal_text(n.Scalar());
+  if (!text) fail(path, "expected a number, got " + describe(n));
+  double v = 0;
+  const auto r = std::from_chars(text->data(), text->data() + text->size(), v);
+  if (r.ec != std::errc() || r.ptr != text->data() + text->size() || !std::isfinite(v))
+    fail(path, "expected a finite number, got " + describe(n));
+  return v;
+}
+
+int read_int(const YAML::Node& n, const std::string& path) {
+  if (!n.IsScalar() || is_string_scalar(n) || !is_integer_text(n.Scalar()))
+    fail(path, "expected an integer, got " + describe(n));
+  const std::string& s = n.Scalar();
+  const char* begin = s.data() + (s[0] == '+' ? 1 : 0);
+  long long v = 0;
+  const auto r = std::from_chars(begin, s.data() + s.size(), v);
+  if (r.ec != std::errc() || v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+    fail(path, "integer out of range, got " + describe(n));
+  return static_cast<int>(v);
+}
+
+bool read_bool(const YAML::Node& n, const std::string& path) {
+  if (n.IsScalar() && !is_string_scalar(n)) {
+    const std::string& s = n.Scalar();
+    if (s == "true" || s == "True" || s == "TRUE") return true;
+    if (s == "false" || s == "False" || s == "FALSE") return false;
+  }
+  fail(path, "expected true or false, got " + describe(n));
+}
+
+std::string read_string(const YAML::Node& n, const std::string& path) {
+  if (!n.IsScalar()) fail(path, "expected a string, got " + describe(n));
+  return n.Scalar();
+}
+
+bool matches_name_charset(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+  return true;
+}
+
+// A map's entries by key, checked: only `allowed` keys, each at most once, keys are plain names.
+class Fields {
+ public:
+  Fields(const YAML::Node& map, const std::string& path, std::initializer_list<const char*> allowed) : path_(path) {
+    if (!map.IsMap()) fail(path, "expected a map, got " + describe(map));
+    for (auto it = map.begin(); it != map.end(); ++it) {
+      // Copies: it-> returns a temporary proxy, a reference into it would dangle.
+      const YAML::Node key = it->first;
+      const YAML::Node value = it->second;
+      if (!key.IsScalar()) fail(path.empty() ? "case file" : path, "expected a key name, got " + describe(key));
+      const std::string& name = key.Scalar();
+      if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return name == a; }) == allowed.end()) {
+        std::string expected;
+        for (const char* a : allowed) expected += (expected.empty() ? "" : ", ") + std::string(a);
+        fail(key_path(path, printable(name)), "unknown key (expected one of: " + expected + ")");
+      }
+      for (const auto& e : entries_)
+        if (e.first == name) fail(key_path(path, name), "duplicate key");
+      entries_.emplace_back(name, value);
+    }
+  }
+  std::optional<YAML::Node> get(const std::string& key) const {
+    for (const auto& e : entries_)
+      if (e.first == key) return e.second;
+    return std::nullopt;
+  }
+  YAML::Node required(const std::string& key) const {
+    auto n = get(key);
+    if (!n) fail(path(key), "required key is missing");
+    return *n;
+  }
+  std::string path(const std::string& key) const { return key_path(path_, key); }
+
+  // Optional scalar fields: keep `value` (the case.hpp default) when the key is absent.
+  void number(const std::string& key, double& value) const {
+    if (auto n = get(key)) value = read_number(*n, path(key));
+  }
+  void integer(const std::string& key, int& value) const {
+    if (auto n = get(key)) value = read_int(*n, path(key));
+  }
+  void boolean(const std::string& key, bool& value) const {
+    if (auto n = get(key)) value = read_bool(*n, path(key));
+  }
+
+ private:
+  std::string path_;
+  std::vector<std::pair<std::string, YAML::Node>> entries_;
+};
+
+// Exactly three numbers, e.g. permeability [kx, ky, kz].
+std::array<double, 3> read_triple(const YAML::Node& n, const std::string& path, const char* shape) {
+  if (!n.IsSequence()) fail(path, std::string("expected a list of 3 numbers ") + shape + ", got " + describe(n));
+  if (n.size() != 3) fail(path, std::string("expected 3 values ") + shape + ", got " + std::to_string(n.size()));
+  std::array<double, 3> v{};
+  for (size_t i = 0; i < 3; ++i) v[i] = read_number(n[i], index_path(path, i));
+  return v;
+}
+
+std::vector<double> read_axis(const YAML::Node& n, const std::string& path) {
+  if (!n.IsSequence()) fail(path, "expected a list of numbers, got " + describe(n));
+  if (n.size() < 2) fail(path, "needs at least 2 values");
+  if (n.size() > kMaxAxisValues)
+    fail(path, "at most " + std::to_string(kMaxAxisValues) + " values (got " + std::to_string(n.size()) + ")");
+  std::vector<double> v;
+  v.reserve(n.size());
+  for (size_t i = 0; i < n.size(); ++i) {
+    v.push_back(read_number(n[i], index_path(path, i)));
+    if (i > 0 && !(v[i] > v[i - 1])) fail(path, "not strictly increasing at index " + std::to_string(i));
+  }
+  return v;
+}
+
+void require(bool ok, const std::string& path, const std::string& reason) {
+  if (!ok) fail(path, reason);
+}
+
+ReservoirSpec read_reservoir(const YAML::Node& n) {
+  const Fields f(n, "reservoir", {"x", "y", "z", "permeability", "porosity", "initial_pressure"});
+  ReservoirSpec r;
+  r.x = read_axis(f.required("x"), f.path("x"));
+  r.y = read_axis(f.required("y"), f.path("y"));
+  r.z = read_axis(f.required("z"), f.path("z"));
+  const double cells = double(r.x.size() - 1) * double(r.y.size() - 1) * double(r.z.size() - 1);
+  if (cells > kMaxCells)
+    fail("reservoir", "too many cells (" + std::to_string(r.x.size() - 1) + " x " + std::to_string(r.y.size() - 1) +
+                          " x " + std::to_string(r.z.size() - 1) + " = " + fmt_count(cells) + " > " +
+                          fmt_count(kMaxCells) + ")");
+  if (auto k = f.get("permeability")) {
+    const auto v = read_triple(*k, f.path("permeability"), "[kx, ky, kz]");
+    for (size_t i = 0; i < 3; ++i) require(v[i] > 0, index_path(f.path("permeability"), i), "must be > 0");
+    r.permeability = {v[0], v[1], v[2]};
+  }
+  f.number("porosity", r.porosity);
+  require(r.porosity > 0 && r.porosity <= 1, f.path("porosity"), "must be in (0, 1]");
+  f.number("initial_pressure", r.initial_pressure);
+  require(r.initial_pressure > 0, f.path("initial_pressure"), "must be > 0");
+  return r;
+}
+
+TransitionSpec read_transition(const YAML::Node& n) {
+  TransitionSpec t;
+  if (n.IsNull()) return t;
+  const Fields f(n, "transition", {"dilation", "optimize", "gamma", "omega_o", "omega_p", "expansion"});
+  f.number("dilation", t.dilation);
+  require(t.dilation >= 1, f.path("dilation"), "must be >= 1");
+  f.boolean("optimize", t.optimize);
+  if (auto g = f.get("gamma")) t.gamma = read_triple(*g, f.path("gamma"), "[G1, G2, G3]");
+  require(0 < t.gamma[0] && t.gamma[0] <= t.gamma[1] && t.gamma[1] <= t.gamma[2] && t.gamma[2] <= 0.5,
+          f.path("gamma"), "must satisfy 0 < G1 <= G2 <= G3 <= 0.5");
+  f.number("omega_o", t.omega_o);
+  require(t.omega_o >= 80 && t.omega_o <= 90, f.path("omega_o"), "must be in [80, 90] degrees");
+  f.number("omega_p", t.omega_p);
+  require(t.omega_p >= 0 && t.omega_p <= 10, f.path("omega_p"), "must be in [0, 10] degrees");
+  f.number("expansion", t.expansion);
+  require(t.expansion > 1 && t.expansion <= 1.1, f.path("expansion"), "must be in (1, 1.1]");
+  return t;
+}
+
+FluidSpec read_fluid(const YAML::Node& n) {
+  FluidSpec fl;
+  if (n.IsNull()) return fl;
+  const Fields f(n, "fluid", {"viscosity", "density", "compressibility"});
+  f.number("viscosity", fl.viscosity);
+  require(fl.viscosity > 0, f.path("viscosity"), "must be > 0");
+  f.number("density", fl.density);
+  require(fl.density > 0, f.path("density"), "must be > 0");
+  f.number("compressibility", fl.compressibility);
+  require(fl.compressibility >= 0, f.path("compressibility"), "must be >= 0");
+  return fl;
+}
+
+std::vector<Vec3> read_trajectory(const YAML::Node& n, const std::string& path, size_t& points_budget) {
+  if (!n.IsSequence()) fail(path, "expected a list of points [[x, y, z], ...], got " + describe(n));
+  if (n.size() < 2) fail(path, "needs at least 2 points");
+  if (n.size() > points_budget)
+    fail(path, "too many points (at most " + std::to_string(kMaxTrajectoryPoints) + " over all wells)");
+  points_budget -= n.size();
+  std::vector<Vec3> pts;
+  pts.reserve(n.size());
+  for (size_t i = 0; i < n.size(); ++i) {
+    const std::string p = index_path(path, i);
+    if (!n[i].IsSequence()) fail(p, "expected a point [x, y, z], got " + describe(n[i]));
+    const auto v = read_triple(n[i], p, "[x, y, z]");
+    pts.push_back({v[0], v[1], v[2]});
+    if (i > 0 && pts[i] == pts[i - 1]) fail(p, "repeats the previous point");
+  }
+  return pts;
+}
+
+WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_budget) {
+  const Fields f(n, path,
+                 {"name", "type", "trajectory", "radius", "drainage_radius", "rings", "sectors", "segment_length", "bhp"});
+  WellSpec w;
+  w.name = read_string(f.required("name"), f.path("name"));
+  require(matches_name_charset(w.name), f.path("name"), "must match [A-Za-z0-9_-]+");
+  require(w.name.size() <= kMaxWellNameLength, f.path("name"),
+          "at most " + std::to_string(kMaxWellNameLength) + " characters (Eclipse well names)");
+  if (auto t = f.get("type")) {
+    const std::string s = t->IsScalar() ? t->Scalar() : std::string();
+    if (t->IsScalar() && s == "producer") w.type = WellType::Producer;
+    else if (t->IsScalar() && s == "injector") w.type = WellType::Injector;
+    else fail(f.path("type"), "expected producer or injector, got " + describe(*t));
+  }
+  w.trajectory = read_trajectory(f.required("trajectory"), f.path("trajectory"), points_budget);
+  w.radius = read_number(f.required("radius"), f.path("radius"));
+  require(w.radius > 0, f.path("radius"), "must be > 0");
+  w.drainage_radius = read_number(f.required("drainage_radius"), f.path("drainage_radius"));
+  require(w.drainage_radius > w.radius, f.path("drainage_radius"), "must be > radius (" + fmt(w.radius) + ")");
+  f.integer("rings", w.rings);
+  require(w.rings >= 1, f.path("rings"), "must be >= 1");
+  f.integer("sectors", w.sectors);
+  require(w.sectors >= 3, f.path("sectors"), "must be >= 3");
+  f.number("segment_length", w.segment_length);
+  require(w.segment_length > 0, f.path("segment_length"), "must be > 0");
+  w.bhp = read_number(f.required("bhp"), f.path("bhp"));
+  require(w.bhp > 0, f.path("bhp"), "must be > 0");
+  return w;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// Cross-field checks that need the whole case: wells inside the box, unique names,
+// radial grids apart, bounded total size.
+void check_wells(const CaseSpec& cs) {
+  const ReservoirSpec& r = cs.reservoir;
+  const Vec3 lo{r.x.front(), r.y.front(), r.z.front()};
+  const Vec3 hi{r.x.back(), r.y.back(), r.z.back()};
+  double total_cells = double(r.x.size() - 1) * double(r.y.size() - 1) * double(r.z.size() - 1);
+
+  for (size_t a = 0; a < cs.wells.size(); ++a) {
+    const WellSpec& w = cs.wells[a];
+    const std::string path = index_path("wells", a);
+    // The dilated well block must fit in the box: every trajectory point strictly inside
+    // the box shrunk by drainage_radius x dilation.
+    const double margin = w.drainage_radius * cs.transition.dilation;
+    for (size_t i = 0; i < w.trajectory.size(); ++i) {
+      const Vec3 p = w.trajectory[i];
+      bool inside = true;
+      for (int d = 0; d < 3; ++d) inside = inside && p[d] > lo[d] + margin && p[d] < hi[d] - margin;
+      if (!inside)
+        fail(index_path(path + ".trajectory", i), "outside the reservoir (with drainage radius x dilation margin)");
+    }
+    for (size_t b = 0; b < a; ++b) {
+      if (cs.wells[b].name == w.name) fail(path + ".name", "duplicate of " + index_path("wells", b) + ".name");
+      if (lower(cs.wells[b].name) == lower(w.name))
+        fail(path + ".name", "duplicate of " + index_path("wells", b) +
+                                 ".name (names are compared ignoring case, as in Eclipse decks)");
+    }
+    double segments = 0;
+    for (size_t i = 0; i + 1 < w.trajectory.size(); ++i)
+      segments += std::max(1.0, std::ceil(norm(w.trajectory[i + 1] - w.trajectory[i]) / w.segment_length));
+    const double cells = double(w.rings) * double(w.sectors) * segments;
+    total_cells += cells;
+    if (total_cells > kMaxCells)
+      fail(path, "too many cells (" + std::to_string(w.rings) + " x " + std::to_string(w.sectors) + " x " +
+                     fmt_count(segments) + " = " + fmt_count(cells) +
+                     " rings x sectors x segments; at most " + fmt_count(kMaxCells) + " in the whole case)");
+  }
+
+  // Two radial grids may not overlap: polylines at least the sum of the drainage radii apart
+  // (stronger than "a block does not reach the other wellbore").
+  for (size_t b = 1; b < cs.wells.size(); ++b) {
+    for (size_t a = 0; a < b; ++a) {
+      const double limit = cs.wells[a].drainage_radius + cs.wells[b].drainage_radius;
+      const double d = polyline_distance(cs.wells[a].trajectory, cs.wells[b].trajectory, limit);
+      if (d < limit)
+        fail(index_path("wells", b) + ".trajectory",
+             "too close to " + index_path("wells", a) + " (distance " + fmt6(d) + " m < " + fmt6(limit) +
+                 " m = sum of drainage radii; radial grids may not overlap)");
+    }
+  }
+}
+
+CaseSpec read_case(const YAML::Node& root) {
+  if (!root.IsMap()) fail("case file", "expected a map with keys name, reservoir, ..., got " + describe(root));
+  const Fields f(root, "", {"name", "reservoir", "wells", "transition", "fluid"});
+  CaseSpec cs;
+  cs.name = read_string(f.required("name"), "name");
+  require(matches_name_charset(cs.name), "name", "must match [A-Za-z0-9_-]+");
+  require(cs.name.size() <= kMaxCaseNameLength, "name",
+          "at most " + std::to_string(kMaxCaseNameLength) + " characters");
+  cs.reservoir = read_reservoir(f.required("reservoir"));
+  if (auto t = f.get("transition")) cs.transition = read_transition(*t);
+  if (auto fl = f.get("fluid")) cs.fluid = read_fluid(*fl);
+  if (auto wells = f.get("wells"); wells && !wells->IsNull()) {
+    if (!wells->IsSequence()) fail("wells", "expected a list of wells, got " + describe(*wells));
+    if (wells->size() > kMaxWells)
+      fail("wells", "at most " + std::to_string(kMaxWells) + " wells (got " + std::to_string(wells->size()) + ")");
+    size_t points_budget = kMaxTrajectoryPoints;
+    for (size_t i = 0; i < wells->size(); ++i) cs.wells.push_back(read_well((*wells)[i], index_path("wells", i), points_budget));
+  }
+  check_wells(cs);
+  return cs;
+}
+
+}  // namespace
+
+CaseSpec parse_case(const std::string& yaml_text) {
+  try {
+    const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
+    if (docs.empty() || (docs.size() == 1 && docs[0].IsNull())) fail("case file", "empty document");
+    if (docs.size() > 1) fail("case file", "expected one YAML document, got " + std::to_string(docs.size()));
+    return read_case(docs[0]);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp reports its nesting limit as "bad file"; say what happened.
+    fail("case file", "YAML error at line " + std::to_string(e.mark.line + 1) + ", column " +
+                          std::to_string(e.mark.column + 1) + ": nested too deeply (" + std::to_string(e.depth()) +
+                          " levels)");
+  } catch (const YAML::Exception& e) {
+    if (e.mark.is_null()) fail("case file", "YAML error: " + printable(e.msg, 200));
+    fail("case file", "YAML error at line " + std::to_string(e.mark.line + 1) + ", column " +
+                          std::to_string(e.mark.column + 1) + ": " + printable(e.msg, 200));
+  }
+}
+
+CaseSpec load_case(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail("case file", "cannot open " + quoted(path, 300));
+  std::string text;
+  char buf[65536];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxCaseFileBytes)
+      fail("case file", quoted(path, 300) + " is larger than " + std::to_string(kMaxCaseFileBytes >> 20) + " MiB");
+  }
+  if (in.bad()) fail("case file", "cannot read " + quoted(path, 300));
+  return parse_case(text);
+}
+
+}  // namespace hm

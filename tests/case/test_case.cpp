@@ -1,0 +1,698 @@
+// Case-file loader: round trip, defaults, one exact message per validation rule,
+// robustness against malformed documents (only InputError, one-line messages).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "meshgen/case/case.hpp"
+#include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/segment_distance.hpp"
+
+using namespace hm;
+
+namespace {
+
+// Two vertical wells 40 m apart; margins: drainage 8 x dilation 1.5 = 12 m from each side.
+const std::string kBase = R"(name: paper_single_well
+reservoir:
+  x: [0, 30, 55, 80, 100]
+  y: [0, 25, 50, 75, 100]
+  z: [0, 20, 40, 60]
+  permeability: [100, 100, 10]
+  porosity: 0.2
+  initial_pressure: 200
+wells:
+  - name: P1
+    type: producer
+    trajectory: [[30, 50, 15], [30, 50, 45]]
+    radius: 0.1
+    drainage_radius: 8.0
+    rings: 6
+    sectors: 12
+    segment_length: 4.0
+    bhp: 150
+  - name: I1
+    type: injector
+    trajectory: [[70, 50, 15], [70, 50, 45]]
+    radius: 0.1
+    drainage_radius: 8.0
+    bhp: 250
+)";
+
+// Replaces the single occurrence of `from` in `text` (fails the test if it is not unique).
+std::string with(const std::string& text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "'" << from << "' not in the text";
+  if (at == std::string::npos) return text;
+  EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "'" << from << "' is not unique";
+  return text.substr(0, at) + to + text.substr(at + from.size());
+}
+
+// The InputError message of parse_case(text), or "" when it succeeds. Any other
+// exception type fails the test.
+std::string error_of(const std::string& text) {
+  try {
+    parse_case(text);
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "non-InputError exception: " << e.what();
+    return "<other exception>";
+  } catch (...) {
+    ADD_FAILURE() << "non-std exception";
+    return "<other exception>";
+  }
+  return "";
+}
+
+std::string axis(size_t n) {
+  std::string s = "[";
+  for (size_t i = 0; i < n; ++i) s += (i ? ", " : "") + std::to_string(i);
+  return s + "]";
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- valid input
+
+TEST(CaseValid, BaseCaseParses) { EXPECT_EQ(error_of(kBase), ""); }
+
+TEST(CaseValid, FullCaseRoundTripsEveryField) {
+  const std::string text = R"(name: full-case_2
+reservoir:
+  x: [-10, 0.5, 30, 1.25e2]
+  y: [0, 40, 100]
+  z: [1000, 1010, 1030, 1060]
+  permeability: [150, 120, 12.5]
+  porosity: 0.25
+  initial_pressure: 210.5
+wells:
+  - name: INJ-1_a
+    type: injector
+    trajectory: [[50, 50, 1015], [55, 52, 1030], [60, 50, 1045]]
+    radius: 0.08
+    drainage_radius: 6.5
+    rings: 5
+    sectors: 16
+    segment_length: 3.5
+    bhp: 140
+transition:
+  dilation: 1.3
+  optimize: false
+  gamma: [0.1, 0.2, 0.45]
+  omega_o: 88
+  omega_p: 5
+  expansion: 1.05
+fluid: {viscosity: 0.5, density: 950, compressibility: 4.5e-5}
+)";
+  const CaseSpec cs = parse_case(text);
+  EXPECT_EQ(cs.name, "full-case_2");
+  EXPECT_EQ(cs.reservoir.x, (std::vector<double>{-10, 0.5, 30, 125}));
+  EXPECT_EQ(cs.reservoir.y, (std::vector<double>{0, 40, 100}));
+  EXPECT_EQ(cs.reservoir.z, (std::vector<double>{1000, 1010, 1030, 1060}));
+  EXPECT_EQ(cs.reservoir.permeability, (Vec3{150, 120, 12.5}));
+  EXPECT_EQ(cs.reservoir.porosity, 0.25);
+  EXPECT_EQ(cs.reservoir.initial_pressure, 210.5);
+  ASSERT_EQ(cs.wells.size(), 1u);
+  const WellSpec& w = cs.wells[0];
+  EXPECT_EQ(w.name, "INJ-1_a");
+  EXPECT_EQ(w.type, WellType::Injector);
+  ASSERT_EQ(w.trajectory.size(), 3u);
+  EXPECT_EQ(w.trajectory[0], (Vec3{50, 50, 1015}));
+  EXPECT_EQ(w.trajectory[1], (Vec3{55, 52, 1030}));
+  EXPECT_EQ(w.trajectory[2], (Vec3{60, 50, 1045}));
+  EXPECT_EQ(w.radius, 0.08);
+  EXPECT_EQ(w.drainage_radius, 6.5);
+  EXPECT_EQ(w.rings, 5);
+  EXPECT_EQ(w.sectors, 16);
+  EXPECT_EQ(w.segment_length, 3.5);
+  EXPECT_EQ(w.bhp, 140);
+  EXPECT_EQ(cs.transition.dilation, 1.3);
+  EXPECT_FALSE(cs.transition.optimize);
+  EXPECT_EQ(cs.transition.gamma, (std::array<double, 3>{0.1, 0.2, 0.45}));
+  EXPECT_EQ(cs.transition.omega_o, 88);
+  EXPECT_EQ(cs.transition.omega_p, 5);
+  EXPECT_EQ(cs.transition.expansion, 1.05);
+  EXPECT_EQ(cs.fluid.viscosity, 0.5);
+  EXPECT_EQ(cs.fluid.density, 950);
+  EXPECT_EQ(cs.fluid.compressibility, 4.5e-5);
+}
+
+TEST(CaseValid, DefaultsApplyWhenOptionalKeysAreAbsent) {
+  const CaseSpec cs = parse_case(R"(name: minimal
+reservoir: {x: [0, 100], y: [0, 100], z: [0, 50]}
+)");
+  const CaseSpec defaults;
+  EXPECT_EQ(cs.reservoir.permeability, defaults.reservoir.permeability);
+  EXPECT_EQ(cs.reservoir.porosity, defaults.reservoir.porosity);
+  EXPECT_EQ(cs.reservoir.initial_pressure, defaults.reservoir.initial_pressure);
+  EXPECT_TRUE(cs.wells.empty());
+  EXPECT_EQ(cs.transition.dilation, defaults.transition.dilation);
+  EXPECT_EQ(cs.transition.optimize, defaults.transition.optimize);
+  EXPECT_EQ(cs.transition.gamma, defaults.transition.gamma);
+  EXPECT_EQ(cs.transition.omega_o, defaults.transition.omega_o);
+  EXPECT_EQ(cs.transition.omega_p, defaults.transition.omega_p);
+  EXPECT_EQ(cs.transition.expansion, defaults.transition.expansion);
+  EXPECT_EQ(cs.fluid.viscosity, defaults.fluid.viscosity);
+  EXPECT_EQ(cs.fluid.density, defaults.fluid.density);
+  EXPECT_EQ(cs.fluid.compressibility, defaults.fluid.compressibility);
+  // The documented values (docs/case-format.md), so that a silent change of case.hpp shows up here.
+  EXPECT_EQ(cs.reservoir.permeability, (Vec3{100, 100, 10}));
+  EXPECT_EQ(cs.reservoir.porosity, 0.2);
+  EXPECT_EQ(cs.transition.gamma, (std::array<double, 3>{0.05, 0.30, 0.40}));
+}
+
+TEST(CaseValid, WellDefaultsApplyWhenOptionalWellKeysAreAbsent) {
+  const CaseSpec cs = parse_case(kBase);
+  ASSERT_EQ(cs.wells.size(), 2u);
+  const WellSpec defaults;
+  const WellSpec& w = cs.wells[1];  // I1 gives only the required keys (+ type)
+  EXPECT_EQ(w.rings, defaults.rings);
+  EXPECT_EQ(w.sectors, defaults.sectors);
+  EXPECT_EQ(w.segment_length, defaults.segment_length);
+  EXPECT_EQ(w.type, WellType::Injector);
+  const CaseSpec untyped = parse_case(with(kBase, "    type: injector\n", ""));
+  EXPECT_EQ(untyped.wells[1].type, WellType::Producer);
+}
+
+TEST(CaseValid, NullOrEmptyOptionalBlocksMeanDefaults) {
+  const std::string base = "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\n";
+  for (const char* extra : {"wells:\n", "wells: []\n", "transition:\n", "fluid:\n", "transition: {}\n"}) {
+    SCOPED_TRACE(extra);
+    EXPECT_EQ(error_of(base + extra), "");
+  }
+  EXPECT_TRUE(parse_case(base + "wells: []\n").wells.empty());
+}
+
+TEST(CaseValid, NumberSyntaxesAccepted) {
+  const std::string base = "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], porosity: P}\n";
+  const std::vector<std::pair<std::string, double>> cases = {
+      {"0.5", 0.5}, {".5", 0.5}, {"5e-1", 0.5}, {"+0.5", 0.5}, {"1", 1.0}, {"1.", 1.0}, {"!!float 0.5", 0.5}};
+  for (const auto& [text, value] : cases) {
+    SCOPED_TRACE(text);
+    EXPECT_EQ(parse_case(with(base, "P", text)).reservoir.porosity, value);
+  }
+}
+
+TEST(CaseValid, LoadCaseReadsAFile) {
+  const std::string path = ::testing::TempDir() + "hm_test_case_load.yaml";
+  {
+    std::ofstream out(path);
+    out << kBase;
+  }
+  const CaseSpec cs = load_case(path);
+  std::remove(path.c_str());
+  EXPECT_EQ(cs.name, "paper_single_well");
+  ASSERT_EQ(cs.wells.size(), 2u);
+  EXPECT_EQ(cs.wells[1].name, "I1");
+  EXPECT_EQ(cs.wells[1].bhp, 250);
+}
+
+// The complete example in docs/case-format.md must be a valid case (keeps the doc honest).
+TEST(CaseValid, DocumentationExampleIsValid) {
+  std::ifstream in(std::string(HM_SOURCE_DIR) + "/docs/case-format.md");
+  ASSERT_TRUE(in) << "docs/case-format.md missing";
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string doc = ss.str();
+  const std::string marker = "<!-- complete example -->\n```yaml\n";
+  const size_t begin = doc.find(marker);
+  ASSERT_NE(begin, std::string::npos);
+  const size_t end = doc.find("```", begin + marker.size());
+  ASSERT_NE(end, std::string::npos);
+  const std::string example = doc.substr(begin + marker.size(), end - begin - marker.size());
+  EXPECT_EQ(error_of(example), "");
+  const CaseSpec cs = parse_case(example);
+  EXPECT_FALSE(cs.wells.empty());
+}
+
+// ---------------------------------------------------------------- file errors
+
+TEST(CaseErrors, MissingFile) {
+  try {
+    load_case("/nonexistent_dir_hm/case.yaml");
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "case file: cannot open '/nonexistent_dir_hm/case.yaml'");
+  }
+}
+
+TEST(CaseErrors, DirectoryIsNotACaseFile) {
+  try {
+    load_case(::testing::TempDir());
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("case file: cannot ", 0), 0u) << msg;
+  }
+}
+
+TEST(CaseErrors, YamlSyntaxError) {
+  EXPECT_EQ(error_of("name: a\nreservoir: {x: [0, 1\n"),
+            "case file: YAML error at line 3, column 1: end of sequence flow not found");
+  EXPECT_EQ(error_of("name: a: b\n"), "case file: YAML error at line 1, column 8: illegal map value");
+}
+
+TEST(CaseErrors, NestingTooDeep) {
+  const std::string msg = error_of(std::string(10000, '[') + std::string(10000, ']'));
+  EXPECT_EQ(msg.rfind("case file: YAML error at line 1, column ", 0), 0u) << msg;
+  EXPECT_NE(msg.find(": nested too deeply ("), std::string::npos) << msg;
+}
+
+TEST(CaseErrors, EmptyDocuments) {
+  for (const char* text : {"", "# only a comment\n", "---\n", "~\n", "   \n\n"}) {
+    SCOPED_TRACE(text);
+    EXPECT_EQ(error_of(text), "case file: empty document");
+  }
+}
+
+TEST(CaseErrors, SeveralDocuments) {
+  EXPECT_EQ(error_of(kBase + "---\nname: b\n"), "case file: expected one YAML document, got 2");
+}
+
+TEST(CaseErrors, TopLevelNotAMap) {
+  EXPECT_EQ(error_of("[1, 2]\n"), "case file: expected a map with keys name, reservoir, ..., got a list");
+  EXPECT_EQ(error_of("hello\n"), "case file: expected a map with keys name, reservoir, ..., got 'hello'");
+}
+
+// ---------------------------------------------------------------- keys
+
+TEST(CaseErrors, UnknownKeyInTransition) {
+  EXPECT_EQ(error_of(kBase + "transition:\n  dilaton: 1.2\n"),
+            "transition.dilaton: unknown key (expected one of: dilation, optimize, gamma, omega_o, omega_p, "
+            "expansion)");
+}
+
+TEST(CaseErrors, UnknownKeyAtEveryLevel) {
+  EXPECT_EQ(error_of(kBase + "wellz: []\n"),
+            "wellz: unknown key (expected one of: name, reservoir, wells, transition, fluid)");
+  EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  poro: 0.2\n")),
+            "reservoir.poro: unknown key (expected one of: x, y, z, permeability, porosity, initial_pressure)");
+  EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "    bhp: 250\n    skin: 0\n")),
+            "wells[1].skin: unknown key (expected one of: name, type, trajectory, radius, drainage_radius, rings, "
+            "sectors, segment_length, bhp)");
+  EXPECT_EQ(error_of(kBase + "fluid: {viscosity: 1, mu: 1}\n"),
+            "fluid.mu: unknown key (expected one of: viscosity, density, compressibility)");
+}
+
+TEST(CaseErrors, DuplicateKey) {
+  EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  porosity: 0.3\n")),
+            "reservoir.porosity: duplicate key");
+}
+
+TEST(CaseErrors, NonScalarKey) {
+  EXPECT_EQ(error_of(kBase + "? [1, 2]\n: 3\n"), "case file: expected a key name, got a list");
+  EXPECT_EQ(error_of(kBase + "transition: {[a]: 1}\n"), "transition: expected a key name, got a list");
+}
+
+TEST(CaseErrors, RequiredKeysMissing) {
+  EXPECT_EQ(error_of(with(kBase, "name: paper_single_well\n", "")), "name: required key is missing");
+  EXPECT_EQ(error_of("name: a\n"), "reservoir: required key is missing");
+  EXPECT_EQ(error_of(with(kBase, "  y: [0, 25, 50, 75, 100]\n", "")), "reservoir.y: required key is missing");
+  EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "")), "wells[1].bhp: required key is missing");
+  EXPECT_EQ(error_of(with(kBase, "    trajectory: [[70, 50, 15], [70, 50, 45]]\n", "")),
+            "wells[1].trajectory: required key is missing");
+}
+
+// ---------------------------------------------------------------- types
+
+TEST(CaseErrors, NotANumber) {
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: abc")), "reservoir.porosity: expected a number, got 'abc'");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: '0.2'")),
+            "reservoir.porosity: expected a number, got a quoted string '0.2'");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity:")), "reservoir.porosity: expected a number, got null");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: [0.2]")),
+            "reservoir.porosity: expected a number, got a list");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 0x10")), "reservoir.porosity: expected a number, got '0x10'");
+}
+
+TEST(CaseErrors, NanAndInfinityAreNotNumbers) {
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: .nan")), "reservoir.porosity: expected a number, got '.nan'");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: .inf")), "reservoir.porosity: expected a number, got '.inf'");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: nan")), "reservoir.porosity: expected a number, got 'nan'");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: -inf")), "reservoir.porosity: expected a number, got '-inf'");
+  EXPECT_EQ(error_of(with(kBase, "initial_pressure: 200", "initial_pressure: 1e400")),
+            "reservoir.initial_pressure: expected a finite number, got 1e400");
+}
+
+TEST(CaseErrors, NotAnInteger) {
+  EXPECT_EQ(error_of(with(kBase, "rings: 6", "rings: 2.5")), "wells[0].rings: expected an integer, got 2.5");
+  EXPECT_EQ(error_of(with(kBase, "rings: 6", "rings: six")), "wells[0].rings: expected an integer, got 'six'");
+  EXPECT_EQ(error_of(with(kBase, "sectors: 12", "sectors: 99999999999")),
+            "wells[0].sectors: integer out of range, got 99999999999");
+}
+
+TEST(CaseErrors, NotABoolean) {
+  EXPECT_EQ(error_of(kBase + "transition: {optimize: yes}\n"), "transition.optimize: expected true or false, got 'yes'");
+  EXPECT_EQ(error_of(kBase + "transition: {optimize: 1}\n"), "transition.optimize: expected true or false, got 1");
+}
+
+TEST(CaseErrors, NotAString) {
+  EXPECT_EQ(error_of(with(kBase, "name: paper_single_well", "name: [a]")), "name: expected a string, got a list");
+  EXPECT_EQ(error_of(with(kBase, "name: P1", "name:")), "wells[0].name: expected a string, got null");
+}
+
+TEST(CaseErrors, WrongBlockTypes) {
+  EXPECT_EQ(error_of("name: a\nreservoir: [1, 2]\n"), "reservoir: expected a map, got a list");
+  EXPECT_EQ(error_of(kBase + "transition: 3\n"), "transition: expected a map, got 3");
+  EXPECT_EQ(error_of("name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells: {a: 1}\n"),
+            "wells: expected a list of wells, got a map");
+  EXPECT_EQ(error_of("name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells: [P1]\n"),
+            "wells[0]: expected a map, got 'P1'");
+}
+
+TEST(CaseErrors, WellType) {
+  EXPECT_EQ(error_of(with(kBase, "type: producer", "type: producr")),
+            "wells[0].type: expected producer or injector, got 'producr'");
+}
+
+// ---------------------------------------------------------------- reservoir
+
+TEST(CaseErrors, AxisNotStrictlyIncreasing) {
+  EXPECT_EQ(error_of(with(kBase, "x: [0, 30, 55, 80, 100]", "x: [0, 30, 55, 80, 70]")),
+            "reservoir.x: not strictly increasing at index 4");
+  EXPECT_EQ(error_of(with(kBase, "x: [0, 30, 55, 80, 100]", "x: [0, 30, 30, 80, 100]")),
+            "reservoir.x: not strictly increasing at index 2");
+}
+
+TEST(CaseErrors, AxisTooShortOrNotAList) {
+  EXPECT_EQ(error_of(with(kBase, "x: [0, 30, 55, 80, 100]", "x: [0]")), "reservoir.x: needs at least 2 values");
+  EXPECT_EQ(error_of(with(kBase, "z: [0, 20, 40, 60]", "z: []")), "reservoir.z: needs at least 2 values");
+  EXPECT_EQ(error_of(with(kBase, "y: [0, 25, 50, 75, 100]", "y: 100")), "reservoir.y: expected a list of numbers, got 100");
+  EXPECT_EQ(error_of(with(kBase, "x: [0, 30, 55, 80, 100]", "x: [0, 30, a, 80, 100]")),
+            "reservoir.x[2]: expected a number, got 'a'");
+}
+
+TEST(CaseErrors, AxisTooManyValues) {
+  const std::string base = "name: a\nreservoir: {x: X, y: [0, 1], z: [0, 1]}\n";
+  EXPECT_EQ(error_of(with(base, "X", axis(kMaxAxisValues))), "");
+  EXPECT_EQ(error_of(with(base, "X", axis(kMaxAxisValues + 1))), "reservoir.x: at most 2000 values (got 2001)");
+}
+
+TEST(CaseErrors, TooManyReservoirCells) {
+  // 1999 x 1999 x 5 = 19,980,005 cells is allowed, 1999 x 1999 x 6 is not.
+  const std::string base = "name: a\nreservoir: {x: X, y: X, z: Z}\n";
+  const std::string big = axis(2000);
+  EXPECT_EQ(error_of(with(with(base, "Z", axis(6)), "x: X, y: X", "x: " + big + ", y: " + big)), "");
+  EXPECT_EQ(error_of(with(with(base, "Z", axis(7)), "x: X, y: X", "x: " + big + ", y: " + big)),
+            "reservoir: too many cells (1999 x 1999 x 6 = 23976006 > 20000000)");
+}
+
+TEST(CaseErrors, PermeabilityPorosityPressure) {
+  EXPECT_EQ(error_of(with(kBase, "permeability: [100, 100, 10]", "permeability: [100, 0, 10]")),
+            "reservoir.permeability[1]: must be > 0");
+  EXPECT_EQ(error_of(with(kBase, "permeability: [100, 100, 10]", "permeability: [100, 100]")),
+            "reservoir.permeability: expected 3 values [kx, ky, kz], got 2");
+  EXPECT_EQ(error_of(with(kBase, "permeability: [100, 100, 10]", "permeability: 100")),
+            "reservoir.permeability: expected a list of 3 numbers [kx, ky, kz], got 100");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 0")), "reservoir.porosity: must be in (0, 1]");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 1.01")), "reservoir.porosity: must be in (0, 1]");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 1")), "");
+  EXPECT_EQ(error_of(with(kBase, "initial_pressure: 200", "initial_pressure: -1")),
+            "reservoir.initial_pressure: must be > 0");
+}
+
+TEST(CaseErrors, CaseName) {
+  EXPECT_EQ(error_of(with(kBase, "name: paper_single_well", "name: paper well")), "name: must match [A-Za-z0-9_-]+");
+  EXPECT_EQ(error_of(with(kBase, "name: paper_single_well", "name: ''")), "name: must match [A-Za-z0-9_-]+");
+  EXPECT_EQ(error_of(with(kBase, "name: paper_single_well", "name: " + std::string(64, 'a'))), "");
+  EXPECT_EQ(error_of(with(kBase, "name: paper_single_well", "name: " + std::string(65, 'a'))),
+            "name: at most 64 characters");
+}
+
+// ---------------------------------------------------------------- wells
+
+TEST(CaseErrors, WellName) {
+  EXPECT_EQ(error_of(with(kBase, "name: P1", "name: P 1")), "wells[0].name: must match [A-Za-z0-9_-]+");
+  EXPECT_EQ(error_of(with(kBase, "name: P1", "name: P1234567")), "");
+  EXPECT_EQ(error_of(with(kBase, "name: P1", "name: P12345678")),
+            "wells[0].name: at most 8 characters (Eclipse well names)");
+}
+
+TEST(CaseErrors, DuplicateWellName) {
+  EXPECT_EQ(error_of(with(kBase, "name: I1", "name: P1")), "wells[1].name: duplicate of wells[0].name");
+  EXPECT_EQ(error_of(with(kBase, "name: I1", "name: p1")),
+            "wells[1].name: duplicate of wells[0].name (names are compared ignoring case, as in Eclipse decks)");
+}
+
+TEST(CaseErrors, WellRadius) {
+  EXPECT_EQ(error_of(with(kBase, "    radius: 0.1\n    drainage_radius: 8.0\n    bhp: 250",
+                          "    radius: 0\n    drainage_radius: 8.0\n    bhp: 250")),
+            "wells[1].radius: must be > 0");
+  EXPECT_EQ(error_of(with(kBase, "drainage_radius: 8.0\n    rings", "drainage_radius: 0.1\n    rings")),
+            "wells[0].drainage_radius: must be > radius (0.1)");
+  EXPECT_EQ(error_of(with(kBase, "drainage_radius: 8.0\n    rings", "drainage_radius: 0.05\n    rings")),
+            "wells[0].drainage_radius: must be > radius (0.1)");
+}
+
+TEST(CaseErrors, WellDiscretisation) {
+  EXPECT_EQ(error_of(with(kBase, "rings: 6", "rings: 0")), "wells[0].rings: must be >= 1");
+  EXPECT_EQ(error_of(with(kBase, "rings: 6", "rings: 1")), "");
+  EXPECT_EQ(error_of(with(kBase, "sectors: 12", "sectors: 2")), "wells[0].sectors: must be >= 3");
+  EXPECT_EQ(error_of(with(kBase, "sectors: 12", "sectors: 3")), "");
+  EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 0")), "wells[0].segment_length: must be > 0");
+  EXPECT_EQ(error_of(with(kBase, "bhp: 150", "bhp: 0")), "wells[0].bhp: must be > 0");
+}
+
+TEST(CaseErrors, TooManyWellCells) {
+  // 30 m / 1e-5 m = 3,000,000 segments x 6 rings x 12 sectors.
+  EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 1e-5")),
+            "wells[0]: too many cells (6 x 12 x 3000000 = 216000000 rings x sectors x segments; at most 20000000 "
+            "in the whole case)");
+}
+
+TEST(CaseErrors, TrajectoryShape) {
+  const std::string t = "trajectory: [[30, 50, 15], [30, 50, 45]]";
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [[30, 50, 15]]")), "wells[0].trajectory: needs at least 2 points");
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [30, 50, 15]")),
+            "wells[0].trajectory[0]: expected a point [x, y, z], got 30");
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [[30, 50, 15], [30, 50]]")),
+            "wells[0].trajectory[1]: expected 3 values [x, y, z], got 2");
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [[30, 50, 15], [30, 50, deep]]")),
+            "wells[0].trajectory[1][2]: expected a number, got 'deep'");
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: {a: 1}")),
+            "wells[0].trajectory: expected a list of points [[x, y, z], ...], got a map");
+}
+
+TEST(CaseErrors, TrajectoryRepeatsPoint) {
+  EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", "[[30, 50, 15], [30, 50, 45], [30, 50, 45]]")),
+            "wells[0].trajectory[2]: repeats the previous point");
+  // Coming back to an earlier (not the previous) point is not this rule.
+  EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", "[[30, 50, 15], [30, 50, 45], [30, 50, 15]]")), "");
+}
+
+TEST(CaseErrors, TrajectoryOutsideTheReservoir) {
+  // Margin 8 x 1.5 = 12: z must lie strictly inside (12, 48), x inside (12, 88).
+  const std::string t = "[[30, 50, 15], [30, 50, 45]]";
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 47.9]]")), "");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 48]]")),
+            "wells[0].trajectory[1]: outside the reservoir (with drainage radius x dilation margin)");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 30], [12, 50, 40]]")),
+            "wells[0].trajectory[2]: outside the reservoir (with drainage radius x dilation margin)");
+  // The margin follows transition.dilation: 8 x 1.0 = 8 lets z = 48 in.
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 48]]") + "transition: {dilation: 1.0}\n"), "");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 45]]") + "transition: {dilation: 2.0}\n"),
+            "wells[0].trajectory[0]: outside the reservoir (with drainage radius x dilation margin)");
+}
+
+TEST(CaseErrors, WellsTooClose) {
+  // Parallel vertical wells 10 m apart, drainage radii 8 + 8 = 16.
+  const std::string t = "trajectory: [[70, 50, 15], [70, 50, 45]]";
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [[40, 50, 15], [40, 50, 45]]")),
+            "wells[1].trajectory: too close to wells[0] (distance 10 m < 16 m = sum of drainage radii; radial "
+            "grids may not overlap)");
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [[46.5, 50, 15], [46.5, 50, 45]]")), "");
+  // Skew legs: a horizontal well passing P1's vertical axis 3 m to the side; the closest
+  // points are (30, 50, 20) on P1 and (33, 50, 20) on I1.
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [[33, 20, 20], [33, 80, 20]]")),
+            "wells[1].trajectory: too close to wells[0] (distance 3 m < 16 m = sum of drainage radii; radial "
+            "grids may not overlap)");
+  // The stronger rule: blocks overlapping without reaching the other wellbore (d = 12 > 8 + 0.1).
+  EXPECT_EQ(error_of(with(kBase, t, "trajectory: [[42, 50, 15], [42, 50, 45]]")),
+            "wells[1].trajectory: too close to wells[0] (distance 12 m < 16 m = sum of drainage radii; radial "
+            "grids may not overlap)");
+}
+
+TEST(CaseErrors, TooManyWells) {
+  std::string text = "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells:\n";
+  for (size_t i = 0; i <= kMaxWells; ++i) text += "  - {}\n";
+  EXPECT_EQ(error_of(text), "wells: at most 1000 wells (got 1001)");
+}
+
+TEST(CaseErrors, TooManyTrajectoryPoints) {
+  std::string traj = "[";
+  for (size_t i = 0; i <= kMaxTrajectoryPoints; ++i) traj += (i ? ", [50, 50, " : "[50, 50, ") + std::to_string(15 + i * 1e-3) + "]";
+  traj += "]";
+  EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", traj)),
+            "wells[0].trajectory: too many points (at most 10000 over all wells)");
+}
+
+// ---------------------------------------------------------------- transition and fluid
+
+TEST(CaseErrors, TransitionRanges) {
+  const auto bad = [&](const std::string& block) { return error_of(kBase + "transition: {" + block + "}\n"); };
+  EXPECT_EQ(bad("dilation: 0.99"), "transition.dilation: must be >= 1");
+  EXPECT_EQ(bad("dilation: 1"), "");
+  const std::string gamma_msg = "transition.gamma: must satisfy 0 < G1 <= G2 <= G3 <= 0.5";
+  EXPECT_EQ(bad("gamma: [0, 0.3, 0.4]"), gamma_msg);
+  EXPECT_EQ(bad("gamma: [0.3, 0.2, 0.4]"), gamma_msg);
+  EXPECT_EQ(bad("gamma: [0.1, 0.4, 0.3]"), gamma_msg);
+  EXPECT_EQ(bad("gamma: [0.1, 0.3, 0.51]"), gamma_msg);
+  EXPECT_EQ(bad("gamma: [0.5, 0.5, 0.5]"), "");
+  EXPECT_EQ(bad("gamma: [0.1, 0.3]"), "transition.gamma: expected 3 values [G1, G2, G3], got 2");
+  EXPECT_EQ(bad("omega_o: 79.9"), "transition.omega_o: must be in [80, 90] degrees");
+  EXPECT_EQ(bad("omega_o: 90.1"), "transition.omega_o: must be in [80, 90] degrees");
+  EXPECT_EQ(bad("omega_o: 80"), "");
+  EXPECT_EQ(bad("omega_p: -1"), "transition.omega_p: must be in [0, 10] degrees");
+  EXPECT_EQ(bad("omega_p: 10.5"), "transition.omega_p: must be in [0, 10] degrees");
+  EXPECT_EQ(bad("omega_p: 0"), "");
+  EXPECT_EQ(bad("expansion: 1"), "transition.expansion: must be in (1, 1.1]");
+  EXPECT_EQ(bad("expansion: 1.11"), "transition.expansion: must be in (1, 1.1]");
+  EXPECT_EQ(bad("expansion: 1.1"), "");
+}
+
+TEST(CaseErrors, FluidRanges) {
+  EXPECT_EQ(error_of(kBase + "fluid: {viscosity: 0}\n"), "fluid.viscosity: must be > 0");
+  EXPECT_EQ(error_of(kBase + "fluid: {density: -1}\n"), "fluid.density: must be > 0");
+  EXPECT_EQ(error_of(kBase + "fluid: {compressibility: -1e-9}\n"), "fluid.compressibility: must be >= 0");
+  EXPECT_EQ(error_of(kBase + "fluid: {compressibility: 0}\n"), "");
+}
+
+// ---------------------------------------------------------------- robustness
+
+TEST(CaseRobustness, MalformedDocumentsGiveOneLineInputErrors) {
+  const std::vector<std::string> docs = {
+      "",
+      "\n\n\n",
+      "42\n",
+      "- a\n- b\n",
+      "[[1, 2], [3, 4]]\n",
+      "name: a\nreservoir: 5\n",
+      "name: a\nreservoir: {x: {a: 1}, y: [0, 1], z: [0, 1]}\n",
+      "name: a\nreservoir: {x: [[0, 1]], y: [0, 1], z: [0, 1]}\n",
+      "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells: [[1, 2]]\n",
+      "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells: [{name: {a: b}}]\n",
+      "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells: [~, ~]\n",
+      "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nfluid: [1, 2, 3]\n",
+      "name: a\nreservoir: ~\n",
+      "name: ~\n",
+      "name: réservoir\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\n",
+      "nâme: a\n",
+      "\"na\\nme\": a\n",
+      "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\ntransition: {gamma: [[0.1], [0.2], [0.3]]}\n",
+      "name: a\nreservoir: {x: &a [0, *a], y: [0, 1], z: [0, 1]}\n",
+      "&r [*r]\n",
+      "name: a\nreservoir: &r {x: *r, y: [0, 1], z: [0, 1]}\n",
+      "name: !!binary aGVsbG8=\n",
+      "\xff\xfe\x00\x41",
+      "name: \x01\x02\n",
+      std::string("name: a\0b\n", 10),
+      "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells:\n  - name: P1\n    trajectory: [[0.5, 0.5, 0.5], "
+      "[0.5, 0.5, 0.6]]\n    radius: 0.1\n    drainage_radius: 0.4\n    bhp: 100\n",
+      "{{{{{{{{\n",
+      "'unterminated\n",
+      "key: [unbalanced}\n",
+      "\t- tab indented\n",
+      std::string(10000, '[') + std::string(10000, ']'),
+      std::string(10000, '-') + " x\n",
+  };
+  for (size_t i = 0; i < docs.size(); ++i) {
+    SCOPED_TRACE("document " + std::to_string(i));
+    const std::string msg = error_of(docs[i]);
+    EXPECT_NE(msg, "") << "accepted";
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_NE(msg.find(": "), std::string::npos) << msg;
+  }
+}
+
+TEST(CaseRobustness, UserTextIsEchoedOnOneLine) {
+  EXPECT_EQ(error_of("\"na\\nme\": a\n"),
+            "na\\nme: unknown key (expected one of: name, reservoir, wells, transition, fluid)");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: \"a\\tb\\x01\"")),
+            "reservoir.porosity: expected a number, got 'a\\tb\\x01'");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: " + std::string(100, 'q'))),
+            "reservoir.porosity: expected a number, got '" + std::string(40, 'q') + "...'");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: é")), "reservoir.porosity: expected a number, got 'é'");
+}
+
+// Deterministic mutation fuzzing of a valid case: whatever the damage, parse_case either
+// succeeds or throws a one-line InputError.
+TEST(CaseRobustness, MutatedCasesOnlyThrowInputError) {
+  std::mt19937 rng(12345);
+  const std::string alphabet = "[]{}:,-'\"#&*!|>? \n\t0123456789.eE+xyzabc~\xc3\xa9";
+  int accepted = 0, rejected = 0;
+  for (int iter = 0; iter < 3000; ++iter) {
+    std::string text = kBase;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits && !text.empty(); ++e) {
+      const size_t at = rng() % text.size();
+      switch (rng() % 4) {
+        case 0: text.erase(at, 1 + rng() % 3); break;
+        case 1: text.insert(at, 1, alphabet[rng() % alphabet.size()]); break;
+        case 2: text[at] = alphabet[rng() % alphabet.size()]; break;
+        default: {  // duplicate a chunk elsewhere
+          const size_t len = 1 + rng() % 20;
+          const std::string chunk = text.substr(at, len);
+          text.insert(rng() % text.size(), chunk);
+        }
+      }
+    }
+    const std::string msg = error_of(text);
+    if (msg.empty()) {
+      ++accepted;
+    } else {
+      ++rejected;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+  RecordProperty("accepted", accepted);
+  RecordProperty("rejected", rejected);
+  // Both outcomes occur, so the fuzzing explores valid and invalid documents.
+  EXPECT_GT(accepted, 0);
+  EXPECT_GT(rejected, 0);
+}
+
+// ---------------------------------------------------------------- segment distance
+
+TEST(SegmentDistance, KnownConfigurations) {
+  EXPECT_DOUBLE_EQ(segment_segment_distance({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}), 1.0);       // parallel
+  EXPECT_DOUBLE_EQ(segment_segment_distance({0, 0, 0}, {1, 0, 0}, {3, 0, 0}, {4, 0, 0}), 2.0);       // collinear gap
+  EXPECT_DOUBLE_EQ(segment_segment_distance({-1, 0, 0}, {1, 0, 0}, {0, -1, 2}, {0, 1, 2}), 2.0);     // skew crossing
+  EXPECT_DOUBLE_EQ(segment_segment_distance({0, 0, 0}, {1, 0, 0}, {0.5, -1, 0}, {0.5, 1, 0}), 0.0);  // intersecting
+  EXPECT_DOUBLE_EQ(segment_segment_distance({0, 0, 0}, {1, 0, 0}, {2, 1, 0}, {3, 5, 0}), std::sqrt(2.0));  // end-end
+  EXPECT_DOUBLE_EQ(segment_segment_distance({0, 0, 0}, {0, 0, 0}, {0, 3, 4}, {0, 3, 4}), 5.0);       // two points
+}
+
+// Against brute-force sampling: the exact distance is <= every sampled distance and
+// within the sampling resolution of the best one.
+TEST(SegmentDistance, MatchesBruteForceSampling) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-5, 5);
+  const int n = 200;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vec3 p0{u(rng), u(rng), u(rng)}, p1{u(rng), u(rng), u(rng)};
+    Vec3 q0{u(rng), u(rng), u(rng)}, q1{u(rng), u(rng), u(rng)};
+    if (trial % 4 == 0) q1 = q0 + (p1 - p0) * 0.7;  // parallel pairs too
+    const double d = segment_segment_distance(p0, p1, q0, q1);
+    double sampled = 1e300;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j)
+        sampled = std::min(sampled, norm((p0 + (p1 - p0) * (double(i) / n)) - (q0 + (q1 - q0) * (double(j) / n))));
+    const double resolution = (norm(p1 - p0) + norm(q1 - q0)) / n;
+    EXPECT_LE(d, sampled + 1e-12);
+    EXPECT_GE(d, sampled - resolution);
+  }
+}
+
+TEST(SegmentDistance, PolylineCutoffIsExactBelowAndBoundAbove) {
+  const std::vector<Vec3> a{{0, 0, 0}, {10, 0, 0}, {10, 10, 0}};
+  const std::vector<Vec3> b{{20, 5, 0}, {13, 5, 0}, {13, 5, 10}};
+  EXPECT_DOUBLE_EQ(polyline_distance(a, b), 3.0);
+  EXPECT_DOUBLE_EQ(polyline_distance(a, b, 3.5), 3.0);
+  EXPECT_GE(polyline_distance(a, b, 2.0), 2.0);
+}
