@@ -1,0 +1,181 @@
+#include "transmissibility.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace hm {
+
+namespace {
+
+Vec3 times_perm(Vec3 perm, Vec3 v) { return {perm.x * v.x, perm.y * v.y, perm.z * v.z}; }
+
+/// Standard TPFA half: t = A n . K c / |c|^2, c from the FV centre to the face centroid.
+double generic_half(Vec3 area_out, Vec3 perm, Vec3 c) { return dot(area_out, times_perm(perm, c)) / norm2(c); }
+
+/// Power/Voronoi cell: the face is orthogonal to the site-to-site segment, so the flux is
+/// A k_n / d with d the signed distance from the site to the face plane (n . c), exact for
+/// K-orthogonal cells. The generic form would divide by |c| >= n . c and underestimate.
+double orthogonal_half(Vec3 area_out, Vec3 perm, Vec3 c) {
+  const double a = norm(area_out);
+  if (a == 0) return 0;
+  const Vec3 n = area_out / a;
+  return a * dot(n, times_perm(perm, n)) / dot(n, c);
+}
+
+/// Radial structure of one well cell: which of its faces are ring faces, and its transverse k.
+struct RadialSides {
+  int32_t inner = -1;  ///< face at r_in (wellbore face for ring 0)
+  int32_t outer = -1;  ///< face at r_out
+  double k_perp = 0;
+};
+
+bool same_column(const RadialCellInfo& a, const RadialCellInfo& b) {
+  return a.well == b.well && a.sector == b.sector && a.segment == b.segment;
+}
+
+Vec3 unit_out(const PolyMesh& m, const MeshGeometry& g, int32_t f, int c) {
+  return normalized(m.face_sign(f, c) * g.face_area[f]);
+}
+
+RadialSides classify_radial_cell(const PolyMesh& m, const MeshGeometry& g, int c) {
+  const RadialCellInfo& me = m.cell_radial[c];
+  RadialSides out;
+  std::vector<int32_t> angular, wellbore, other;
+  Vec3 axial_sum;  // outward areas of axial faces, previous segment's side flipped
+  for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+    const int32_t f = *fp;
+    const int32_t nb = m.face_owner[f] == c ? m.face_neighbour[f] : m.face_owner[f];
+    if (nb < 0) {
+      const int32_t p = m.face_patch[f];
+      if (me.ring == 0 && is_wellbore_patch(p) && well_of_patch(p) == me.well)
+        wellbore.push_back(f);
+      else
+        other.push_back(f);
+      continue;
+    }
+    const RadialCellInfo& o = m.cell_radial[nb];
+    if (o.well >= 0 && same_column(me, o) && o.ring == me.ring - 1) {
+      out.inner = f;
+    } else if (o.well >= 0 && same_column(me, o) && o.ring == me.ring + 1) {
+      out.outer = f;
+    } else if (o.well == me.well && o.ring == me.ring && o.segment == me.segment && o.sector != me.sector) {
+      angular.push_back(f);
+    } else if (o.well == me.well && o.ring == me.ring && o.sector == me.sector && o.segment != me.segment) {
+      const Vec3 a = m.face_sign(f, c) * g.face_area[f];
+      axial_sum += o.segment > me.segment ? a : -a;
+    } else {
+      other.push_back(f);
+    }
+  }
+  if (me.ring == 0 && !wellbore.empty()) {
+    // Normally exactly one wellbore face; if several, the one facing away from the outer ring face.
+    out.inner = wellbore[0];
+    if (wellbore.size() > 1 && out.outer >= 0) {
+      const Vec3 n_out = unit_out(m, g, out.outer, c);
+      for (int32_t f : wellbore)
+        if (dot(unit_out(m, g, f, c), n_out) < dot(unit_out(m, g, out.inner, c), n_out)) out.inner = f;
+    }
+    for (int32_t f : wellbore)
+      if (f != out.inner) other.push_back(f);
+  }
+  // Outermost ring: its outer face borders a transition cell or the boundary; among the faces
+  // left, it is the one whose normal is most opposite to the inner face's.
+  if (out.outer < 0 && out.inner >= 0) {
+    const Vec3 n_in = unit_out(m, g, out.inner, c);
+    double best = 0;
+    for (int32_t f : other) {
+      const double d = dot(unit_out(m, g, f, c), n_in);
+      if (d < best) best = d, out.outer = f;
+    }
+  }
+  // Well axis: normal to both angular faces (exact for a straight leg); else normal to an
+  // angular face and the inner face; else along the axial faces.
+  Vec3 axis;
+  double quality = 0;
+  auto consider = [&](Vec3 a, Vec3 b) {
+    const double s = norm(a) * norm(b);
+    if (s == 0) return;
+    const Vec3 d = cross(a, b);
+    if (norm(d) / s > quality) quality = norm(d) / s, axis = d;
+  };
+  auto area_of = [&](int32_t f) { return m.face_sign(f, c) * g.face_area[f]; };
+  if (angular.size() >= 2) consider(area_of(angular[0]), area_of(angular[1]));
+  if (quality < 1e-3 && out.inner >= 0)
+    for (int32_t f : angular) consider(area_of(out.inner), area_of(f));
+  if (quality < 1e-3 && norm(axial_sum) > 0) axis = axial_sum, quality = 1;
+  const Vec3 k = m.cell_perm[c];
+  out.k_perp = quality >= 1e-3 ? transverse_permeability(k, normalized(axis)) : std::cbrt(k.x * k.y * k.z);
+  return out;
+}
+
+double log_half(const RadialCellInfo& r, double r_face, double k_perp) {
+  return r.angle * r.length * k_perp / std::fabs(std::log(r_face / r.r_center));
+}
+
+/// Harmonic combination written with reciprocals so that a zero half gives 0 and an infinite
+/// half gives the other one.
+double harmonic(double t1, double t2) { return 1.0 / (1.0 / t1 + 1.0 / t2); }
+
+bool is_bad(double t) { return !(t >= 0) || std::isinf(t); }
+
+}  // namespace
+
+double transverse_permeability(Vec3 k, Vec3 a) {
+  return std::sqrt(k.y * k.z * a.x * a.x + k.x * k.z * a.y * a.y + k.x * k.y * a.z * a.z);
+}
+
+Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeometry& g,
+                                              const TransmissibilityOptions& opt) {
+  const int nf = m.n_faces(), nc = m.n_cells();
+  std::vector<RadialSides> radial(nc);
+  if (opt.exact_radial)
+    for (int c = 0; c < nc; ++c)
+      if (m.cell_radial[c].well >= 0) radial[c] = classify_radial_cell(m, g, c);
+
+  const double unit = opt.metric_units ? kDarcyMetric : 1.0;
+  auto half = [&](int c, int32_t f) {
+    const Vec3 area_out = m.face_sign(f, c) * g.face_area[f];
+    const Vec3 to_face = g.face_centroid[f] - m.cell_fv_center[c];
+    const RadialSides& rs = radial[c];
+    if (f == rs.inner) return unit * log_half(m.cell_radial[c], m.cell_radial[c].r_in, rs.k_perp);
+    if (f == rs.outer) return unit * log_half(m.cell_radial[c], m.cell_radial[c].r_out, rs.k_perp);
+    if (m.cell_region[c] == kTransition) return unit * orthogonal_half(area_out, m.cell_perm[c], to_face);
+    return unit * generic_half(area_out, m.cell_perm[c], to_face);
+  };
+
+  Transmissibilities t;
+  t.half_owner.assign(nf, 0.0);
+  t.half_neighbour.assign(nf, 0.0);
+  t.face.assign(nf, 0.0);
+  for (int f = 0; f < nf; ++f) {
+    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+    t.half_owner[f] = half(o, f);
+    int bad = is_bad(t.half_owner[f]);
+    if (n >= 0) {
+      t.half_neighbour[f] = half(n, f);
+      bad += is_bad(t.half_neighbour[f]);
+      t.face[f] = harmonic(t.half_owner[f], t.half_neighbour[f]);
+    } else if (is_wellbore_patch(m.face_patch[f])) {
+      t.face[f] = t.half_owner[f];
+    }
+    t.negative += bad;
+    if (bad && static_cast<int>(t.negative_faces.size()) < kMaxListedNegative) t.negative_faces.push_back(f);
+  }
+  return t;
+}
+
+std::vector<std::vector<std::pair<int32_t, double>>> well_connection_factors(const PolyMesh& m,
+                                                                             const Transmissibilities& t, int n_wells) {
+  std::vector<std::map<int32_t, double>> sums(std::max(n_wells, 0));
+  for (int f = 0; f < m.n_faces(); ++f) {
+    if (m.face_neighbour[f] >= 0 || !is_wellbore_patch(m.face_patch[f])) continue;
+    const int w = well_of_patch(m.face_patch[f]);
+    if (w < n_wells) sums[w][m.face_owner[f]] += t.face[f];
+  }
+  std::vector<std::vector<std::pair<int32_t, double>>> out(sums.size());
+  for (size_t w = 0; w < sums.size(); ++w) out[w].assign(sums[w].begin(), sums[w].end());
+  return out;
+}
+
+}  // namespace hm
