@@ -1,0 +1,106 @@
+// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [--export vtu,eclipse,openfoam]
+// Exit codes: 0 success, 1 meshing failure, 2 bad input or arguments.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/summary.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+int usage(const std::string& why) {
+  std::cerr << "meshgen: " << why << "\n"
+            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [--export vtu,eclipse,openfoam]\n";
+  return 2;
+}
+
+// Writes text atomically (temp file + rename) so that a failure never leaves a
+// complete-looking file behind.
+bool write_text(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    if (!f) return false;
+    f << text;
+    if (!f.good()) return false;
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  return !ec;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string case_path, out_dir;
+  hm::PipelineOptions opts;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-o" || a == "--output") {
+      if (++i >= argc) return usage("-o needs a directory");
+      out_dir = argv[i];
+    } else if (a == "--no-optimize") {
+      opts.optimize = false;
+    } else if (a == "--no-transition") {
+      opts.build_transition = false;
+    } else if (a == "-h" || a == "--help") {
+      usage("help");
+      return 0;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage("unknown option '" + a + "'");
+    } else if (case_path.empty()) {
+      case_path = a;
+    } else {
+      return usage("more than one case file given");
+    }
+  }
+  if (case_path.empty()) return usage("no case file given");
+  if (out_dir.empty()) return usage("no output directory given (-o OUTDIR)");
+
+  hm::CaseSpec cs;
+  hm::HybridMesh result;
+  try {
+    cs = hm::load_case(case_path);
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (ec || !fs::is_directory(out_dir)) {
+      std::cerr << "meshgen: -o: cannot create directory '" << out_dir << "': " << ec.message() << "\n";
+      return 2;
+    }
+    result = hm::build_hybrid_mesh(cs, opts);
+  } catch (const hm::InputError& e) {
+    std::cerr << "meshgen: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "meshgen: meshing failed: " << e.what() << "\n";
+    return 1;
+  }
+
+  const fs::path out(out_dir);
+  std::vector<std::string> written;
+  for (size_t k = 0; k < result.cavities.cavities.size(); ++k) {
+    const fs::path p = out / ("cavity_" + std::to_string(k) + ".obj");
+    if (!hm::write_cavity_surface(result.cavities.cavities[k], result.cavity_node_coords, p.string())) {
+      std::cerr << "meshgen: cannot write '" << p.string() << "'\n";
+      return 2;
+    }
+    written.push_back(p.string());
+  }
+  const nlohmann::json summary = hm::make_summary(cs, result);
+  if (!write_text(out / "summary.json", summary.dump(2) + "\n")) {
+    std::cerr << "meshgen: cannot write '" << (out / "summary.json").string() << "'\n";
+    return 2;
+  }
+  written.push_back((out / "summary.json").string());
+  std::cout << "meshgen: " << cs.name << ": " << result.mesh.n_cells() << " cells ("
+            << summary["cells"]["reservoir"] << " reservoir, " << summary["cells"]["transition"] << " transition, "
+            << summary["cells"]["well"] << " well), " << summary["cavities"] << " cavities\n";
+  for (const std::string& n : result.notes) std::cout << "  note: " << n << "\n";
+  for (const std::string& w : written) std::cout << "  wrote " << w << "\n";
+  return 0;
+}

@@ -1,0 +1,124 @@
+#include "hybrid_mesh.hpp"
+
+#include <chrono>
+#include <future>
+#include <stdexcept>
+
+namespace hm {
+
+namespace {
+
+class StageTimer {
+ public:
+  explicit StageTimer(std::vector<std::pair<std::string, double>>* out) : out_(out) {}
+  void mark(const std::string& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    out_->push_back({stage, std::chrono::duration<double>(now - last_).count()});
+    last_ = now;
+  }
+
+ private:
+  std::vector<std::pair<std::string, double>>* out_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
+  HybridMesh out;
+  StageTimer timer(&out.timings_s);
+
+  out.grid = make_reservoir_grid(cs.reservoir);
+  for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w) {
+    out.blocks.push_back(make_gabriel_well_block(cs, w));
+    for (const std::string& n : out.blocks.back().notes) out.notes.push_back(n);
+  }
+  timer.mark("well_blocks");
+
+  // Nodes first (reservoir lattice, then each block) so that the cavity can name them.
+  MeshBuilder builder;
+  const std::vector<int32_t> res_nodes = add_reservoir_nodes(out.grid, builder);
+  std::vector<std::vector<int32_t>> well_nodes;
+  for (const WellBlock& b : out.blocks) {
+    well_nodes.push_back(add_well_block(b, builder));
+  }
+  std::vector<Vec3> coords(builder.n_nodes());
+  for (int32_t i = 0; i < builder.n_nodes(); ++i) coords[i] = builder.node(i);
+
+  out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords);
+  for (const std::string& n : out.cavities.notes) out.notes.push_back(n);
+  for (size_t k = 0; k < out.cavities.cavities.size(); ++k) {
+    const auto problems = check_cavity_manifold(out.cavities.cavities[k], coords);
+    if (!problems.empty())
+      throw std::runtime_error("cavity " + std::to_string(k) + ": boundary is not a closed 2-manifold: " + problems[0]);
+  }
+  out.cavity_node_coords = coords;
+  timer.mark("cavities");
+
+  add_reservoir_cells(out.grid, cs.reservoir, res_nodes, out.cavities.reservoir_active, builder);
+  timer.mark("reservoir_cells");
+
+  // Transition meshes: cavities are independent, so they are built concurrently; the
+  // result is assembled in cavity order, so the output does not depend on scheduling.
+  std::vector<TransitionCells> transitions;
+  if (opts.build_transition) {
+    const int32_t base = builder.n_nodes();
+    std::vector<std::future<TransitionCells>> jobs;
+    for (const Cavity& cav : out.cavities.cavities)
+      jobs.push_back(std::async(std::launch::async, [&, base, cavp = &cav] {
+        return build_transition(*cavp, coords, out.grid, out.blocks, base);
+      }));
+    for (auto& j : jobs) transitions.push_back(j.get());
+    timer.mark("transition");
+  }
+
+  // Assemble the transition cells; free nodes are renumbered cavity by cavity.
+  std::vector<int32_t> cell_cavity_list;
+  std::vector<double> h_ref_list;
+  for (size_t k = 0; k < transitions.size(); ++k) {
+    TransitionCells& t = transitions[k];
+    const int32_t first = builder.n_nodes();
+    for (const Vec3& p : t.new_nodes) builder.add_node(p);
+    for (size_t c = 0; c < t.cells.size(); ++c) {
+      std::vector<CellFace> faces = t.cells[c];
+      for (CellFace& f : faces)
+        for (int32_t& v : f.nodes)
+          if (v >= t.base_node_id) v = v - t.base_node_id + first;
+      CellAttributes at;
+      at.region = kTransition;
+      at.fv_center = t.sites[c];
+      at.perm = cs.reservoir.permeability;
+      at.porosity = cs.reservoir.porosity;
+      builder.add_cell(faces, at);
+      cell_cavity_list.push_back(static_cast<int32_t>(k));
+      h_ref_list.push_back(t.h_ref[c]);
+    }
+    out.transition_reports.push_back(t.report);
+  }
+
+  out.mesh = builder.finish(&out.build_report);
+  const int nc = out.mesh.n_cells();
+  out.cell_cavity.assign(nc, -1);
+  out.cell_h_ref.assign(nc, 0.0);
+  out.reservoir_cell_of.assign(nc, -1);
+  for (int c = 0, t = 0; c < nc; ++c) {
+    if (out.mesh.cell_region[c] == kTransition) {
+      out.cell_cavity[c] = cell_cavity_list[t];
+      out.cell_h_ref[c] = h_ref_list[t];
+      ++t;
+    }
+    const auto& ijk = out.mesh.cell_ijk[c];
+    if (out.mesh.cell_region[c] == kReservoir) out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
+  }
+  out.geometry = compute_geometry(out.mesh);
+  timer.mark("assembly_geometry");
+  if (opts.build_transition && !out.build_report.ok)
+    throw std::runtime_error("assembly: the hybrid mesh is not conforming: " +
+                             (out.build_report.problems.empty() ? std::string("?") : out.build_report.problems[0]) +
+                             " (" + std::to_string(out.build_report.unmatched_faces) + " unmatched, " +
+                             std::to_string(out.build_report.misoriented_faces) + " misoriented, " +
+                             std::to_string(out.build_report.overused_faces) + " overused faces)");
+  return out;
+}
+
+}  // namespace hm

@@ -1,0 +1,103 @@
+#include "summary.hpp"
+
+#include <set>
+
+#include "fvcheck/lib/quality.hpp"
+
+namespace hm {
+
+namespace {
+nlohmann::json stats_json(const Stats& s) { return {{"min", s.min}, {"max", s.max}, {"mean", s.mean}}; }
+}  // namespace
+
+nlohmann::json transition_quality(const PolyMesh& mesh, const MeshGeometry& geo, const std::vector<double>& h_ref) {
+  std::vector<bool> is_transition(mesh.n_cells());
+  std::set<int32_t> faces, vertices;
+  int cells = 0;
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    is_transition[c] = mesh.cell_region[c] == kTransition;
+    if (!is_transition[c]) continue;
+    ++cells;
+    for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f) {
+      faces.insert(*f);
+      vertices.insert(mesh.face_begin(*f), mesh.face_end(*f));
+    }
+  }
+  const auto q_s = cell_shape_quality(mesh, h_ref);
+  const auto q_o = cell_min_of_faces(mesh, face_orthogonality(mesh, geo));
+  const auto q_p = cell_max_of_faces(mesh, face_planarity(mesh, geo));
+  return {{"vertices", vertices.size()},
+          {"faces", faces.size()},
+          {"cells", cells},
+          {"Q_S", stats_json(stats_of(q_s, is_transition))},
+          {"Q_O", stats_json(stats_of(q_o, is_transition))},
+          {"Q_P", stats_json(stats_of(q_p, is_transition))}};
+}
+
+nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
+  nlohmann::json j;
+  j["case"] = cs.name;
+  int by_region[3] = {0, 0, 0};
+  for (int32_t r : h.mesh.cell_region) ++by_region[r];
+  j["cells"] = {{"reservoir", by_region[kReservoir]},
+                {"transition", by_region[kTransition]},
+                {"well", by_region[kWell]},
+                {"total", h.mesh.n_cells()}};
+  j["nodes"] = h.mesh.n_nodes();
+  j["faces"] = h.mesh.n_faces();
+  j["cavities"] = h.cavities.cavities.size();
+  nlohmann::json cav = nlohmann::json::array();
+  for (size_t k = 0; k < h.cavities.cavities.size(); ++k) {
+    const Cavity& c = h.cavities.cavities[k];
+    std::vector<std::string> names;
+    for (int w : c.wells) names.push_back(cs.wells[h.blocks[w].well].name);
+    int res_faces = 0, well_faces = 0;
+    for (const auto& f : c.faces) (f.side == FaceSide::Reservoir ? res_faces : well_faces)++;
+    cav.push_back({{"wells", names},
+                   {"deactivated_reservoir_cells", c.deactivated_cells.size()},
+                   {"constrained_faces", {{"reservoir", res_faces}, {"well", well_faces}}},
+                   {"vertices", c.vertices.size()},
+                   {"dilation_used", c.dilation_used}});
+  }
+  j["cavity_list"] = cav;
+  nlohmann::json wells = nlohmann::json::array();
+  for (const WellBlock& b : h.blocks)
+    wells.push_back({{"name", cs.wells[b.well].name},
+                     {"rings", b.rings},
+                     {"sectors", b.sectors},
+                     {"sectors_requested", b.sectors_requested},
+                     {"segments", b.layers - 1}});
+  j["wells"] = wells;
+  j["notes"] = h.notes;
+  if (!h.transition_reports.empty()) {
+    nlohmann::json t;
+    t["before"] = transition_quality(h.mesh, h.geometry, h.cell_h_ref);
+    int corrections = 0, hidden = 0, snapped = 0, removed = 0, internal = 0, external = 0;
+    for (const TransitionReport& r : h.transition_reports) {
+      corrections += r.site_corrections;
+      hidden += r.hidden_sites;
+      snapped += r.snapped_vertices;
+      removed += r.removed_faces;
+      internal += r.internal_sites;
+      external += r.external_sites;
+    }
+    t["sites"] = {{"internal", internal}, {"external", external}};
+    t["site_corrections"] = corrections;
+    t["hidden_sites"] = hidden;
+    t["snapped_vertices"] = snapped;
+    t["removed_faces"] = removed;
+    j["transition"] = t;
+  }
+  double total = 0;
+  nlohmann::json t = nlohmann::json::object();
+  for (const auto& [stage, s] : h.timings_s) {
+    t[stage] = s;
+    total += s;
+  }
+  t["total"] = total;
+  j["timings_s"] = t;
+  j["mesh_volume"] = total_volume(h.geometry);
+  return j;
+}
+
+}  // namespace hm
