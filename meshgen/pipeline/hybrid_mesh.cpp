@@ -2,9 +2,31 @@
 
 #include <chrono>
 #include <future>
+#include <set>
 #include <stdexcept>
 
 namespace hm {
+
+TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& geo, const std::vector<double>& h_ref) {
+  TransitionQuality q;
+  std::vector<bool> is_transition(mesh.n_cells());
+  std::set<int32_t> faces, vertices;
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    is_transition[c] = mesh.cell_region[c] == kTransition;
+    if (!is_transition[c]) continue;
+    ++q.cells;
+    for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f) {
+      faces.insert(*f);
+      vertices.insert(mesh.face_begin(*f), mesh.face_end(*f));
+    }
+  }
+  q.vertices = static_cast<int>(vertices.size());
+  q.faces = static_cast<int>(faces.size());
+  q.q_s = stats_of(cell_shape_quality(mesh, h_ref), is_transition);
+  q.q_o = stats_of(cell_min_of_faces(mesh, face_orthogonality(mesh, geo)), is_transition);
+  q.q_p = stats_of(cell_max_of_faces(mesh, face_planarity(mesh, geo)), is_transition);
+  return q;
+}
 
 namespace {
 
@@ -118,6 +140,21 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
                              " (" + std::to_string(out.build_report.unmatched_faces) + " unmatched, " +
                              std::to_string(out.build_report.misoriented_faces) + " misoriented, " +
                              std::to_string(out.build_report.overused_faces) + " overused faces)");
+  if (!opts.build_transition) return out;
+
+  out.transition_before = transition_quality(out.mesh, out.geometry, out.cell_h_ref);
+  if (opts.optimize && cs.transition.optimize && out.transition_before.cells > 0) {
+    OptimizeParams params;
+    params.gamma = cs.transition.gamma;
+    params.omega_o = cs.transition.omega_o;
+    params.omega_p = cs.transition.omega_p;
+    params.expansion = cs.transition.expansion;
+    out.mesh = optimize_transition(out.mesh, out.cell_h_ref, params, &out.optimize_report);
+    out.geometry = compute_geometry(out.mesh);
+    out.optimized = true;
+    out.transition_after = transition_quality(out.mesh, out.geometry, out.cell_h_ref);
+    timer.mark("optimization");
+  }
   return out;
 }
 

@@ -10,7 +10,9 @@
 #include "meshgen/core/geometry.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 #include "meshgen/grids/reservoir_grid.hpp"
+#include "fvcheck/lib/quality.hpp"
 #include "meshgen/grids/well_block.hpp"
+#include "meshgen/optimize/optimize.hpp"
 #include "meshgen/transition/transition.hpp"
 
 namespace hm {
@@ -19,6 +21,15 @@ struct PipelineOptions {
   bool build_transition = true;  ///< false: stop after the cavities (the mesh then has open cavity faces)
   bool optimize = true;          ///< run the small-edge optimisation when the case asks for it
 };
+
+/// The paper's Table 1 and 2 quantities for the transition cells of a mesh.
+struct TransitionQuality {
+  int vertices = 0;  ///< distinct nodes of the transition cells
+  int faces = 0;     ///< distinct faces of the transition cells
+  int cells = 0;
+  Stats q_s, q_o, q_p;  ///< Q_S (h = cell_h_ref), Q_O(V), Q_P(V) over the transition cells
+};
+TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& geo, const std::vector<double>& h_ref);
 
 struct HybridMesh {
   PolyMesh mesh;
@@ -32,6 +43,10 @@ struct HybridMesh {
   std::vector<double> cell_h_ref;    ///< n_cells: Q_S reference length (transition: mean constrained edge)
   std::vector<int32_t> reservoir_cell_of;  ///< n_cells: linear reservoir index of reservoir cells, -1 otherwise
   BuildReport build_report;
+  TransitionQuality transition_before;  ///< before optimisation
+  TransitionQuality transition_after;   ///< after optimisation (when optimized)
+  bool optimized = false;
+  OptimizeReport optimize_report;
   std::vector<std::string> notes;    ///< every automatic change made to the input (sectors, dilation, ...)
   std::vector<std::pair<std::string, double>> timings_s;  ///< stage name -> seconds, in stage order
 };

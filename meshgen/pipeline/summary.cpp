@@ -1,8 +1,5 @@
 #include "summary.hpp"
 
-#include <set>
-
-#include "fvcheck/lib/quality.hpp"
 
 namespace hm {
 
@@ -10,28 +7,9 @@ namespace {
 nlohmann::json stats_json(const Stats& s) { return {{"min", s.min}, {"max", s.max}, {"mean", s.mean}}; }
 }  // namespace
 
-nlohmann::json transition_quality(const PolyMesh& mesh, const MeshGeometry& geo, const std::vector<double>& h_ref) {
-  std::vector<bool> is_transition(mesh.n_cells());
-  std::set<int32_t> faces, vertices;
-  int cells = 0;
-  for (int c = 0; c < mesh.n_cells(); ++c) {
-    is_transition[c] = mesh.cell_region[c] == kTransition;
-    if (!is_transition[c]) continue;
-    ++cells;
-    for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f) {
-      faces.insert(*f);
-      vertices.insert(mesh.face_begin(*f), mesh.face_end(*f));
-    }
-  }
-  const auto q_s = cell_shape_quality(mesh, h_ref);
-  const auto q_o = cell_min_of_faces(mesh, face_orthogonality(mesh, geo));
-  const auto q_p = cell_max_of_faces(mesh, face_planarity(mesh, geo));
-  return {{"vertices", vertices.size()},
-          {"faces", faces.size()},
-          {"cells", cells},
-          {"Q_S", stats_json(stats_of(q_s, is_transition))},
-          {"Q_O", stats_json(stats_of(q_o, is_transition))},
-          {"Q_P", stats_json(stats_of(q_p, is_transition))}};
+nlohmann::json to_json(const TransitionQuality& q) {
+  return {{"vertices", q.vertices},  {"faces", q.faces},          {"cells", q.cells},
+          {"Q_S", stats_json(q.q_s)}, {"Q_O", stats_json(q.q_o)}, {"Q_P", stats_json(q.q_p)}};
 }
 
 nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
@@ -71,7 +49,15 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
   j["notes"] = h.notes;
   if (!h.transition_reports.empty()) {
     nlohmann::json t;
-    t["before"] = transition_quality(h.mesh, h.geometry, h.cell_h_ref);
+    t["before"] = to_json(h.transition_before);
+    if (h.optimized) {
+      t["after"] = to_json(h.transition_after);
+      t["optimization"] = {{"removed_uncontrolled", h.optimize_report.removed_uncontrolled},
+                           {"removed_controlled", h.optimize_report.removed_controlled},
+                           {"expanded", h.optimize_report.expanded},
+                           {"rejected", h.optimize_report.rejected},
+                           {"passes", h.optimize_report.passes}};
+    }
     int corrections = 0, hidden = 0, snapped = 0, removed = 0, internal = 0, external = 0;
     for (const TransitionReport& r : h.transition_reports) {
       corrections += r.site_corrections;

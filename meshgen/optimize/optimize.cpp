@@ -1,0 +1,415 @@
+#include "optimize.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include "meshgen/core/mesh_builder.hpp"
+
+namespace hm {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+// A mutable copy of the mesh: faces as node cycles (owner orientation) that edge
+// operations rewrite in place, with enough incidence to find the ball of a node.
+struct EditableMesh {
+  std::vector<Vec3> nodes;
+  std::vector<char> fixed;  // node used by a reservoir or well cell: never moves
+  std::vector<std::vector<int32_t>> faces;
+  std::vector<char> alive;
+  std::vector<int32_t> owner, neighbour;
+  std::vector<std::vector<int32_t>> cell_faces;
+  std::vector<std::set<int32_t>> node_faces;  // alive faces containing each node
+};
+
+struct CellMeasures {
+  bool valid = false;     // closed, >= 4 faces, non-degenerate faces, positive volume
+  bool convex = false;
+  bool centred = false;   // site strictly inside
+  double q_o = 90, q_p = 0, q_s = 1;
+};
+
+// Outward node cycle of face f seen from cell c.
+std::vector<int32_t> outward_cycle(const EditableMesh& m, int32_t f, int32_t c) {
+  std::vector<int32_t> cyc = m.faces[f];
+  if (m.owner[f] != c) std::reverse(cyc.begin(), cyc.end());
+  return cyc;
+}
+
+void face_area_centroid(const EditableMesh& m, const std::vector<int32_t>& cyc, Vec3* area, Vec3* g) {
+  Vec3 mean;
+  for (int32_t v : cyc) mean += m.nodes[v];
+  mean = mean / static_cast<double>(cyc.size());
+  Vec3 a;
+  for (size_t i = 0; i < cyc.size(); ++i) a += 0.5 * cross(m.nodes[cyc[i]] - mean, m.nodes[cyc[(i + 1) % cyc.size()]] - mean);
+  *area = a;
+  *g = mean;
+}
+
+// Paper eq. 10: the largest angle between the face normal and its fan triangles' normals.
+double face_planarity_deg(const EditableMesh& m, const std::vector<int32_t>& cyc, Vec3 area, Vec3 g) {
+  const double an = norm(area);
+  if (an == 0) return 90;
+  const Vec3 n = area / an;
+  double worst = 0;
+  for (size_t i = 0; i < cyc.size(); ++i) {
+    const Vec3 t = cross(m.nodes[cyc[i]] - g, m.nodes[cyc[(i + 1) % cyc.size()]] - g);
+    const double tn = norm(t);
+    if (tn <= 1e-12 * an) continue;
+    worst = std::max(worst, std::acos(std::min(1.0, std::abs(dot(n, t / tn)))) * kRadToDeg);
+  }
+  return worst;
+}
+
+CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std::vector<double>& h_ref, int32_t c) {
+  CellMeasures r;
+  std::vector<std::vector<int32_t>> cycles;
+  for (int32_t f : m.cell_faces[c])
+    if (m.alive[f]) cycles.push_back(outward_cycle(m, f, c));
+  if (cycles.size() < 4) return r;
+  // Combinatorial closure: each directed edge once, and its reverse once.
+  std::map<std::pair<int32_t, int32_t>, int> directed;
+  std::set<int32_t> cell_nodes;
+  for (const auto& cyc : cycles) {
+    std::set<int32_t> distinct(cyc.begin(), cyc.end());
+    if (distinct.size() != cyc.size() || cyc.size() < 3) return r;
+    for (size_t i = 0; i < cyc.size(); ++i) {
+      if (++directed[{cyc[i], cyc[(i + 1) % cyc.size()]}] > 1) return r;
+      cell_nodes.insert(cyc[i]);
+    }
+  }
+  for (const auto& [e, n] : directed)
+    if (!directed.count({e.second, e.first})) return r;
+
+  Vec3 lo = m.nodes[*cell_nodes.begin()], hi = lo;
+  for (int32_t v : cell_nodes)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], m.nodes[v][a]);
+      hi[a] = std::max(hi[a], m.nodes[v][a]);
+    }
+  const double L = norm(hi - lo);
+  const double tol = 1e-9 * L;
+  const Vec3 site = src.cell_fv_center[c];
+  double vol = 0;
+  r.convex = true;
+  r.centred = true;
+  r.q_o = 90;
+  r.q_p = 0;
+  size_t k = 0;
+  for (int32_t f : m.cell_faces[c]) {
+    if (!m.alive[f]) continue;
+    const auto& cyc = cycles[k++];
+    Vec3 area, g;
+    face_area_centroid(m, cyc, &area, &g);
+    const double an = norm(area);
+    if (an <= 1e-12 * L * L) return r;
+    const Vec3 n = area / an;
+    for (size_t i = 0; i < cyc.size(); ++i)
+      vol += dot(g - site, cross(m.nodes[cyc[i]] - site, m.nodes[cyc[(i + 1) % cyc.size()]] - site)) / 6.0;
+    for (int32_t v : cell_nodes)
+      if (std::find(cyc.begin(), cyc.end(), v) == cyc.end() && dot(n, m.nodes[v] - g) > tol) r.convex = false;
+    if (dot(n, site - g) >= -tol) r.centred = false;
+    // Q_O (eq. 8): the segment to the other cell's FV centre (or the face centroid on the boundary).
+    const int32_t other = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
+    const Vec3 u = (other >= 0 ? src.cell_fv_center[other] : g) - site;
+    const double un = norm(u);
+    r.q_o = std::min(r.q_o, un > 0 ? std::asin(std::min(1.0, std::abs(dot(u / un, n)))) * kRadToDeg : 0.0);
+    r.q_p = std::max(r.q_p, face_planarity_deg(m, cyc, area, g));
+  }
+  if (vol <= 1e-12 * L * L * L) return r;
+  // Q_S (eq. 7) over the distinct edges.
+  const double h = h_ref.size() > static_cast<size_t>(c) && h_ref[c] > 0 ? h_ref[c] : L;
+  r.q_s = 1;
+  for (const auto& [e, n] : directed) {
+    if (e.first > e.second) continue;
+    const double l = norm(m.nodes[e.first] - m.nodes[e.second]);
+    r.q_s = std::min(r.q_s, l > 0 ? std::min(l / h, h / l) : 0.0);
+  }
+  r.valid = true;
+  return r;
+}
+
+EditableMesh to_editable(const PolyMesh& mesh) {
+  EditableMesh m;
+  m.nodes = mesh.nodes;
+  m.fixed.assign(mesh.n_nodes(), 0);
+  const int nf = mesh.n_faces();
+  m.faces.resize(nf);
+  m.alive.assign(nf, 1);
+  m.owner = mesh.face_owner;
+  m.neighbour = mesh.face_neighbour;
+  m.node_faces.resize(mesh.n_nodes());
+  for (int f = 0; f < nf; ++f) {
+    m.faces[f].assign(mesh.face_begin(f), mesh.face_end(f));
+    for (int32_t v : m.faces[f]) m.node_faces[v].insert(f);
+    const int32_t o = mesh.face_owner[f], n = mesh.face_neighbour[f];
+    // Nodes of reservoir/well faces and of boundary faces (wellbore caps, outer boundary)
+    // are constrained: moving them would break conformity or change the domain.
+    const bool interior_transition = mesh.cell_region[o] == kTransition && n >= 0 && mesh.cell_region[n] == kTransition;
+    if (!interior_transition)
+      for (int32_t v : m.faces[f]) m.fixed[v] = 1;
+  }
+  m.cell_faces.resize(mesh.n_cells());
+  for (int c = 0; c < mesh.n_cells(); ++c) m.cell_faces[c].assign(mesh.cell_begin(c), mesh.cell_end(c));
+  return m;
+}
+
+PolyMesh from_editable(const EditableMesh& m, const PolyMesh& src) {
+  MeshBuilder b;
+  for (const Vec3& p : m.nodes) b.add_node(p);
+  for (int c = 0; c < src.n_cells(); ++c) {
+    std::vector<CellFace> faces;
+    for (int32_t f : m.cell_faces[c]) {
+      if (!m.alive[f]) continue;
+      CellFace cf;
+      cf.nodes = outward_cycle(m, f, c);
+      cf.patch = src.face_patch[f] == kInteriorFace ? kInteriorFace : src.face_patch[f];
+      faces.push_back(std::move(cf));
+    }
+    CellAttributes at;
+    at.region = src.cell_region[c];
+    at.fv_center = src.cell_fv_center[c];
+    at.ijk = src.cell_ijk[c];
+    at.perm = src.cell_perm[c];
+    at.porosity = src.cell_porosity[c];
+    at.radial = src.cell_radial[c];
+    b.add_cell(faces, at);
+  }
+  BuildReport rep;
+  PolyMesh out = b.finish(&rep);
+  if (!rep.ok)
+    throw std::runtime_error("optimize: the optimised mesh is not conforming: " +
+                             (rep.problems.empty() ? std::string("?") : rep.problems[0]));
+  return out;
+}
+
+class Optimizer {
+ public:
+  Optimizer(const PolyMesh& src, const std::vector<double>& h_ref, const OptimizeParams& p)
+      : src_(src), h_ref_(h_ref), p_(p), m_(to_editable(src)) {
+    const int nc = src.n_cells();
+    thr_o_.assign(nc, p.omega_o);
+    thr_p_.assign(nc, p.omega_p);
+    convex0_.assign(nc, 0);
+    centred0_.assign(nc, 0);
+    for (int c = 0; c < nc; ++c) {
+      if (src.cell_region[c] != kTransition) continue;
+      const CellMeasures cm = measure_cell(m_, src_, h_ref_, c);
+      thr_o_[c] = std::min(p.omega_o, cm.q_o);  // a cell that starts below omega_o keeps its own level
+      thr_p_[c] = std::max(p.omega_p, cm.q_p);
+      convex0_[c] = cm.valid && cm.convex;
+      centred0_[c] = cm.valid && cm.centred;
+    }
+  }
+
+  // Phase: 0 = remove without control, 1 = remove under control, 2 = expand under control.
+  int run_phase(int phase, double gamma, OptimizeReport* rep) {
+    int total = 0;
+    for (int pass = 0; pass < p_.max_passes; ++pass) {
+      ++rep->passes;
+      int changed = 0;
+      for (const auto& cand : short_edges(gamma)) {
+        const int32_t a = cand.second.first, b = cand.second.second;
+        if (!edge_exists(a, b) || norm(m_.nodes[a] - m_.nodes[b]) >= gamma * edge_h(a, b)) continue;
+        const bool ok = phase == 2 ? try_expand(a, b) : try_collapse(a, b, phase == 1);
+        if (ok) ++changed;
+        else ++rep->rejected;
+      }
+      total += changed;
+      if (changed == 0) break;
+    }
+    return total;
+  }
+
+  PolyMesh result() const { return from_editable(m_, src_); }
+
+ private:
+  struct Saved {
+    std::vector<std::pair<int32_t, std::vector<int32_t>>> faces;
+    std::vector<std::pair<int32_t, char>> alive;
+    std::vector<std::pair<int32_t, Vec3>> nodes;
+  };
+
+  bool transition_face(int32_t f) const {
+    return src_.cell_region[m_.owner[f]] == kTransition && m_.neighbour[f] >= 0 &&
+           src_.cell_region[m_.neighbour[f]] == kTransition;
+  }
+
+  // Reference length of an edge: the largest h of the transition cells around it (an edge
+  // is small if it is small for any cell that has it).
+  double edge_h(int32_t a, int32_t b) const {
+    double h = 0;
+    for (int32_t f : m_.node_faces[a]) {
+      if (!m_.alive[f] || !m_.node_faces[b].count(f)) continue;
+      for (int32_t c : {m_.owner[f], m_.neighbour[f]})
+        if (c >= 0 && src_.cell_region[c] == kTransition && c < static_cast<int32_t>(h_ref_.size())) h = std::max(h, h_ref_[c]);
+    }
+    return h;
+  }
+
+  bool edge_exists(int32_t a, int32_t b) const {
+    for (int32_t f : m_.node_faces[a]) {
+      if (!m_.alive[f]) continue;
+      const auto& cyc = m_.faces[f];
+      for (size_t i = 0; i < cyc.size(); ++i) {
+        const int32_t u = cyc[i], v = cyc[(i + 1) % cyc.size()];
+        if ((u == a && v == b) || (u == b && v == a)) return true;
+      }
+    }
+    return false;
+  }
+
+  // Candidate edges (not both fixed) shorter than gamma * h, shortest (relative) first;
+  // ties broken by node ids so that the result is deterministic.
+  std::vector<std::pair<double, std::pair<int32_t, int32_t>>> short_edges(double gamma) const {
+    std::set<std::pair<int32_t, int32_t>> seen;
+    std::vector<std::pair<double, std::pair<int32_t, int32_t>>> out;
+    for (size_t f = 0; f < m_.faces.size(); ++f) {
+      if (!m_.alive[f] || !transition_face(static_cast<int32_t>(f))) continue;
+      const auto& cyc = m_.faces[f];
+      for (size_t i = 0; i < cyc.size(); ++i) {
+        int32_t a = cyc[i], b = cyc[(i + 1) % cyc.size()];
+        if (a > b) std::swap(a, b);
+        if ((m_.fixed[a] && m_.fixed[b]) || !seen.insert({a, b}).second) continue;
+        const double h = edge_h(a, b);
+        const double l = norm(m_.nodes[a] - m_.nodes[b]);
+        if (h > 0 && l < gamma * h) out.push_back({l / h, {a, b}});
+      }
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  std::set<int32_t> ball(int32_t v) const {
+    std::set<int32_t> cells;
+    for (int32_t f : m_.node_faces[v]) {
+      if (!m_.alive[f]) continue;
+      for (int32_t c : {m_.owner[f], m_.neighbour[f]})
+        if (c >= 0 && src_.cell_region[c] == kTransition) cells.insert(c);
+    }
+    return cells;
+  }
+
+  void restore(const Saved& s) {
+    for (const auto& [f, cyc] : s.faces) m_.faces[f] = cyc;
+    for (const auto& [f, al] : s.alive) m_.alive[f] = al;
+    for (const auto& [v, p] : s.nodes) m_.nodes[v] = p;
+  }
+
+  // Validity always; with `control`, the FV controls of paper 6.2 (orthogonality and
+  // planarity thresholds per cell, auto-centering) on every touched cell.
+  bool accept(const std::set<int32_t>& cells, bool control, const std::set<int32_t>* must_improve_qs,
+              double qs_before) {
+    std::vector<std::pair<int32_t, CellMeasures>> measured;
+    double qs_sum = 0;
+    for (int32_t c : cells) {
+      const CellMeasures cm = measure_cell(m_, src_, h_ref_, c);
+      if (!cm.valid || (convex0_[c] && !cm.convex)) return false;
+      if (control && (cm.q_o < thr_o_[c] || cm.q_p > thr_p_[c] || (centred0_[c] && !cm.centred))) return false;
+      qs_sum += cm.q_s;
+      measured.push_back({c, cm});
+    }
+    if (must_improve_qs && qs_sum / std::max<size_t>(1, cells.size()) <= qs_before) return false;
+    // A cell's thresholds follow its improvements (paper 6.2).
+    for (const auto& [c, cm] : measured) {
+      thr_o_[c] = std::max(thr_o_[c], std::min(p_.omega_o, cm.q_o));
+      thr_p_[c] = std::min(thr_p_[c], std::max(p_.omega_p, cm.q_p));
+    }
+    return true;
+  }
+
+  bool try_collapse(int32_t a, int32_t b, bool control) {
+    if (m_.fixed[b] && !m_.fixed[a]) std::swap(a, b);  // keep the constrained vertex in place
+    if (m_.fixed[a] && m_.fixed[b]) return false;
+    const Vec3 target = m_.fixed[a] ? m_.nodes[a] : 0.5 * (m_.nodes[a] + m_.nodes[b]);
+    // Touched: faces that lose b, and faces of a when a moves (case 1); their cells are
+    // the ones to check (B_b, or B_a u B_b).
+    std::set<int32_t> cells = ball(b);
+    if (!m_.fixed[a])
+      for (int32_t c : ball(a)) cells.insert(c);
+    Saved s;
+    s.nodes = {{a, m_.nodes[a]}, {b, m_.nodes[b]}};
+    std::set<int32_t> touched;
+    for (int32_t f : m_.node_faces[b])
+      if (m_.alive[f]) touched.insert(f);
+    if (!m_.fixed[a])
+      for (int32_t f : m_.node_faces[a])
+        if (m_.alive[f]) touched.insert(f);
+    for (int32_t f : touched) {
+      if (!transition_face(f)) return false;  // never rewrite a reservoir or well face
+      s.faces.push_back({f, m_.faces[f]});
+      s.alive.push_back({f, m_.alive[f]});
+    }
+    m_.nodes[a] = target;
+    for (int32_t f : touched) {
+      std::vector<int32_t> cyc;
+      for (int32_t v : m_.faces[f]) {
+        const int32_t w = v == b ? a : v;
+        if (cyc.empty() || cyc.back() != w) cyc.push_back(w);
+      }
+      while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
+      m_.faces[f] = cyc;
+      if (cyc.size() < 3) m_.alive[f] = 0;
+    }
+    if (!accept(cells, control, nullptr, 0)) {
+      restore(s);
+      return false;
+    }
+    for (int32_t f : m_.node_faces[b])
+      if (m_.alive[f]) m_.node_faces[a].insert(f);
+    m_.node_faces[b].clear();
+    for (auto it = m_.node_faces[a].begin(); it != m_.node_faces[a].end();)
+      it = m_.alive[*it] ? std::next(it) : m_.node_faces[a].erase(it);
+    ++collapsed_;
+    return true;
+  }
+
+  bool try_expand(int32_t a, int32_t b) {
+    if (m_.fixed[b] && !m_.fixed[a]) std::swap(a, b);
+    if (m_.fixed[a] && m_.fixed[b]) return false;
+    const Vec3 ab = m_.nodes[b] - m_.nodes[a];
+    const double s = 0.5 * (p_.expansion - 1.0);
+    std::set<int32_t> cells = ball(b);
+    if (!m_.fixed[a])
+      for (int32_t c : ball(a)) cells.insert(c);
+    double qs_before = 0;
+    for (int32_t c : cells) qs_before += measure_cell(m_, src_, h_ref_, c).q_s;
+    qs_before /= std::max<size_t>(1, cells.size());
+    Saved saved;
+    saved.nodes = {{a, m_.nodes[a]}, {b, m_.nodes[b]}};
+    if (!m_.fixed[a]) m_.nodes[a] = m_.nodes[a] - s * ab;
+    m_.nodes[b] = m_.nodes[b] + s * ab;
+    if (!accept(cells, true, &cells, qs_before)) {
+      restore(saved);
+      return false;
+    }
+    return true;
+  }
+
+  const PolyMesh& src_;
+  const std::vector<double>& h_ref_;
+  OptimizeParams p_;
+  EditableMesh m_;
+  std::vector<double> thr_o_, thr_p_;
+  std::vector<char> convex0_, centred0_;  // initial state: a control never makes a cell worse
+  int collapsed_ = 0;
+};
+
+}  // namespace
+
+PolyMesh optimize_transition(const PolyMesh& mesh, const std::vector<double>& h_ref, const OptimizeParams& params,
+                             OptimizeReport* report) {
+  OptimizeReport rep;
+  Optimizer opt(mesh, h_ref, params);
+  rep.removed_uncontrolled = opt.run_phase(0, params.gamma[0], &rep);
+  rep.removed_controlled = opt.run_phase(1, params.gamma[1], &rep);
+  rep.expanded = opt.run_phase(2, params.gamma[2], &rep);
+  if (report) *report = rep;
+  return opt.result();
+}
+
+}  // namespace hm

@@ -1,0 +1,37 @@
+// Optimisation of the transition mesh (paper 6.2): small edges are removed, then
+// expanded, under finite-volume controls. Constrained vertices (those of the reservoir
+// and well grids) never move, so conformity with the structured grids and the total
+// volume are preserved; every accepted change keeps the touched cells closed, convex
+// (if they were) and with positive volume.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "meshgen/core/polymesh.hpp"
+
+namespace hm {
+
+struct OptimizeParams {
+  std::array<double, 3> gamma{0.05, 0.30, 0.40};  ///< G1, G2, G3: edge thresholds as fractions of h
+  double omega_o = 85;     ///< orthogonality threshold (deg): a cell is orthogonal if Q_O(V) >= it
+  double omega_p = 10;     ///< planarity threshold (deg): a cell is planar if Q_P(V) <= it
+  double expansion = 1.1;  ///< edge expansion coefficient alpha, 1 < alpha <= 1.1
+  int max_passes = 30;     ///< passes per phase before giving up on a fixed point
+};
+
+struct OptimizeReport {
+  int removed_uncontrolled = 0;  ///< phase 1: edges < G1 h
+  int removed_controlled = 0;    ///< phase 2: edges < G2 h, under FV controls
+  int expanded = 0;              ///< phase 3: edges < G3 h, expanded
+  int rejected = 0;              ///< candidate operations refused by a control
+  int passes = 0;
+};
+
+/// Optimises the transition cells (region kTransition) of `mesh`. h_ref[c] is the Q_S
+/// reference length of cell c (used for transition cells). Returns the new mesh: same
+/// cells in the same order with the same attributes; nodes renumbered.
+PolyMesh optimize_transition(const PolyMesh& mesh, const std::vector<double>& h_ref, const OptimizeParams& params,
+                             OptimizeReport* report);
+
+}  // namespace hm
