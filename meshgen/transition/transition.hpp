@@ -19,6 +19,18 @@ struct TransitionReport {
   int snapped_vertices = 0;     ///< power vertices identified with constrained vertices (5.7)
   int removed_faces = 0;        ///< faces degenerated to < 3 nodes by conformity
   std::vector<std::string> notes;
+  // ---- added by the transition module (docs/transition.md)
+  int box_sites = 0;            ///< internal sites that are deactivated-cell centres (n > 1 rule)
+  int split_boxes = 0;          ///< box sites replaced by per-polygon sites (sphere not empty / correction)
+  int emptiness_fixes = 0;      ///< sites moved so that their sphere holds no other cavity vertex
+  int hidden_repairs = 0;       ///< rebuilds after moving hidden internal sites
+  int power_vertices = 0;       ///< distinct power vertices used by the cells (after exact merging)
+  int merged_cells = 0;         ///< RT cells merged into another's power vertex (co-spherical sites)
+  int identified_vertices = 0;  ///< power vertices identified with a constrained vertex combinatorially
+  int free_vertices = 0;        ///< new nodes (transition-only vertices)
+  int unmatched_external_faces = 0;  ///< external faces that are not exactly a constrained polygon (bug)
+  int missing_polygons = 0;     ///< constrained polygons that are no face of any cell (bug)
+  int faces = 0;                ///< distinct faces of the transition cells
 };
 
 /// Transition cells of one cavity, ready for the builder.
@@ -32,6 +44,8 @@ struct TransitionCells {
   std::vector<Vec3> sites;        ///< FV centre of each cell (its site)
   std::vector<double> weights;    ///< power weight (radius) of each cell's site
   std::vector<double> h_ref;      ///< mean edge length of the cell's constrained polygons (Q_S's h)
+  /// Per cell: the cavity face indices (constrained polygons) that are faces of this cell.
+  std::vector<std::vector<int32_t>> cell_polygons;
   TransitionReport report;
 };
 
@@ -41,5 +55,16 @@ struct TransitionCells {
 TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
                                  const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                                  int32_t base_node_id);
+
+/// Dual (Voronoi) edge parameters of each constrained polygon, found from the Delaunay
+/// tetrahedra attached to it (paper 5.3): the internal Voronoi vertex is O + t_in n, the
+/// external one O + t_out n (O circumcentre, n unit normal into the cavity; +-inf if none).
+/// Exposed for tests (cross-check against a brute-force empty-sphere search).
+struct PolygonDual {
+  Vec3 center, normal;
+  double radius = 0, t_in = 0, t_out = 0;
+  int inner_tets = 0, outer_tets = 0;
+};
+std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<Vec3>& node_coords);
 
 }  // namespace hm

@@ -1,0 +1,92 @@
+// Driver of the transition mesh of one cavity (paper 5.2-5.7). CGAL-free: the two CGAL
+// stages are in transition_delaunay.cpp and transition_power.cpp.
+#include "transition.hpp"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "transition_internal.hpp"
+
+namespace hm {
+
+using namespace transition_detail;
+
+namespace {
+constexpr int kMaxCorrectionIterations = 100;
+constexpr int kMaxHiddenRepairs = 8;
+constexpr double kHiddenShrink = 0.7;
+
+std::vector<PolygonFrame> frames_of(const Cavity& cavity, const std::vector<Vec3>& coords,
+                                    std::vector<std::string>& notes) {
+  std::vector<PolygonFrame> frames;
+  frames.reserve(cavity.faces.size());
+  for (const ConstrainedFace& f : cavity.faces) frames.push_back(fit_polygon(f.nodes, coords));
+  attach_voronoi_edges(cavity, coords, frames, notes);
+  return frames;
+}
+}  // namespace
+
+std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<Vec3>& node_coords) {
+  std::vector<std::string> notes;
+  const std::vector<PolygonFrame> frames = frames_of(cavity, node_coords, notes);
+  std::vector<PolygonDual> out;
+  for (const PolygonFrame& f : frames)
+    out.push_back({f.center, f.normal, f.radius, f.t_in, f.t_out, f.inner_tets, f.outer_tets});
+  return out;
+}
+
+TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
+                                 const ReservoirGrid& grid, const std::vector<WellBlock>& /*blocks*/,
+                                 int32_t base_node_id) {
+  TransitionReport report;
+  const std::vector<PolygonFrame> frames = frames_of(cavity, node_coords, report.notes);
+  SiteSet set = make_sites(cavity, node_coords, grid, frames, report.notes);
+  enforce_empty_spheres(set, cavity, node_coords, grid, frames);
+  int iterations = 0;
+  report.site_corrections = correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
+  report.correction_iterations = iterations;
+
+  TransitionCells out;
+  for (int round = 0;; ++round) {
+    out = TransitionCells{};
+    out.base_node_id = base_node_id;
+    const std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out);
+    if (hidden.empty()) break;
+    for (int s : hidden) {
+      std::ostringstream os;
+      os << "site " << s << (set.sites[s].internal() ? " (internal" : " (external") << ", polygon "
+         << set.sites[s].polygons.front() << ") is hidden: moved toward its polygon and rebuilt";
+      if (report.notes.size() < 50) report.notes.push_back(os.str());
+      if (set.sites[s].internal()) ++report.hidden_sites;
+    }
+    if (round == kMaxHiddenRepairs) {
+      std::ostringstream os;
+      os << "transition: " << hidden.size() << " sites stay hidden after " << kMaxHiddenRepairs << " repairs";
+      throw std::runtime_error(os.str());
+    }
+    ++report.hidden_repairs;
+    for (int s : hidden) shrink_or_split(set, s, kHiddenShrink, cavity, node_coords, grid, frames);
+    enforce_empty_spheres(set, cavity, node_coords, grid, frames);
+    report.site_corrections +=
+        correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
+    report.correction_iterations += iterations;
+  }
+  // Merge the stage reports.
+  TransitionReport& r = out.report;
+  r.site_corrections = report.site_corrections;
+  r.correction_iterations = report.correction_iterations;
+  r.hidden_sites = report.hidden_sites;
+  r.hidden_repairs = report.hidden_repairs;
+  r.notes.insert(r.notes.begin(), report.notes.begin(), report.notes.end());
+  for (const Site& s : set.sites) {
+    if (!s.alive) continue;
+    if (s.internal()) ++r.internal_sites;
+    else if (s.kind != SiteKind::Guard) ++r.external_sites;
+    if (s.kind == SiteKind::InternalBox) ++r.box_sites;
+  }
+  r.split_boxes = set.splits;
+  r.emptiness_fixes = set.emptiness_fixes;
+  return out;
+}
+
+}  // namespace hm

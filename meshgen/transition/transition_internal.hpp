@@ -1,0 +1,99 @@
+// Internal stages of the transition mesh (paper 5.2-5.7), shared by the .cpp files of
+// this folder. CGAL-free: the two CGAL stages (Delaunay of the cavity vertices, power
+// diagram of the sites) live in their own translation units and talk through these types.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "meshgen/cavity/cavity.hpp"
+#include "meshgen/core/vec3.hpp"
+#include "transition.hpp"
+
+namespace hm::transition_detail {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Frame of one constrained polygon: the line through its circumcentre O along its unit
+/// normal n (into the cavity) carries its Voronoi (dual) edge, points O + t n.
+struct PolygonFrame {
+  Vec3 center;           ///< O: centre of the least-squares circle through the nodes, in the mean plane
+  Vec3 normal;           ///< n: unit, pointing into the cavity
+  double radius = 0;     ///< rho: circumradius (least squares)
+  double circle_error = 0;  ///< max | |X - O| - rho | over the nodes (0 when co-circular)
+  double mean_edge = 0;  ///< mean edge length
+  /// Voronoi vertices of the polygon on its dual line (5.3): t of the barycentre of the
+  /// circumcentres of the attached Delaunay tetrahedra inside (t_in > 0) and outside
+  /// (t_out < 0) the cavity; +-kInf when none was found.
+  double t_in = kInf, t_out = -kInf;
+  int inner_tets = 0, outer_tets = 0, sliver_tets = 0;
+};
+
+/// Least-squares circle of a polygon (exact for co-circular planar polygons).
+PolygonFrame fit_polygon(const std::vector<int32_t>& nodes, const std::vector<Vec3>& coords);
+
+/// Stage 5.2-5.3 (CGAL Delaunay_triangulation_3): fills t_in/t_out and the tet counts of
+/// every frame from the tetrahedra attached to each polygon. Notes polygons that are not
+/// Delaunay faces.
+void attach_voronoi_edges(const Cavity& cavity, const std::vector<Vec3>& coords,
+                          std::vector<PolygonFrame>& frames, std::vector<std::string>& notes);
+
+enum class SiteKind : int {
+  InternalBox = 0,      ///< centre of a deactivated reservoir cell, weight = half diagonal (fixed)
+  InternalPolygon = 1,  ///< on one polygon's dual line, O + t n (movable)
+  ExternalBox = 2,      ///< centre of an active reservoir cell, weight = half diagonal (fixed)
+  ExternalMirror = 3,   ///< reflection of the polygon's internal site through O (5.4.2)
+  Guard = 4,            ///< far point of weight 0 that bounds every cell
+};
+
+struct Site {
+  SiteKind kind = SiteKind::InternalBox;
+  Vec3 p;
+  double w2 = 0;          ///< squared weight (CGAL's weight)
+  bool alive = true;      ///< false once replaced (a split box)
+  int reservoir_cell = -1;  ///< boxes: reservoir linear cell index
+  int polygon = -1;       ///< InternalPolygon / ExternalMirror: its polygon
+  double t = 0;           ///< InternalPolygon: parameter on the dual line
+  std::vector<int> polygons;       ///< constrained polygons of this site (cavity face indices)
+  std::vector<int32_t> vertices;   ///< sorted distinct global node ids of those polygons
+  bool internal() const { return kind == SiteKind::InternalBox || kind == SiteKind::InternalPolygon; }
+};
+
+struct SiteSet {
+  std::vector<Site> sites;
+  std::vector<int> internal_of;  ///< per polygon: its internal site
+  std::vector<int> external_of;  ///< per polygon: its external site
+  int splits = 0;                ///< boxes replaced by per-polygon sites
+  int emptiness_fixes = 0;       ///< sites moved because their sphere held a cavity vertex
+};
+
+/// Stage 5.4: one site per deactivated cell (box) or per polygon, plus external sites.
+SiteSet make_sites(const Cavity& cavity, const std::vector<Vec3>& coords, const ReservoirGrid& grid,
+                   const std::vector<PolygonFrame>& frames, std::vector<std::string>& notes);
+
+/// Keeps every site's sphere free of other cavity vertices (a conformity condition:
+/// every constrained vertex must be a power vertex). Returns the number of fixes.
+int enforce_empty_spheres(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                          const ReservoirGrid& grid, const std::vector<PolygonFrame>& frames);
+
+/// Stage 5.5.3: auto-centering correction. Returns the number of corrected pairs over all
+/// iterations, sets *iterations; throws std::runtime_error when it does not converge.
+int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                  const ReservoirGrid& grid, const std::vector<PolygonFrame>& frames, int max_iterations,
+                  int* iterations);
+
+/// Moves a movable site toward its polygon (alpha in (0,1)) or splits a fixed box site;
+/// used by the correction and by the hidden-site repair.
+void shrink_or_split(SiteSet& set, int site, double alpha, const Cavity& cavity,
+                     const std::vector<Vec3>& coords, const ReservoirGrid& grid,
+                     const std::vector<PolygonFrame>& frames);
+
+/// Stage 5.6-5.7 (CGAL Regular_triangulation_3): power cells of the internal sites,
+/// power vertices identified combinatorially, external faces snapped to the constrained
+/// polygons. Fills `out` (cells, new nodes, report counters). Returns the ids of internal
+/// sites that are hidden (no cell); nothing is emitted then.
+std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                   const std::vector<PolygonFrame>& frames, TransitionCells& out);
+
+}  // namespace hm::transition_detail

@@ -1,0 +1,456 @@
+// Paper 5.6-5.7: power diagram of the cavity sites (CGAL Regular_triangulation_3) and
+// its conformity with the constrained polygons. One of the two CGAL translation units.
+//
+// Power vertices are identified combinatorially (as geogram does): RT cells whose power
+// spheres coincide (exact predicate across a facet) are one vertex (union-find), and a
+// vertex whose four sites share exactly one constrained node IS that node. Only what is
+// left on the external faces is snapped to the nearest constrained vertex (5.7).
+#include <CGAL/Cartesian_converter.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_3.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+#include "transition_internal.hpp"
+
+namespace hm::transition_detail {
+
+namespace {
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vbb = CGAL::Regular_triangulation_vertex_base_3<K>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, Vbb>;
+using Cbb = CGAL::Regular_triangulation_cell_base_3<K>;
+using Cb = CGAL::Triangulation_cell_base_with_info_3<int, K, Cbb>;
+using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
+using Regular = CGAL::Regular_triangulation_3<K, Tds>;
+using WPoint = K::Weighted_point_3;
+using BPoint = K::Point_3;
+using EK = CGAL::Exact_predicates_exact_constructions_kernel;
+
+// The power vertex of a cell, computed exactly and rounded once: the double formula loses
+// up to 1e-8 relative on the nearly flat cells that co-spherical sites produce, which
+// would tilt the faces (orthogonality is checked to 1e-9 degrees).
+Vec3 exact_power_center(const Regular::Cell_handle& c) {
+  const CGAL::Cartesian_converter<K, EK> to_exact;
+  const EK::Point_3 p = EK().construct_weighted_circumcenter_3_object()(
+      to_exact(c->vertex(0)->point()), to_exact(c->vertex(1)->point()), to_exact(c->vertex(2)->point()),
+      to_exact(c->vertex(3)->point()));
+  return Vec3{CGAL::to_double(CGAL::exact(p.x())), CGAL::to_double(CGAL::exact(p.y())),
+              CGAL::to_double(CGAL::exact(p.z()))};
+}
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  bool unite(int a, int b) {
+    a = find(a), b = find(b);
+    if (a == b) return false;
+    if (b < a) std::swap(a, b);
+    parent[b] = a;
+    return true;
+  }
+};
+
+std::vector<int32_t> intersect(const std::vector<int32_t>& a, const std::vector<int32_t>& b) {
+  std::vector<int32_t> out;
+  std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  return out;
+}
+
+// A vertex of a face cycle before numbering: a constrained node id (>= 0) or a free power
+// vertex, encoded as -1 - class.
+using Token = int64_t;
+
+// Removes consecutive repeats and spikes (x y x -> x) cyclically: what vertex
+// identification leaves in a face. Both keep a closed cell surface closed.
+void clean_cycle(std::vector<Token>& c) {
+  bool changed = true;
+  while (changed && c.size() >= 2) {
+    changed = false;
+    for (size_t i = 0; i < c.size() && c.size() >= 2; ++i) {
+      const size_t n = c.size(), j = (i + 1) % n;
+      if (c[i] == c[j]) {
+        c.erase(c.begin() + static_cast<long>(j));
+        changed = true;
+        break;
+      }
+      if (n >= 3 && c[i] == c[(i + 2) % n]) {  // spike i -> i+1 -> i
+        const size_t a = j, b = (i + 2) % n;
+        c.erase(c.begin() + static_cast<long>(std::max(a, b)));
+        c.erase(c.begin() + static_cast<long>(std::min(a, b)));
+        changed = true;
+        break;
+      }
+    }
+  }
+}
+
+std::vector<int32_t> rotate_to_min(std::vector<int32_t> c) {
+  std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+  return c;
+}
+
+bool same_cycle(const std::vector<int32_t>& a, const std::vector<int32_t>& b) {
+  return a.size() == b.size() && rotate_to_min(a) == rotate_to_min(b);
+}
+
+struct RawFace {
+  int s = -1, t = -1;          // sites; s internal; cycle is outward for s
+  std::vector<int> classes;    // power vertex classes in cycle order
+  bool external = false;       // t is an external site
+};
+}  // namespace
+
+std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                   const std::vector<PolygonFrame>& frames, TransitionCells& out) {
+  const int ns = static_cast<int>(set.sites.size());
+  TransitionReport& rep = out.report;
+  // ---- regular triangulation of the sites plus 8 far guard points of weight 0
+  std::vector<std::pair<WPoint, int>> points;
+  Vec3 lo{kInf, kInf, kInf}, hi = -lo;
+  for (int s = 0; s < ns; ++s) {
+    const Site& site = set.sites[s];
+    if (!site.alive || site.kind == SiteKind::Guard) continue;
+    points.emplace_back(WPoint(BPoint(site.p.x, site.p.y, site.p.z), site.w2), s);
+    const double r = std::sqrt(site.w2);
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], site.p[k] - r), hi[k] = std::max(hi[k], site.p[k] + r);
+  }
+  const double margin = norm(hi - lo);
+  for (int c = 0; c < 8; ++c)
+    points.emplace_back(WPoint(BPoint((c & 1) ? hi.x + margin : lo.x - margin, (c & 2) ? hi.y + margin : lo.y - margin,
+                                      (c & 4) ? hi.z + margin : lo.z - margin),
+                               0.0),
+                        ns + c);
+  Regular rt(points.begin(), points.end());
+
+  std::vector<Regular::Vertex_handle> vertex_of(ns + 8);
+  for (auto v : rt.finite_vertex_handles()) vertex_of[v->info()] = v;
+  std::vector<int> hidden;
+  for (int s = 0; s < ns; ++s)
+    if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard && vertex_of[s] == Regular::Vertex_handle())
+      hidden.push_back(s);
+  if (!hidden.empty()) return hidden;
+  auto is_guard = [&](int id) { return id >= ns; };
+  auto is_internal = [&](int id) { return id < ns && set.sites[id].internal(); };
+
+  // ---- power vertices: merge cells with the same power sphere (exact), union-find
+  std::vector<Regular::Cell_handle> cells;
+  for (auto c : rt.finite_cell_handles()) {
+    c->info() = static_cast<int>(cells.size());
+    cells.push_back(c);
+  }
+  const int nc = static_cast<int>(cells.size());
+  UnionFind uf(nc);
+  const auto power_side = rt.geom_traits().power_side_of_oriented_power_sphere_3_object();
+  int merged = 0;
+  for (int a = 0; a < nc; ++a) {
+    const Regular::Cell_handle c = cells[a];
+    for (int i = 0; i < 4; ++i) {
+      const Regular::Cell_handle n = c->neighbor(i);
+      if (rt.is_infinite(n) || n->info() < a) continue;
+      const Regular::Vertex_handle opp = n->vertex(n->index(c));
+      if (power_side(c->vertex(0)->point(), c->vertex(1)->point(), c->vertex(2)->point(), c->vertex(3)->point(),
+                        opp->point()) == CGAL::ON_ORIENTED_BOUNDARY)
+        merged += uf.unite(a, n->info()) ? 1 : 0;
+    }
+  }
+  rep.merged_cells = merged;
+
+  // Per class (lazily, for classes used by a face of an internal site): a deterministic
+  // key (smallest sorted site tuple of its cells), coordinates, identified node.
+  struct ClassInfo {
+    bool done = false;
+    std::array<int, 4> key{};
+    Vec3 point;
+    int32_t node = -1;     // identified constrained node, -1 if free
+    int ambiguous = 0;
+  };
+  std::vector<ClassInfo> info(nc);
+  std::map<int, std::vector<int>> class_cells;
+  for (int a = 0; a < nc; ++a) class_cells[uf.find(a)].push_back(a);
+  auto class_info = [&](int cls) -> ClassInfo& {
+    ClassInfo& ci = info[cls];
+    if (ci.done) return ci;
+    ci.done = true;
+    bool first = true;
+    int rep_cell = -1;
+    std::vector<int32_t> candidates;
+    for (int a : class_cells[cls]) {
+      std::array<int, 4> key;
+      for (int i = 0; i < 4; ++i) key[i] = cells[a]->vertex(i)->info();
+      std::sort(key.begin(), key.end());
+      if (first || key < ci.key) ci.key = key, rep_cell = a, first = false;
+      std::vector<int32_t> common;
+      bool has_guard = false;
+      for (int i = 0; i < 4; ++i) {
+        if (is_guard(key[i])) { has_guard = true; break; }
+        common = i == 0 ? set.sites[key[i]].vertices : intersect(common, set.sites[key[i]].vertices);
+      }
+      if (has_guard) continue;
+      if (common.size() == 1) candidates.push_back(common[0]);
+      else if (common.size() > 1) ++ci.ambiguous, candidates.insert(candidates.end(), common.begin(), common.end());
+    }
+    ci.point = exact_power_center(cells[rep_cell]);
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    if (!candidates.empty()) {
+      if (candidates.size() > 1) ++ci.ambiguous;
+      ci.node = candidates[0];
+      for (int32_t v : candidates)
+        if (norm2(coords[v] - ci.point) < norm2(coords[ci.node] - ci.point)) ci.node = v;
+    }
+    return ci;
+  };
+
+  // ---- faces: one per RT edge with an internal endpoint, from the cells around it
+  std::vector<RawFace> faces;
+  for (auto e : rt.finite_edges()) {
+    const Regular::Cell_handle c = e.first;
+    int s = c->vertex(e.second)->info(), t = c->vertex(e.third)->info();
+    const bool si = is_internal(s), ti = is_internal(t);
+    if (!si && !ti) continue;
+    RawFace f;
+    auto circ = rt.incident_cells(e), done = circ;
+    bool unbounded = false;
+    do {
+      if (rt.is_infinite(circ)) { unbounded = true; break; }
+      f.classes.push_back(uf.find(circ->info()));
+    } while (++circ != done);
+    const int inner = si ? s : t, other = si ? t : s;
+    if (unbounded || is_guard(other)) {
+      std::ostringstream os;
+      os << "transition: the cavity leaked: internal site " << inner << " (polygon "
+         << set.sites[inner].polygons.front() << ") meets the far guard points";
+      throw std::runtime_error(os.str());
+    }
+    // Drop repeated classes (co-spherical cells merged): a zero-area face has < 3 left.
+    f.classes.erase(std::unique(f.classes.begin(), f.classes.end()), f.classes.end());
+    while (f.classes.size() > 1 && f.classes.front() == f.classes.back()) f.classes.pop_back();
+    if (f.classes.size() < 3) continue;
+    // The circulator turns positively around the oriented edge s -> t, so the cycle's
+    // right-hand normal points from s to t: outward for s.
+    if (!si) {
+      std::swap(s, t);
+      std::reverse(f.classes.begin(), f.classes.end());
+    }
+    f.s = s;
+    f.t = t;
+    f.external = !ti || !si;
+    faces.push_back(std::move(f));
+  }
+  // Deterministic face order: by (s, t) site ids.
+  std::sort(faces.begin(), faces.end(), [](const RawFace& a, const RawFace& b) {
+    return a.s != b.s ? a.s < b.s : a.t < b.t;
+  });
+
+  // ---- conformity (5.7): vertices of external faces become constrained vertices
+  std::map<int, std::vector<int32_t>> snap_candidates;  // free class -> candidate nodes
+  auto common_polygons = [&](int s, int t) {
+    std::vector<int> a = set.sites[s].polygons, b = set.sites[t].polygons, o;
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(o));
+    return o;
+  };
+  for (const RawFace& f : faces) {
+    if (!f.external) continue;
+    std::vector<int> polys = common_polygons(f.s, f.t);
+    if (polys.empty()) polys = set.sites[f.s].polygons;
+    std::vector<int32_t> cand;
+    for (int q : polys) cand.insert(cand.end(), cavity.faces[q].nodes.begin(), cavity.faces[q].nodes.end());
+    for (int cls : f.classes) {
+      if (class_info(cls).node >= 0) continue;
+      auto& v = snap_candidates[cls];
+      v.insert(v.end(), cand.begin(), cand.end());
+    }
+  }
+  std::map<int, int32_t> snapped;  // class -> node
+  for (auto& [cls, cand] : snap_candidates) {
+    std::sort(cand.begin(), cand.end());
+    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    const Vec3 p = class_info(cls).point;
+    int32_t best = cand[0];
+    for (int32_t v : cand)
+      if (norm2(coords[v] - p) < norm2(coords[best] - p)) best = v;
+    snapped[cls] = best;
+  }
+  rep.snapped_vertices = static_cast<int>(snapped.size());
+
+  auto token = [&](int cls) -> Token {
+    const ClassInfo& ci = class_info(cls);
+    if (ci.node >= 0) return ci.node;
+    auto it = snapped.find(cls);
+    if (it != snapped.end()) return it->second;
+    return -1 - static_cast<Token>(cls);
+  };
+  std::vector<std::vector<Token>> cycles(faces.size());
+  int removed = 0;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    for (int cls : faces[i].classes) cycles[i].push_back(token(cls));
+    clean_cycle(cycles[i]);
+    if (cycles[i].size() < 3) ++removed;
+  }
+  rep.removed_faces = removed;
+
+  // ---- number the free vertices by their class key (deterministic)
+  std::vector<std::pair<std::array<int, 4>, int>> free_classes;
+  std::map<int, int32_t> free_id;
+  int identified = 0, ambiguous = 0;
+  {
+    std::map<int, bool> seen_class;
+    for (size_t i = 0; i < faces.size(); ++i) {
+      if (cycles[i].size() < 3) continue;
+      for (int cls : faces[i].classes) {
+        if (seen_class.count(cls)) continue;
+        seen_class[cls] = true;
+        const ClassInfo& ci = class_info(cls);
+        ambiguous += ci.ambiguous ? 1 : 0;
+        if (ci.node >= 0) ++identified;
+      }
+      for (Token tk : cycles[i])
+        if (tk < 0 && !free_id.count(static_cast<int>(-1 - tk))) {
+          const int cls = static_cast<int>(-1 - tk);
+          free_id[cls] = -1;
+          free_classes.push_back({class_info(cls).key, cls});
+        }
+    }
+  }
+  std::sort(free_classes.begin(), free_classes.end());
+  out.new_nodes.clear();
+  for (const auto& [key, cls] : free_classes) {
+    free_id[cls] = out.base_node_id + static_cast<int32_t>(out.new_nodes.size());
+    out.new_nodes.push_back(class_info(cls).point);
+  }
+  rep.identified_vertices = identified;
+  rep.free_vertices = static_cast<int>(out.new_nodes.size());
+  if (ambiguous) {
+    std::ostringstream os;
+    os << ambiguous << " power vertices had several candidate constrained nodes (nearest taken)";
+    rep.notes.push_back(os.str());
+  }
+  auto node_of = [&](Token tk) -> int32_t { return tk >= 0 ? static_cast<int32_t>(tk) : free_id.at(static_cast<int>(-1 - tk)); };
+
+  // ---- cells
+  std::vector<int> cell_of_site(ns, -1);
+  std::vector<int> internal_sites;
+  for (int s = 0; s < ns; ++s)
+    if (set.sites[s].alive && set.sites[s].internal()) {
+      cell_of_site[s] = static_cast<int>(internal_sites.size());
+      internal_sites.push_back(s);
+    }
+  const size_t ncell = internal_sites.size();
+  out.cells.assign(ncell, {});
+  out.cell_polygons.assign(ncell, {});
+  out.sites.resize(ncell);
+  out.weights.resize(ncell);
+  out.h_ref.resize(ncell);
+  std::vector<int> polygon_uses(cavity.faces.size(), 0);
+  int unmatched = 0, n_faces = 0;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    if (cycles[i].size() < 3) continue;
+    const RawFace& f = faces[i];
+    std::vector<int32_t> cyc;
+    for (Token tk : cycles[i]) cyc.push_back(node_of(tk));
+    CellFace cf;
+    if (!f.external) {
+      cf.nodes = rotate_to_min(cyc);
+      out.cells[cell_of_site[f.s]].push_back(cf);
+      std::reverse(cyc.begin(), cyc.end());
+      cf.nodes = rotate_to_min(cyc);
+      out.cells[cell_of_site[f.t]].push_back(cf);
+      ++n_faces;
+      continue;
+    }
+    // External face: must be exactly one of the polygons shared by s and t.
+    std::vector<int32_t> sorted_cyc = cyc;
+    std::sort(sorted_cyc.begin(), sorted_cyc.end());
+    int match = -1;
+    for (int q : common_polygons(f.s, f.t)) {
+      std::vector<int32_t> qs = cavity.faces[q].nodes;
+      std::sort(qs.begin(), qs.end());
+      if (qs == sorted_cyc) match = q;
+    }
+    ++n_faces;
+    if (match < 0) {
+      ++unmatched;
+      std::ostringstream os;
+      os << "external face of site " << f.s << " toward site " << f.t << " (" << cyc.size()
+         << " nodes) matches no constrained polygon";
+      if (rep.notes.size() < 50) rep.notes.push_back(os.str());
+      cf.nodes = rotate_to_min(cyc);
+      out.cells[cell_of_site[f.s]].push_back(cf);
+      continue;
+    }
+    std::vector<int32_t> outward(cavity.faces[match].nodes.rbegin(), cavity.faces[match].nodes.rend());
+    if (!same_cycle(outward, cyc)) {
+      ++unmatched;
+      std::ostringstream os;
+      os << "external face of site " << f.s << " has the nodes of polygon " << match << " in another order";
+      if (rep.notes.size() < 50) rep.notes.push_back(os.str());
+    }
+    if (polygon_uses[match]++ > 0) {
+      ++unmatched;
+      std::ostringstream os;
+      os << "polygon " << match << " is the face of two power faces";
+      if (rep.notes.size() < 50) rep.notes.push_back(os.str());
+      continue;
+    }
+    cf.nodes = rotate_to_min(outward);
+    cf.patch = cavity.faces[match].patch;
+    out.cells[cell_of_site[f.s]].push_back(cf);
+    out.cell_polygons[cell_of_site[f.s]].push_back(match);
+  }
+  rep.faces = n_faces;
+  rep.unmatched_external_faces = unmatched;
+  int missing = 0;
+  for (size_t q = 0; q < cavity.faces.size(); ++q)
+    if (polygon_uses[q] == 0) {
+      ++missing;
+      std::ostringstream os;
+      os << "polygon " << q << " is no face of the transition mesh";
+      if (rep.notes.size() < 50) rep.notes.push_back(os.str());
+    }
+  rep.missing_polygons = missing;
+  for (size_t c = 0; c < ncell; ++c) {
+    const Site& site = set.sites[internal_sites[c]];
+    out.sites[c] = site.p;
+    out.weights[c] = std::sqrt(site.w2);
+    double len = 0;
+    int edges = 0;
+    for (int q : site.polygons) {
+      const auto& nodes = cavity.faces[q].nodes;
+      for (size_t k = 0; k < nodes.size(); ++k, ++edges) len += norm(coords[nodes[(k + 1) % nodes.size()]] - coords[nodes[k]]);
+    }
+    out.h_ref[c] = edges ? len / edges : 0.0;
+    std::sort(out.cell_polygons[c].begin(), out.cell_polygons[c].end());
+    if (out.cells[c].size() < 4) {
+      std::ostringstream os;
+      os << "cell of site " << internal_sites[c] << " has only " << out.cells[c].size() << " faces";
+      if (rep.notes.size() < 50) rep.notes.push_back(os.str());
+    }
+  }
+  // Distinct power vertices used by the cells.
+  {
+    std::vector<int32_t> used;
+    for (const auto& cell : out.cells)
+      for (const CellFace& cf : cell) used.insert(used.end(), cf.nodes.begin(), cf.nodes.end());
+    std::sort(used.begin(), used.end());
+    rep.power_vertices = static_cast<int>(std::unique(used.begin(), used.end()) - used.begin());
+  }
+  (void)frames;
+  return {};
+}
+
+}  // namespace hm::transition_detail

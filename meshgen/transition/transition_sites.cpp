@@ -1,0 +1,378 @@
+// Sites of the transition mesh (paper 5.4-5.5): placement, empty-sphere repair and the
+// auto-centering correction. CGAL-free.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "transition_internal.hpp"
+
+namespace hm::transition_detail {
+
+namespace {
+
+// Relative slack of the empty-sphere test: a vertex counts as inside a sphere only when
+// its power is below -kEmptySlack * w^2. Own vertices are excluded, so this only absorbs
+// the rounding of vertices that are co-spherical by construction (lattice nodes).
+constexpr double kEmptySlack = 1e-10;
+constexpr double kShrink = 0.7;  // alpha of 5.5.3 (paper: 0.7 <= alpha < 1)
+
+struct Box {
+  Vec3 center;
+  double w2 = 0;
+};
+
+Box reservoir_box(const ReservoirGrid& grid, int cell) {
+  const auto ijk = grid.cell_ijk(cell);
+  const Vec3 lo{grid.x[ijk[0]], grid.y[ijk[1]], grid.z[ijk[2]]};
+  const Vec3 hi{grid.x[ijk[0] + 1], grid.y[ijk[1] + 1], grid.z[ijk[2] + 1]};
+  Box b;
+  b.center = 0.5 * (lo + hi);
+  const Vec3 h = 0.5 * (hi - lo);
+  b.w2 = dot(h, h);
+  return b;
+}
+
+std::vector<int32_t> vertices_of(const Cavity& cavity, const std::vector<int>& polygons) {
+  std::vector<int32_t> v;
+  for (int q : polygons) v.insert(v.end(), cavity.faces[q].nodes.begin(), cavity.faces[q].nodes.end());
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+double mean_w2(Vec3 p, const std::vector<int32_t>& nodes, const std::vector<Vec3>& coords) {
+  double s = 0;
+  for (int32_t v : nodes) s += norm2(coords[v] - p);
+  return s / static_cast<double>(nodes.size());
+}
+
+// Re-derives the mirror of polygon q from its internal site (5.4.2).
+void update_mirror(SiteSet& set, int q, const std::vector<PolygonFrame>& frames) {
+  const int e = set.external_of[q];
+  if (e < 0 || set.sites[e].kind != SiteKind::ExternalMirror) return;
+  const Site& in = set.sites[set.internal_of[q]];
+  set.sites[e].p = 2.0 * frames[q].center - in.p;
+  set.sites[e].w2 = in.w2;
+}
+
+// Places the internal polygon site s at O + t n with the weight of its constrained vertices.
+void place_polygon_site(SiteSet& set, int s, double t, const Cavity& cavity, const std::vector<Vec3>& coords,
+                        const std::vector<PolygonFrame>& frames) {
+  Site& site = set.sites[s];
+  const int q = site.polygon;
+  site.t = t;
+  site.p = frames[q].center + t * frames[q].normal;
+  site.w2 = mean_w2(site.p, cavity.faces[q].nodes, coords);
+  update_mirror(set, q, frames);
+}
+
+// Paper 5.4.1 (n = 1): midpoint of [O V]. When the external site is a mirror, its sphere
+// must stay empty too, which bounds t by the external Voronoi vertex: t <= -t_out.
+double initial_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames) {
+  const PolygonFrame& f = frames[q];
+  double reach = f.t_in;
+  const int e = set.external_of[q];
+  if (e >= 0 && set.sites[e].kind == SiteKind::ExternalMirror) reach = std::min(reach, -f.t_out);
+  if (!(reach > 0) || !std::isfinite(reach)) reach = f.radius;  // not Delaunay: fall back on rho
+  return 0.5 * reach;
+}
+
+int add_polygon_site(SiteSet& set, int q, const Cavity& cavity, const std::vector<Vec3>& coords,
+                     const std::vector<PolygonFrame>& frames) {
+  Site s;
+  s.kind = SiteKind::InternalPolygon;
+  s.polygon = q;
+  s.polygons = {q};
+  s.vertices = vertices_of(cavity, s.polygons);
+  set.sites.push_back(s);
+  const int id = static_cast<int>(set.sites.size()) - 1;
+  set.internal_of[q] = id;
+  place_polygon_site(set, id, initial_t(set, q, frames), cavity, coords, frames);
+  return id;
+}
+
+int add_mirror_site(SiteSet& set, int q, const Cavity& cavity, const std::vector<PolygonFrame>& frames) {
+  Site s;
+  s.kind = SiteKind::ExternalMirror;
+  s.polygon = q;
+  s.polygons = {q};
+  s.vertices = vertices_of(cavity, s.polygons);
+  set.sites.push_back(s);
+  const int id = static_cast<int>(set.sites.size()) - 1;
+  set.external_of[q] = id;
+  update_mirror(set, q, frames);
+  return id;
+}
+
+// Replaces a fixed box site by per-polygon sites (internal) or mirrors (external).
+void split_box(SiteSet& set, int s, const Cavity& cavity, const std::vector<Vec3>& coords,
+               const std::vector<PolygonFrame>& frames) {
+  Site& box = set.sites[s];
+  if (!box.alive) return;
+  box.alive = false;
+  ++set.splits;
+  const std::vector<int> polygons = box.polygons;  // copy: push_back below reallocates
+  const bool internal = box.kind == SiteKind::InternalBox;
+  for (int q : polygons) {
+    if (internal) {
+      add_polygon_site(set, q, cavity, coords, frames);
+    } else {
+      add_mirror_site(set, q, cavity, frames);
+      // A polygon site was placed for a box partner; its mirror now bounds t too.
+      const int in = set.internal_of[q];
+      if (set.sites[in].kind == SiteKind::InternalPolygon)
+        place_polygon_site(set, in, std::min(set.sites[in].t, initial_t(set, q, frames)), cavity, coords, frames);
+    }
+  }
+}
+
+// Sites whose sphere strictly holds a cavity vertex that is not theirs.
+std::vector<int> non_empty_sites(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords) {
+  std::vector<std::pair<double, int32_t>> by_x;
+  by_x.reserve(cavity.vertices.size());
+  for (int32_t v : cavity.vertices) by_x.push_back({coords[v].x, v});
+  std::sort(by_x.begin(), by_x.end());
+  std::vector<int> bad;
+  for (size_t s = 0; s < set.sites.size(); ++s) {
+    const Site& site = set.sites[s];
+    if (!site.alive || site.kind == SiteKind::Guard) continue;
+    const double r = std::sqrt(site.w2);
+    auto it = std::lower_bound(by_x.begin(), by_x.end(), std::make_pair(site.p.x - r, INT32_MIN));
+    for (; it != by_x.end() && it->first <= site.p.x + r; ++it) {
+      if (std::binary_search(site.vertices.begin(), site.vertices.end(), it->second)) continue;
+      if (norm2(coords[it->second] - site.p) - site.w2 < -kEmptySlack * site.w2) {
+        bad.push_back(static_cast<int>(s));
+        break;
+      }
+    }
+  }
+  return bad;
+}
+
+}  // namespace
+
+PolygonFrame fit_polygon(const std::vector<int32_t>& nodes, const std::vector<Vec3>& coords) {
+  PolygonFrame f;
+  const size_t n = nodes.size();
+  Vec3 g, area;
+  for (size_t i = 0; i < n; ++i) {
+    g += coords[nodes[i]];
+    area += cross(coords[nodes[i]], coords[nodes[(i + 1) % n]]);
+  }
+  g = g / static_cast<double>(n);
+  f.normal = normalized(area);
+  double edges = 0;
+  for (size_t i = 0; i < n; ++i) edges += norm(coords[nodes[(i + 1) % n]] - coords[nodes[i]]);
+  f.mean_edge = edges / static_cast<double>(n);
+
+  // An axis-aligned rectangle (every reservoir face): exact centre and axis normal, so that
+  // lattice sites stay exactly co-spherical with it.
+  Vec3 lo = coords[nodes[0]], hi = lo;
+  for (int32_t v : nodes)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], coords[v][k]);
+      hi[k] = std::max(hi[k], coords[v][k]);
+    }
+  int flat_axis = -1, flat_count = 0;
+  for (int k = 0; k < 3; ++k)
+    if (lo[k] == hi[k]) flat_axis = k, ++flat_count;
+  bool rectangle = n == 4 && flat_count == 1;
+  if (rectangle)
+    for (int32_t v : nodes)
+      for (int k = 0; k < 3; ++k)
+        if (coords[v][k] != lo[k] && coords[v][k] != hi[k]) rectangle = false;
+  if (rectangle) {
+    f.center = 0.5 * (lo + hi);
+    f.center[flat_axis] = lo[flat_axis];
+    Vec3 axis;
+    axis[flat_axis] = f.normal[flat_axis] > 0 ? 1.0 : -1.0;
+    f.normal = axis;
+  } else {
+    // Least-squares circle in the mean plane: a^2 + b^2 = 2 ca a + 2 cb b + k.
+    const Vec3 ref = std::abs(f.normal.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 u = normalized(cross(f.normal, ref)), w = cross(f.normal, u);
+    double m[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+    for (int32_t v : nodes) {
+      const Vec3 d = coords[v] - g;
+      const double row[3] = {dot(d, u), dot(d, w), 1.0};
+      const double rhs = row[0] * row[0] + row[1] * row[1];
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) m[i][j] += row[i] * row[j];
+        m[i][3] += row[i] * rhs;
+      }
+    }
+    for (int c = 0; c < 3; ++c) {  // Gaussian elimination with partial pivoting
+      int piv = c;
+      for (int r = c + 1; r < 3; ++r)
+        if (std::abs(m[r][c]) > std::abs(m[piv][c])) piv = r;
+      for (int k = 0; k < 4; ++k) std::swap(m[c][k], m[piv][k]);
+      for (int r = 0; r < 3; ++r) {
+        if (r == c || m[c][c] == 0) continue;
+        const double fac = m[r][c] / m[c][c];
+        for (int k = c; k < 4; ++k) m[r][k] -= fac * m[c][k];
+      }
+    }
+    const double ca = 0.5 * m[0][3] / m[0][0], cb = 0.5 * m[1][3] / m[1][1];
+    f.center = g + ca * u + cb * w;
+  }
+  double r2 = 0;
+  for (int32_t v : nodes) r2 += norm2(coords[v] - f.center);
+  f.radius = std::sqrt(r2 / static_cast<double>(n));
+  for (int32_t v : nodes) f.circle_error = std::max(f.circle_error, std::abs(norm(coords[v] - f.center) - f.radius));
+  return f;
+}
+
+SiteSet make_sites(const Cavity& cavity, const std::vector<Vec3>& coords, const ReservoirGrid& grid,
+                   const std::vector<PolygonFrame>& frames, std::vector<std::string>& notes) {
+  SiteSet set;
+  const int nq = static_cast<int>(cavity.faces.size());
+  set.internal_of.assign(nq, -1);
+  set.external_of.assign(nq, -1);
+  // Group reservoir polygons by deactivated (inside) and active (outside) cell; std::map
+  // keeps the site order deterministic.
+  std::map<int32_t, std::vector<int>> by_inside, by_outside;
+  for (int q = 0; q < nq; ++q) {
+    const ConstrainedFace& cf = cavity.faces[q];
+    if (cf.side != FaceSide::Reservoir) continue;
+    if (cf.inside_cell >= 0) by_inside[cf.inside_cell].push_back(q);
+    if (cf.outside_cell >= 0) by_outside[cf.outside_cell].push_back(q);
+  }
+  // External sites first (placing a polygon site needs to know its partner's kind).
+  for (const auto& [cell, polygons] : by_outside) {
+    Site s;
+    s.kind = SiteKind::ExternalBox;
+    s.reservoir_cell = cell;
+    const Box b = reservoir_box(grid, cell);
+    s.p = b.center;
+    s.w2 = b.w2;
+    s.polygons = polygons;
+    s.vertices = vertices_of(cavity, polygons);
+    set.sites.push_back(s);
+    for (int q : polygons) set.external_of[q] = static_cast<int>(set.sites.size()) - 1;
+  }
+  // Internal sites: a box site per deactivated cell with n > 1 polygons (P = V, the
+  // intersection of their dual lines = the cell centre), a polygon site otherwise.
+  for (const auto& [cell, polygons] : by_inside) {
+    if (polygons.size() > 1) {
+      Site s;
+      s.kind = SiteKind::InternalBox;
+      s.reservoir_cell = cell;
+      const Box b = reservoir_box(grid, cell);
+      s.p = b.center;
+      s.w2 = b.w2;
+      s.polygons = polygons;
+      s.vertices = vertices_of(cavity, polygons);
+      set.sites.push_back(s);
+      for (int q : polygons) set.internal_of[q] = static_cast<int>(set.sites.size()) - 1;
+    }
+  }
+  for (int q = 0; q < nq; ++q) {
+    if (set.external_of[q] >= 0) continue;
+    // Well polygons, end caps, and reservoir polygons on the outer boundary: mirrors.
+    // Their position is set once the internal site exists.
+    Site s;
+    s.kind = SiteKind::ExternalMirror;
+    s.polygon = q;
+    s.polygons = {q};
+    s.vertices = vertices_of(cavity, s.polygons);
+    set.sites.push_back(s);
+    set.external_of[q] = static_cast<int>(set.sites.size()) - 1;
+  }
+  for (int q = 0; q < nq; ++q)
+    if (set.internal_of[q] < 0) add_polygon_site(set, q, cavity, coords, frames);
+  for (int q = 0; q < nq; ++q) update_mirror(set, q, frames);
+  for (int q = 0; q < nq; ++q)
+    if (frames[q].inner_tets == 0) {
+      std::ostringstream os;
+      os << "polygon " << q << ": no attached Delaunay tetrahedron inside the cavity (not Delaunay admissible)";
+      if (notes.size() < 50) notes.push_back(os.str());
+    }
+  return set;
+}
+
+void shrink_or_split(SiteSet& set, int s, double alpha, const Cavity& cavity, const std::vector<Vec3>& coords,
+                     const ReservoirGrid& /*grid*/, const std::vector<PolygonFrame>& frames) {
+  Site& site = set.sites[s];
+  if (!site.alive) return;
+  switch (site.kind) {
+    case SiteKind::InternalPolygon:
+      place_polygon_site(set, s, alpha * site.t, cavity, coords, frames);
+      break;
+    case SiteKind::ExternalMirror: {
+      const int in = set.internal_of[site.polygon];
+      if (set.sites[in].kind == SiteKind::InternalPolygon)
+        place_polygon_site(set, in, alpha * set.sites[in].t, cavity, coords, frames);
+      else
+        split_box(set, in, cavity, coords, frames);
+      break;
+    }
+    case SiteKind::InternalBox:
+    case SiteKind::ExternalBox:
+      split_box(set, s, cavity, coords, frames);
+      break;
+    case SiteKind::Guard:
+      break;
+  }
+}
+
+int enforce_empty_spheres(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                          const ReservoirGrid& grid, const std::vector<PolygonFrame>& frames) {
+  int fixes = 0;
+  for (int round = 0; round < 60; ++round) {
+    const std::vector<int> bad = non_empty_sites(set, cavity, coords);
+    if (bad.empty()) break;
+    for (int s : bad) shrink_or_split(set, s, kShrink, cavity, coords, grid, frames);
+    fixes += static_cast<int>(bad.size());
+  }
+  set.emptiness_fixes += fixes;
+  return fixes;
+}
+
+int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords, const ReservoirGrid& grid,
+                  const std::vector<PolygonFrame>& frames, int max_iterations, int* iterations) {
+  int corrections = 0;
+  int left = 0;
+  for (int it = 1; it <= max_iterations; ++it) {
+    *iterations = it;
+    // Sweep over sites sorted by x; a pair is examined when |Pi Pj|^2 <= max(wi^2, wj^2).
+    std::vector<int> order;
+    double max_w = 0;
+    for (size_t s = 0; s < set.sites.size(); ++s)
+      if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard) {
+        order.push_back(static_cast<int>(s));
+        max_w = std::max(max_w, std::sqrt(set.sites[s].w2));
+      }
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      return set.sites[a].p.x < set.sites[b].p.x || (set.sites[a].p.x == set.sites[b].p.x && a < b);
+    });
+    std::vector<char> fix(set.sites.size(), 0);
+    int n = 0;
+    for (size_t a = 0; a < order.size(); ++a) {
+      const Site& si = set.sites[order[a]];
+      for (size_t b = a + 1; b < order.size(); ++b) {
+        const Site& sj = set.sites[order[b]];
+        if (sj.p.x - si.p.x > max_w) break;
+        const double d2 = norm2(sj.p - si.p);
+        if (d2 > std::max(si.w2, sj.w2)) continue;
+        if (std::abs(si.w2 - sj.w2) <= d2) continue;  // condition (6)
+        ++n;
+        fix[si.w2 > sj.w2 ? order[a] : order[b]] = 1;  // the larger weight moves (5.5.2)
+      }
+    }
+    corrections += n;
+    left = n;
+    if (n == 0) return corrections;
+    if (it == max_iterations) break;
+    for (size_t s = 0; s < fix.size(); ++s)
+      if (fix[s]) shrink_or_split(set, static_cast<int>(s), kShrink, cavity, coords, grid, frames);
+    enforce_empty_spheres(set, cavity, coords, grid, frames);
+  }
+  std::ostringstream os;
+  os << "transition: site correction did not converge after " << max_iterations << " iterations (" << left
+     << " pairs left)";
+  throw std::runtime_error(os.str());
+}
+
+}  // namespace hm::transition_detail
