@@ -1,0 +1,540 @@
+#include "checks.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "quality.hpp"
+
+namespace hm {
+
+namespace {
+
+constexpr size_t kWorstIds = 10;
+
+// Ids of the (up to) k entries with the worst values, worst first; NaN counts as worst.
+// Only entries accepted by `keep` are considered.
+template <class Keep>
+std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_worse, Keep keep) {
+  std::vector<int32_t> idx;
+  idx.reserve(v.size());
+  for (size_t i = 0; i < v.size(); ++i)
+    if (keep(i)) idx.push_back(static_cast<int32_t>(i));
+  auto key = [&](int32_t i) {
+    const double x = v[i];
+    if (std::isnan(x)) return higher_is_worse ? std::numeric_limits<double>::infinity()
+                                              : -std::numeric_limits<double>::infinity();
+    return x;
+  };
+  auto worse = [&](int32_t a, int32_t b) {
+    const double ka = key(a), kb = key(b);
+    if (ka != kb) return higher_is_worse ? ka > kb : ka < kb;
+    return a < b;
+  };
+  const size_t k = std::min(kWorstIds, idx.size());
+  std::partial_sort(idx.begin(), idx.begin() + k, idx.end(), worse);
+  idx.resize(k);
+  return idx;
+}
+std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_worse) {
+  return worst_ids_of(v, higher_is_worse, [](size_t) { return true; });
+}
+
+void push_example(std::vector<int32_t>& ids, int32_t id) {
+  if (ids.size() < kWorstIds && std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
+}
+
+double coord_floor(double max_abs_coord) { return 64.0 * DBL_EPSILON * max_abs_coord; }
+
+// Bounding-box diagonal and absolute tolerance of a node set.
+void scale_of(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* e, double rel_tol, double* length,
+              double* tol) {
+  Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+  double amax = 0;
+  for (const int32_t* v = b; v != e; ++v) {
+    const Vec3 p = nodes[*v];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+      amax = std::max(amax, std::fabs(p[k]));
+    }
+  }
+  *length = b == e ? 0.0 : norm(hi - lo);
+  *tol = std::max(rel_tol * *length, coord_floor(amax));
+}
+
+// Closest distance from p to triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
+double point_triangle_distance(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return norm(p - a);
+  const Vec3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return norm(p - b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return norm(p - (a + (d1 / (d1 - d3)) * ab));
+  const Vec3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return norm(p - c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return norm(p - (a + (d2 / (d2 - d6)) * ac));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return norm(p - (b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b)));
+  const double denom = va + vb + vc;
+  if (!(std::fabs(denom) > 0)) {  // degenerate triangle: distance to its edges
+    auto seg = [](Vec3 q, Vec3 s0, Vec3 s1) {
+      const Vec3 d = s1 - s0;
+      const double l2 = norm2(d);
+      const double t = l2 > 0 ? std::min(1.0, std::max(0.0, dot(q - s0, d) / l2)) : 0.0;
+      return norm(q - (s0 + t * d));
+    };
+    return std::min(seg(p, a, b), std::min(seg(p, b, c), seg(p, c, a)));
+  }
+  const double v = vb / denom, w = vc / denom;
+  return norm(p - (a + v * ab + w * ac));
+}
+
+// Static k-d tree over a subset of nodes, for box queries (hanging-node search).
+class NodeTree {
+ public:
+  NodeTree(const std::vector<Vec3>& pts, std::vector<int32_t> ids) : pts_(pts), idx_(std::move(ids)) {
+    axis_.assign(idx_.size(), 0);
+    build(0, static_cast<int>(idx_.size()));
+  }
+  template <class Visit>
+  void query(Vec3 lo, Vec3 hi, Visit visit) const {
+    std::vector<std::pair<int, int>> stack{{0, static_cast<int>(idx_.size())}};
+    while (!stack.empty()) {
+      auto [b, e] = stack.back();
+      stack.pop_back();
+      if (b >= e) continue;
+      const int m = b + (e - b) / 2;
+      const Vec3 p = pts_[idx_[m]];
+      if (p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z) visit(idx_[m]);
+      const int a = axis_[m];
+      if (lo[a] <= p[a]) stack.emplace_back(b, m);
+      if (hi[a] >= p[a]) stack.emplace_back(m + 1, e);
+    }
+  }
+
+ private:
+  void build(int b, int e) {
+    std::vector<std::pair<int, int>> stack{{b, e}};
+    while (!stack.empty()) {
+      auto [lo_i, hi_i] = stack.back();
+      stack.pop_back();
+      if (hi_i - lo_i <= 1) continue;
+      Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+      for (int i = lo_i; i < hi_i; ++i)
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::min(lo[k], pts_[idx_[i]][k]);
+          hi[k] = std::max(hi[k], pts_[idx_[i]][k]);
+        }
+      const Vec3 ext = hi - lo;
+      const int a = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+      const int m = lo_i + (hi_i - lo_i) / 2;
+      std::nth_element(idx_.begin() + lo_i, idx_.begin() + m, idx_.begin() + hi_i,
+                       [&](int32_t u, int32_t v) { return pts_[u][a] < pts_[v][a]; });
+      axis_[m] = static_cast<int8_t>(a);
+      stack.emplace_back(lo_i, m);
+      stack.emplace_back(m + 1, hi_i);
+    }
+  }
+  const std::vector<Vec3>& pts_;
+  std::vector<int32_t> idx_;
+  std::vector<int8_t> axis_;
+};
+
+double cross2(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
+
+// Distance between 2D segments (p0,p1) and (q0,q1); 0 if they cross.
+double segment_distance_2d(const double* p0, const double* p1, const double* q0, const double* q1) {
+  auto orient = [](const double* a, const double* b, const double* c) {
+    return cross2(b[0] - a[0], b[1] - a[1], c[0] - a[0], c[1] - a[1]);
+  };
+  const double o1 = orient(p0, p1, q0), o2 = orient(p0, p1, q1), o3 = orient(q0, q1, p0), o4 = orient(q0, q1, p1);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return 0.0;
+  auto pseg = [](const double* x, const double* a, const double* b) {
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const double l2 = dx * dx + dy * dy;
+    double t = l2 > 0 ? ((x[0] - a[0]) * dx + (x[1] - a[1]) * dy) / l2 : 0.0;
+    t = std::min(1.0, std::max(0.0, t));
+    const double ex = a[0] + t * dx - x[0], ey = a[1] + t * dy - x[1];
+    return std::sqrt(ex * ex + ey * ey);
+  };
+  return std::min(std::min(pseg(p0, q0, q1), pseg(p1, q0, q1)), std::min(pseg(q0, p0, p1), pseg(q1, p0, p1)));
+}
+
+}  // namespace
+
+CellScales compute_cell_scales(const PolyMesh& m, double rel_tol) {
+  CellScales s;
+  s.length.assign(m.n_cells(), 0.0);
+  s.tol.assign(m.n_cells(), 0.0);
+  std::vector<int32_t> ids;
+  for (int c = 0; c < m.n_cells(); ++c) {
+    ids = cell_node_ids(m, c);
+    scale_of(m.nodes, ids.data(), ids.data() + ids.size(), rel_tol, &s.length[c], &s.tol[c]);
+  }
+  return s;
+}
+
+std::vector<int32_t> cell_node_ids(const PolyMesh& m, int c) {
+  std::vector<int32_t> ids;
+  for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) ids.insert(ids.end(), m.face_begin(*f), m.face_end(*f));
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
+
+int face_polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, const int32_t* end, double rel_tol) {
+  const int k = static_cast<int>(end - begin);
+  if (k < 3) return 3;
+  double diam = 0, tol = 0;
+  scale_of(nodes, begin, end, rel_tol, &diam, &tol);
+  Vec3 area, centroid;
+  polygon_area_centroid(nodes, begin, end, &area, &centroid);
+  const double an = norm(area);
+  if (!(diam > 0) || !(an > tol * tol)) return 3;  // no usable normal
+  const Vec3 n = area / an;
+  // In-plane basis: the coordinate axis least aligned with n gives a stable u.
+  const Vec3 axis = std::fabs(n.x) <= std::fabs(n.y) && std::fabs(n.x) <= std::fabs(n.z)
+                        ? Vec3{1, 0, 0}
+                        : (std::fabs(n.y) <= std::fabs(n.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1});
+  const Vec3 u = normalized(cross(n, axis)), w = cross(n, u);
+  std::vector<double> q(2 * k);
+  for (int i = 0; i < k; ++i) {
+    const Vec3 d = nodes[begin[i]] - centroid;
+    q[2 * i] = dot(d, u);
+    q[2 * i + 1] = dot(d, w);
+  }
+  auto P = [&](int i) { return &q[2 * (((i % k) + k) % k)]; };
+  // Non-adjacent edges must keep apart.
+  for (int i = 0; i < k; ++i)
+    for (int j = i + 2; j < k; ++j) {
+      if (i == 0 && j == k - 1) continue;
+      if (segment_distance_2d(P(i), P(i + 1), P(j), P(j + 1)) <= tol) return 2;
+    }
+  // Turns: (u, w, n) is right-handed and the cycle is counter-clockwise seen from n, so a
+  // convex vertex turns left. A vertex is reflex if it lies beyond tol on the wrong side of
+  // the chord joining its neighbours; a straight-back spike is an intersection.
+  int defect = 0;
+  for (int i = 0; i < k; ++i) {
+    const double* a = P(i - 1);
+    const double* b = P(i);
+    const double* c = P(i + 1);
+    const double e1x = b[0] - a[0], e1y = b[1] - a[1], e2x = c[0] - b[0], e2y = c[1] - b[1];
+    const double cr = cross2(e1x, e1y, e2x, e2y);
+    const double chord = std::hypot(c[0] - a[0], c[1] - a[1]);
+    if (std::fabs(cr) <= tol * chord) {
+      if (e1x * e2x + e1y * e2y < 0) return 2;  // folds back on itself
+      continue;                                 // straight: a node on an edge line is allowed
+    }
+    if (cr < 0) defect = 1;
+  }
+  return defect;
+}
+
+CheckResult check_convexity(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  CheckResult r;
+  r.name = "convexity";
+  r.values.assign(m.n_cells(), 0.0);
+  const CellScales sc = compute_cell_scales(m, opt.rel_tol);
+  std::vector<int> defect(m.n_faces());
+  int64_t reflex = 0, non_simple = 0, degenerate = 0;
+  std::vector<int32_t> ex_reflex, ex_non_simple, ex_degenerate, ex_outside;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    defect[f] = face_polygon_defect(m.nodes, m.face_begin(f), m.face_end(f), opt.rel_tol);
+    if (defect[f] == 1) ++reflex, push_example(ex_reflex, f);
+    if (defect[f] == 2) ++non_simple, push_example(ex_non_simple, f);
+    if (defect[f] == 3) ++degenerate, push_example(ex_degenerate, f);
+  }
+  int64_t outside_cells = 0;
+  for (int c = 0; c < m.n_cells(); ++c) {
+    const std::vector<int32_t> ids = cell_node_ids(m, c);
+    const double L = sc.length[c];
+    double worst = -std::numeric_limits<double>::infinity();
+    bool bad_face = false;
+    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+      const int f = *fp;
+      if (defect[f] != 0) bad_face = true;
+      const Vec3 a = m.face_sign(f, c) * geo.face_area[f];
+      const double an = norm(a);
+      if (!(an > 0)) continue;  // degenerate face: already flagged
+      const Vec3 n = a / an;
+      for (int32_t v : ids) {
+        if (std::find(m.face_begin(f), m.face_end(f), v) != m.face_end(f)) continue;
+        worst = std::max(worst, dot(m.nodes[v] - geo.face_centroid[f], n));
+      }
+    }
+    const bool outside = worst > sc.tol[c];
+    double value = L > 0 && std::isfinite(worst) ? worst / L : (std::isfinite(worst) ? 0.0 : -1.0);
+    if (std::isnan(worst)) value = 1.0;
+    if (bad_face) value = std::max(value, 1.0);
+    r.values[c] = value;
+    if (outside) ++outside_cells, push_example(ex_outside, c);
+    if (outside || bad_face) ++r.violations;
+  }
+  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, true);
+  r.counts = {{"cells_with_node_outside_face_plane", outside_cells},
+              {"faces_with_reflex_vertex", reflex},
+              {"self_intersecting_faces", non_simple},
+              {"degenerate_faces", degenerate}};
+  r.id_lists = {{"cells_with_node_outside_face_plane", ex_outside},
+                {"faces_with_reflex_vertex", ex_reflex},
+                {"self_intersecting_faces", ex_non_simple},
+                {"degenerate_faces", ex_degenerate}};
+  r.measures = {{"rel_tol", opt.rel_tol}};
+  return r;
+}
+
+CheckResult check_conformity(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt,
+                             const BuildReport* build) {
+  CheckResult r;
+  r.name = "conformity";
+  const int nf = m.n_faces(), nc = m.n_cells();
+  r.values.assign(nc, 0.0);
+  auto mark_face = [&](int f) {
+    r.values[m.face_owner[f]] += 1;
+    if (m.face_neighbour[f] >= 0) r.values[m.face_neighbour[f]] += 1;
+  };
+
+  // (a) Faces declared interior that found no second cell.
+  int64_t unmatched = 0;
+  std::vector<int32_t> ex_unmatched;
+  for (int f = 0; f < nf; ++f)
+    if (m.face_patch[f] == kUnmatchedFace) ++unmatched, push_example(ex_unmatched, f), mark_face(f);
+
+  // (b) Two face records over the same node set: a face used by more than two cells.
+  std::vector<int32_t> sorted_ptr(nf + 1, 0), sorted_nodes(m.face_nodes.size());
+  for (int f = 0; f < nf; ++f) {
+    sorted_ptr[f + 1] = m.face_node_ptr[f + 1];
+    std::copy(m.face_begin(f), m.face_end(f), sorted_nodes.begin() + m.face_node_ptr[f]);
+    std::sort(sorted_nodes.begin() + m.face_node_ptr[f], sorted_nodes.begin() + m.face_node_ptr[f + 1]);
+  }
+  auto key_less = [&](int32_t a, int32_t b) {
+    return std::lexicographical_compare(sorted_nodes.begin() + sorted_ptr[a], sorted_nodes.begin() + sorted_ptr[a + 1],
+                                        sorted_nodes.begin() + sorted_ptr[b], sorted_nodes.begin() + sorted_ptr[b + 1]);
+  };
+  std::vector<int32_t> order(nf);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), key_less);
+  int64_t duplicates = 0;
+  std::vector<int32_t> ex_dup;
+  for (int i = 1; i < nf; ++i)
+    if (!key_less(order[i - 1], order[i]) && !key_less(order[i], order[i - 1])) {
+      ++duplicates;
+      push_example(ex_dup, order[i]);
+      mark_face(order[i]);
+      mark_face(order[i - 1]);
+    }
+
+  // (c) Each cell's surface: every edge used by exactly two of its faces, once per direction.
+  int64_t open_cells = 0, misoriented_cells = 0;
+  std::vector<int32_t> ex_open, ex_misoriented;
+  struct DirEdge {
+    int32_t lo, hi;
+    bool forward;  // traversed lo -> hi
+  };
+  std::vector<DirEdge> edges;
+  for (int c = 0; c < nc; ++c) {
+    edges.clear();
+    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+      const int f = *fp, k = m.face_size(f);
+      const int32_t* v = m.face_begin(f);
+      const bool own = m.face_sign(f, c) > 0;
+      for (int i = 0; i < k; ++i) {
+        int32_t a = v[i], b = v[(i + 1) % k];
+        if (!own) std::swap(a, b);
+        edges.push_back(a < b ? DirEdge{a, b, true} : DirEdge{b, a, false});
+      }
+    }
+    std::sort(edges.begin(), edges.end(), [](const DirEdge& x, const DirEdge& y) {
+      return x.lo != y.lo ? x.lo < y.lo : (x.hi != y.hi ? x.hi < y.hi : x.forward < y.forward);
+    });
+    bool open = false, misoriented = false;
+    for (size_t i = 0; i < edges.size();) {
+      size_t j = i;
+      while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+      if (j - i != 2) open = true;
+      else if (edges[i].forward == edges[i + 1].forward) misoriented = true;
+      i = j;
+    }
+    if (open) ++open_cells, push_example(ex_open, c), r.values[c] += 1;
+    if (misoriented) ++misoriented_cells, push_example(ex_misoriented, c), r.values[c] += 1;
+  }
+
+  // (d) Hanging nodes: a node (referenced by some face) lying on a face's fan triangles within
+  // tol_F while not one of its vertices. This also catches duplicated nodes.
+  std::vector<char> used(m.n_nodes(), 0);
+  for (int32_t v : m.face_nodes) used[v] = 1;
+  std::vector<int32_t> used_ids;
+  for (int v = 0; v < m.n_nodes(); ++v)
+    if (used[v]) used_ids.push_back(v);
+  NodeTree tree(m.nodes, std::move(used_ids));
+  std::vector<char> hanging(m.n_nodes(), 0);
+  int64_t hanging_pairs = 0;
+  std::vector<int32_t> ex_hanging;
+  for (int f = 0; f < nf; ++f) {
+    const int k = m.face_size(f);
+    const int32_t* v = m.face_begin(f);
+    double diam = 0, tol = 0;
+    scale_of(m.nodes, v, v + k, opt.rel_tol, &diam, &tol);
+    Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    Vec3 g;
+    for (int i = 0; i < k; ++i) {
+      const Vec3 p = m.nodes[v[i]];
+      g += p;
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+    }
+    g = g / k;
+    const Vec3 pad{tol, tol, tol};
+    tree.query(lo - pad, hi + pad, [&](int32_t p) {
+      if (std::find(v, v + k, p) != v + k) return;
+      double d = DBL_MAX;
+      for (int i = 0; i < k && d > tol; ++i)
+        d = std::min(d, point_triangle_distance(m.nodes[p], g, m.nodes[v[i]], m.nodes[v[(i + 1) % k]]));
+      if (d <= tol) {
+        ++hanging_pairs;
+        hanging[p] = 1;
+        push_example(ex_hanging, p);
+        mark_face(f);
+      }
+    });
+  }
+  const int64_t hanging_nodes = std::count(hanging.begin(), hanging.end(), 1);
+  (void)geo;
+
+  int64_t b_over = 0, b_misor = 0, b_degen = 0;
+  if (build) b_over = build->overused_faces, b_misor = build->misoriented_faces, b_degen = build->degenerate_faces;
+  r.violations = unmatched + duplicates + open_cells + misoriented_cells + hanging_nodes + b_over + b_degen;
+  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, true, [&](size_t c) { return r.values[c] > 0; });
+  r.counts = {{"unmatched_faces", unmatched},
+              {"duplicate_faces", duplicates},
+              {"open_cells", open_cells},
+              {"misoriented_cells", misoriented_cells},
+              {"hanging_nodes", hanging_nodes},
+              {"hanging_node_face_pairs", hanging_pairs},
+              {"builder_overused_faces", b_over},
+              {"builder_misoriented_faces", b_misor},
+              {"builder_degenerate_faces", b_degen}};
+  r.id_lists = {{"unmatched_faces", ex_unmatched},
+                {"duplicate_faces", ex_dup},
+                {"open_cells", ex_open},
+                {"misoriented_cells", ex_misoriented},
+                {"hanging_nodes", ex_hanging}};
+  r.measures = {{"rel_tol", opt.rel_tol}};
+  return r;
+}
+
+CheckResult check_closure(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  CheckResult r;
+  r.name = "closure";
+  r.values.assign(m.n_cells(), 0.0);
+  for (int c = 0; c < m.n_cells(); ++c) {
+    double total = 0;
+    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) total += norm(geo.face_area[*f]);
+    const double s = norm(cell_area_sum(m, geo, c));
+    const double ratio = total > 0 ? s / total : 1.0;
+    r.values[c] = std::isnan(ratio) ? 1.0 : ratio;
+    if (!(r.values[c] <= opt.closure_tol)) ++r.violations;
+  }
+  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, true);
+  r.measures = {{"tolerance", opt.closure_tol}};
+  return r;
+}
+
+CheckResult check_volume(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  CheckResult r;
+  r.name = "volume";
+  r.values.assign(m.n_cells(), 0.0);
+  const CellScales sc = compute_cell_scales(m, opt.rel_tol);
+  double min_vol = std::numeric_limits<double>::infinity(), total = 0;
+  for (int c = 0; c < m.n_cells(); ++c) {
+    const double L = sc.length[c], v = geo.cell_volume[c];
+    r.values[c] = L > 0 ? v / (L * L * L) : 0.0;
+    if (std::isnan(r.values[c])) r.values[c] = -1.0;
+    if (!(r.values[c] > opt.volume_rel_tol)) ++r.violations;
+    min_vol = std::min(min_vol, v);
+    total += v;
+  }
+  r.worst = r.values.empty() ? 0.0 : *std::min_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, false);
+  r.measures = {{"min_volume", std::isfinite(min_vol) ? min_vol : 0.0},
+                {"total_volume", total},
+                {"rel_tol", opt.volume_rel_tol}};
+  return r;
+}
+
+CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  CheckResult r;
+  r.name = "orthogonality";
+  r.id_kind = IdKind::Face;
+  r.values = face_orthogonality(m, geo);
+  std::vector<int32_t> bad_cells;
+  std::vector<char> cell_bad(m.n_cells(), 0);
+  for (int f = 0; f < m.n_faces(); ++f)
+    if (!(r.values[f] >= opt.min_orthogonality_deg)) {
+      ++r.violations;
+      cell_bad[m.face_owner[f]] = 1;
+      if (m.face_neighbour[f] >= 0) cell_bad[m.face_neighbour[f]] = 1;
+    }
+  r.worst = r.values.empty() ? 90.0 : *std::min_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, false);
+  r.counts = {{"cells_with_violations", std::count(cell_bad.begin(), cell_bad.end(), 1)}};
+  r.measures = {{"min_deg", r.worst}, {"threshold_deg", opt.min_orthogonality_deg}};
+  return r;
+}
+
+CheckResult check_auto_centering(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  CheckResult r;
+  r.name = "auto_centering";
+  r.values.assign(m.n_cells(), 0.0);
+  const CellScales sc = compute_cell_scales(m, opt.rel_tol);
+  for (int c = 0; c < m.n_cells(); ++c) {
+    const Vec3 x = m.cell_fv_center[c];
+    double worst = -std::numeric_limits<double>::infinity();
+    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+      const Vec3 a = m.face_sign(*fp, c) * geo.face_area[*fp];
+      const double an = norm(a);
+      if (!(an > 0)) continue;
+      worst = std::max(worst, dot(x - geo.face_centroid[*fp], a / an));
+    }
+    const double L = sc.length[c];
+    double value = L > 0 ? worst / L : 1.0;
+    if (std::isnan(value) || !std::isfinite(worst)) value = 1.0;  // no usable face or a NaN centre
+    r.values[c] = value;
+    if (!(worst < -sc.tol[c]) || !std::isfinite(worst)) ++r.violations;
+  }
+  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, true);
+  r.measures = {{"rel_tol", opt.rel_tol}};
+  return r;
+}
+
+CheckResult check_planarity(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  CheckResult r;
+  r.name = "planarity";
+  r.id_kind = IdKind::Face;
+  r.values = face_planarity(m, geo);
+  std::vector<char> cell_bad(m.n_cells(), 0);
+  for (int f = 0; f < m.n_faces(); ++f)
+    if (!(r.values[f] <= opt.max_planarity_deg)) {
+      ++r.violations;
+      cell_bad[m.face_owner[f]] = 1;
+      if (m.face_neighbour[f] >= 0) cell_bad[m.face_neighbour[f]] = 1;
+    }
+  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, true);
+  r.counts = {{"cells_with_violations", std::count(cell_bad.begin(), cell_bad.end(), 1)}};
+  r.measures = {{"max_deg", r.worst}, {"threshold_deg", opt.max_planarity_deg}};
+  return r;
+}
+
+}  // namespace hm

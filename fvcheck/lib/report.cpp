@@ -1,0 +1,146 @@
+#include "report.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace hm {
+
+bool FvReport::ok() const {
+  if (!structure.ok) return false;
+  for (const CheckResult& c : checks)
+    if (!c.ok()) return false;
+  return !checks.empty();
+}
+
+const CheckResult* FvReport::find(const std::string& name) const {
+  for (const CheckResult& c : checks)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::vector<double>& h_ref,
+                     const BuildReport* build) {
+  FvReport r;
+  r.options = opt;
+  r.cells = mesh.n_cells();
+  r.faces = mesh.n_faces();
+  r.nodes = mesh.n_nodes();
+  r.structure = check_csr_invariants(mesh);
+  if (!r.structure.ok) {
+    for (const char* name :
+         {"convexity", "conformity", "closure", "volume", "orthogonality", "auto_centering", "planarity"}) {
+      CheckResult c;
+      c.name = name;
+      c.skipped = true;
+      r.checks.push_back(c);
+    }
+    return r;
+  }
+  for (int f = 0; f < mesh.n_faces(); ++f) r.boundary_faces += mesh.face_neighbour[f] < 0;
+  r.cell_region = mesh.cell_region;
+  const MeshGeometry geo = compute_geometry(mesh);
+  r.checks.push_back(check_convexity(mesh, geo, opt));
+  r.checks.push_back(check_conformity(mesh, geo, opt, build));
+  r.checks.push_back(check_closure(mesh, geo, opt));
+  r.checks.push_back(check_volume(mesh, geo, opt));
+  r.checks.push_back(check_orthogonality(mesh, geo, opt));
+  r.checks.push_back(check_auto_centering(mesh, geo, opt));
+  r.checks.push_back(check_planarity(mesh, geo, opt));
+  r.q_s = cell_shape_quality(mesh, h_ref);
+  r.q_o_cell = cell_min_of_faces(mesh, r.find("orthogonality")->values);
+  r.q_p_cell = cell_max_of_faces(mesh, r.find("planarity")->values);
+  r.q_s_all = stats_of(r.q_s);
+  r.q_o_all = stats_of(r.q_o_cell);
+  r.q_p_all = stats_of(r.q_p_cell);
+  r.by_region = quality_by_region(mesh, r.q_s, r.q_o_cell, r.q_p_cell);
+  return r;
+}
+
+TransmissibilitySummary summarize_transmissibilities(const std::vector<double>& t) {
+  TransmissibilitySummary s;
+  s.present = true;
+  bool first = true;
+  for (size_t f = 0; f < t.size(); ++f) {
+    const double v = t[f];
+    if (!std::isfinite(v) || v < 0) {
+      ++s.negative;
+      if (s.negative_faces.size() < 10) s.negative_faces.push_back(static_cast<int32_t>(f));
+    }
+    if (v == 0 || std::isnan(v)) continue;
+    ++s.count;
+    s.min = first ? v : std::min(s.min, v);
+    s.max = first ? v : std::max(s.max, v);
+    first = false;
+  }
+  return s;
+}
+
+std::string report_summary_text(const FvReport& r) {
+  std::ostringstream os;
+  os << "fvcheck: " << (r.source.empty() ? "mesh" : r.source) << ": " << r.cells << " cells, " << r.faces
+     << " faces, " << r.nodes << " nodes\n";
+  for (const std::string& n : r.notes) os << "  note: " << n << "\n";
+  if (!r.structure.ok) {
+    os << "  structure       FAILED (checks skipped)\n";
+    for (const std::string& p : r.structure.problems) os << "    " << p << "\n";
+  }
+  char line[256];
+  for (const CheckResult& c : r.checks) {
+    if (c.skipped) continue;
+    std::snprintf(line, sizeof line, "  %-15s %-6s %8lld violations   worst %.6g", c.name.c_str(),
+                  c.ok() ? "ok" : "FAILED", static_cast<long long>(c.violations), c.worst);
+    os << line;
+    if (!c.ok() && !c.worst_ids.empty()) {
+      os << "   worst " << (c.id_kind == IdKind::Face ? "faces" : "cells") << ":";
+      for (size_t i = 0; i < c.worst_ids.size() && i < 5; ++i) os << " " << c.worst_ids[i];
+    }
+    os << "\n";
+  }
+  if (r.structure.ok) {
+    std::snprintf(line, sizeof line, "  quality: Q_S %.3f/%.3f/%.3f  Q_O %.2f/%.2f/%.2f deg  Q_P %.2f/%.2f/%.2f deg (min/max/mean)\n",
+                  r.q_s_all.min, r.q_s_all.max, r.q_s_all.mean, r.q_o_all.min, r.q_o_all.max, r.q_o_all.mean,
+                  r.q_p_all.min, r.q_p_all.max, r.q_p_all.mean);
+    os << line;
+  }
+  if (r.transmissibility.present) {
+    std::snprintf(line, sizeof line, "  transmissibility: %lld faces, min %.6g, max %.6g, negative %lld (halves %lld)\n",
+                  static_cast<long long>(r.transmissibility.count), r.transmissibility.min, r.transmissibility.max,
+                  static_cast<long long>(r.transmissibility.negative),
+                  static_cast<long long>(r.transmissibility.negative_halves));
+    os << line;
+  }
+  os << "result: " << (r.ok() ? "OK" : "FAILED") << "\n";
+  return os.str();
+}
+
+bool write_text_file(const std::string& path, const std::string& text, std::string* error) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      if (error) *error = "cannot write " + path + ": " + std::strerror(errno);
+      return false;
+    }
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.close();
+    if (!out) {
+      std::remove(tmp.c_str());
+      if (error) *error = "cannot write " + path + ": write failed";
+      return false;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::remove(tmp.c_str());
+    if (error) *error = "cannot write " + path + ": " + why;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace hm

@@ -1,0 +1,60 @@
+// Runs every finite-volume check on a mesh and collects the results, the quality
+// statistics (paper Table 2) and the histograms (paper Figure 19) into one FvReport, which
+// the JSON and HTML writers and the fvcheck CLI turn into files. Format: docs/fvcheck.md.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "checks.hpp"
+#include "quality.hpp"
+
+namespace hm {
+
+/// Summary of per-face transmissibilities (filled by the caller, e.g. the fvcheck CLI).
+struct TransmissibilitySummary {
+  bool present = false;  ///< false: not computed, left out of the reports
+  int64_t count = 0;     ///< faces with a non-zero value
+  double min = 0, max = 0;  ///< over the faces with a non-zero value
+  int64_t negative = 0;  ///< faces with T < 0 or not finite (reported, never silently abs()-ed)
+  int64_t negative_halves = 0;          ///< negative or non-finite half-transmissibilities
+  std::vector<int32_t> negative_faces;  ///< first faces concerned
+};
+/// Summary of one value per face (0 = no connection).
+TransmissibilitySummary summarize_transmissibilities(const std::vector<double>& face_values);
+
+struct FvReport {
+  std::string source;  ///< file name or label
+  int64_t cells = 0, faces = 0, nodes = 0, boundary_faces = 0;
+  CheckOptions options;
+  CsrReport structure;                       ///< CSR invariants; when not ok the checks are skipped
+  std::vector<CheckResult> checks;           ///< fixed order: convexity, conformity, closure, volume,
+                                             ///< orthogonality, auto_centering, planarity
+  std::vector<double> q_s, q_o_cell, q_p_cell;  ///< per cell (empty if skipped)
+  std::vector<int32_t> cell_region;          ///< copy of the mesh's regions (histograms per region)
+  Stats q_s_all, q_o_all, q_p_all;           ///< over all cells
+  std::vector<RegionQuality> by_region;
+  TransmissibilitySummary transmissibility;
+  std::vector<std::string> notes;            ///< reader warnings etc., shown in the reports
+
+  /// True when the structure is valid and every check holds (transmissibility is informative).
+  bool ok() const;
+  const CheckResult* find(const std::string& name) const;
+};
+
+/// Runs the checks. h_ref: reference length per cell for Q_S (empty: mean edge length).
+/// build: the builder's report if the mesh was just assembled (folded into conformity).
+FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::vector<double>& h_ref = {},
+                     const BuildReport* build = nullptr);
+
+/// A few lines for a terminal.
+std::string report_summary_text(const FvReport& r);
+
+/// Self-contained HTML page (inline CSS and SVG).
+std::string report_html(const FvReport& r);
+
+/// Writes text to path through path + ".tmp" and a rename. Returns false and sets *error
+/// on failure.
+bool write_text_file(const std::string& path, const std::string& text, std::string* error);
+
+}  // namespace hm

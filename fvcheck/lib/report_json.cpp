@@ -1,0 +1,73 @@
+#include "report_json.hpp"
+
+#include <cmath>
+
+namespace hm {
+
+namespace {
+using nlohmann::json;
+
+// JSON has no inf/NaN: such values become null.
+json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json stats_json(const Stats& s) { return {{"count", s.count}, {"min", num(s.min)}, {"max", num(s.max)}, {"mean", num(s.mean)}}; }
+
+json check_json(const CheckResult& c) {
+  json j;
+  if (c.skipped) {
+    j["skipped"] = true;
+    j["ok"] = false;
+    return j;
+  }
+  j["ok"] = c.ok();
+  j["violations"] = c.violations;
+  j["worst"] = num(c.worst);
+  j["worst_ids"] = c.worst_ids;
+  j["id_kind"] = c.id_kind == IdKind::Face ? "face" : "cell";
+  for (const auto& [name, n] : c.counts) j["counts"][name] = n;
+  for (const auto& [name, ids] : c.id_lists) j["examples"][name] = ids;
+  for (const auto& [name, x] : c.measures) j[name] = num(x);
+  return j;
+}
+}  // namespace
+
+json report_json(const FvReport& r) {
+  json j;
+  j["ok"] = r.ok();
+  j["source"] = r.source;
+  j["cells"] = r.cells;
+  j["faces"] = r.faces;
+  j["nodes"] = r.nodes;
+  j["boundary_faces"] = r.boundary_faces;
+  j["structure"] = {{"ok", r.structure.ok}, {"problems", r.structure.problems}};
+  j["options"] = {{"rel_tol", r.options.rel_tol},
+                  {"closure_tol", r.options.closure_tol},
+                  {"volume_rel_tol", r.options.volume_rel_tol},
+                  {"min_orthogonality_deg", r.options.min_orthogonality_deg},
+                  {"max_planarity_deg", r.options.max_planarity_deg}};
+  j["checks"] = json::object();
+  for (const CheckResult& c : r.checks) j["checks"][c.name] = check_json(c);
+  json q;
+  q["Q_S"] = stats_json(r.q_s_all);
+  q["Q_O"] = stats_json(r.q_o_all);
+  q["Q_P"] = stats_json(r.q_p_all);
+  q["by_region"] = json::object();
+  for (const RegionQuality& rq : r.by_region)
+    q["by_region"][rq.name] = {{"region", rq.region},
+                               {"cells", rq.cells},
+                               {"Q_S", stats_json(rq.q_s)},
+                               {"Q_O", stats_json(rq.q_o)},
+                               {"Q_P", stats_json(rq.q_p)}};
+  j["quality"] = q;
+  if (r.transmissibility.present)
+    j["transmissibility"] = {{"count", r.transmissibility.count},
+                             {"min", num(r.transmissibility.min)},
+                             {"max", num(r.transmissibility.max)},
+                             {"negative", r.transmissibility.negative},
+                             {"negative_halves", r.transmissibility.negative_halves},
+                             {"negative_faces", r.transmissibility.negative_faces}};
+  j["notes"] = r.notes;
+  return j;
+}
+
+}  // namespace hm

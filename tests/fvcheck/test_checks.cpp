@@ -1,0 +1,440 @@
+// Pass/fail pairs for every finite-volume check, and the quality criteria on cells whose
+// values are known in closed form.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "fv_test_meshes.hpp"
+#include "fvcheck/lib/checks.hpp"
+#include "fvcheck/lib/quality.hpp"
+#include "fvcheck/lib/report.hpp"
+#include "fvcheck/lib/report_json.hpp"
+
+using namespace hm;
+using namespace fvtest;
+
+namespace {
+
+int64_t count_of(const CheckResult& r, const std::string& name) {
+  for (const auto& [k, v] : r.counts)
+    if (k == name) return v;
+  ADD_FAILURE() << "no count " << name << " in " << r.name;
+  return -1;
+}
+
+double measure_of(const CheckResult& r, const std::string& name) {
+  for (const auto& [k, v] : r.measures)
+    if (k == name) return v;
+  ADD_FAILURE() << "no measure " << name << " in " << r.name;
+  return NAN;
+}
+
+int face_between(const PolyMesh& m, int a, int b) {
+  for (int f = 0; f < m.n_faces(); ++f)
+    if ((m.face_owner[f] == a && m.face_neighbour[f] == b) || (m.face_owner[f] == b && m.face_neighbour[f] == a))
+      return f;
+  return -1;
+}
+
+const std::vector<std::pair<double, double>> kSquare{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+const std::vector<std::pair<double, double>> kLShape{{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+
+}  // namespace
+
+// ---------------------------------------------------------------- convexity
+TEST(Convexity, BoxPassesLShapedPrismFailsWithExactOutsideDistance) {
+  const PolyMesh good = prism(kSquare, 0, 1, {1, 1, 0.5});
+  const CheckResult ok = check_convexity(good, compute_geometry(good));
+  EXPECT_EQ(ok.violations, 0);
+  EXPECT_TRUE(ok.ok());
+  // Nearest node not on a face is one full edge inside it: -1 / L, L = sqrt(4 + 4 + 1) = 3.
+  EXPECT_NEAR(ok.worst, -1.0 / 3.0, 1e-15);
+
+  const PolyMesh bad = prism(kLShape, 0, 1, {0.5, 0.5, 0.5});
+  const CheckResult r = check_convexity(bad, compute_geometry(bad));
+  EXPECT_EQ(r.violations, 1);
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(count_of(r, "cells_with_node_outside_face_plane"), 1);
+  // Both caps are L-shaped: a reflex vertex each.
+  EXPECT_EQ(count_of(r, "faces_with_reflex_vertex"), 2);
+  EXPECT_EQ(count_of(r, "self_intersecting_faces"), 0);
+  ASSERT_EQ(r.worst_ids.size(), 1u);
+  EXPECT_EQ(r.worst_ids[0], 0);
+  // values: raised to 1 because a face polygon is non-convex; the plane test alone gives 1/3.
+  EXPECT_EQ(r.values[0], 1.0);
+}
+
+TEST(Convexity, DentInsideANonPlanarFaceIsPlanaritysBusiness) {
+  // Documented limit: each face is judged by its mean plane against the nodes NOT on it, so
+  // pushing one top node of a cube down (z 1 -> 0.1) dents the non-planar top face without
+  // moving any node outside another face's plane. Planarity (Q_P) reports it.
+  PolyMesh m = prism({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, 0, 1, {0.5, 0.5, 0.5});
+  m.nodes[6].z = 0.1;  // top node (1, 1, 1): Q_P of the top face about 22 degrees
+  const MeshGeometry g = compute_geometry(m);
+  EXPECT_TRUE(check_convexity(m, g).ok());
+  EXPECT_FALSE(check_planarity(m, g).ok());
+}
+
+TEST(Convexity, FacePolygonDefects) {
+  std::vector<Vec3> p{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0, 0}, {0.3, 0.2, 0}, {0, 0.5, 0}};
+  const int32_t square[] = {0, 1, 2, 3};
+  const int32_t bowtie[] = {0, 2, 1, 6};        // crossing edges, non-zero area
+  const int32_t zero_bowtie[] = {0, 2, 1, 3};   // symmetric: zero area vector, no normal
+  const int32_t dart[] = {0, 1, 2, 5};          // (0.3, 0.2) is a reflex vertex
+  const int32_t straight[] = {0, 4, 1, 2, 3};   // a node on an edge line is allowed
+  const int32_t flat[] = {0, 4, 1};             // collinear: no normal
+  EXPECT_EQ(face_polygon_defect(p, square, square + 4, 1e-9), 0);
+  EXPECT_EQ(face_polygon_defect(p, bowtie, bowtie + 4, 1e-9), 2);
+  EXPECT_EQ(face_polygon_defect(p, zero_bowtie, zero_bowtie + 4, 1e-9), 3);
+  EXPECT_EQ(face_polygon_defect(p, dart, dart + 4, 1e-9), 1);
+  EXPECT_EQ(face_polygon_defect(p, straight, straight + 5, 1e-9), 0);
+  EXPECT_EQ(face_polygon_defect(p, flat, flat + 3, 1e-9), 3);
+}
+
+// ---------------------------------------------------------------- conformity
+TEST(Conformity, GridPassesFlippedInteriorFaceFails) {
+  const PolyMesh good = box_grid(2, 1, 1);
+  const MeshGeometry gg = compute_geometry(good);
+  const CheckResult ok = check_conformity(good, gg);
+  EXPECT_EQ(ok.violations, 0);
+  EXPECT_TRUE(ok.worst_ids.empty());
+
+  PolyMesh bad = good;
+  const int f = face_between(bad, 0, 1);
+  ASSERT_GE(f, 0);
+  std::reverse(bad.face_nodes.begin() + bad.face_node_ptr[f], bad.face_nodes.begin() + bad.face_node_ptr[f + 1]);
+  const MeshGeometry gb = compute_geometry(bad);
+  const CheckResult r = check_conformity(bad, gb);
+  EXPECT_EQ(count_of(r, "misoriented_cells"), 2);
+  EXPECT_EQ(count_of(r, "open_cells"), 0);
+  EXPECT_EQ(r.violations, 2);
+  std::vector<int32_t> ids = r.worst_ids;
+  std::sort(ids.begin(), ids.end());
+  EXPECT_EQ(ids, (std::vector<int32_t>{0, 1}));
+  // The flipped face also breaks closure of both cells.
+  EXPECT_EQ(check_closure(bad, gb).violations, 2);
+}
+
+TEST(Conformity, HangingNodesAreFoundAndTheConformingSplitPasses) {
+  const PolyMesh good = split_face_mesh(true);
+  const CheckResult ok = check_conformity(good, compute_geometry(good));
+  EXPECT_EQ(ok.violations, 0) << count_of(ok, "hanging_nodes");
+
+  const PolyMesh bad = split_face_mesh(false);
+  const CheckResult r = check_conformity(bad, compute_geometry(bad));
+  // (1,0,.5) and (1,1,.5) hang on A's face x = 1 and on A's faces y = 0 and y = 1.
+  EXPECT_EQ(count_of(r, "hanging_nodes"), 2);
+  EXPECT_EQ(count_of(r, "hanging_node_face_pairs"), 4);
+  EXPECT_EQ(r.violations, 2);
+  EXPECT_EQ(r.worst_ids.front(), 0);  // cell A carries every hanging node
+  // Every cell is still closed and convex: only conformity sees the defect.
+  const MeshGeometry g = compute_geometry(bad);
+  EXPECT_TRUE(check_closure(bad, g).ok());
+  EXPECT_TRUE(check_convexity(bad, g).ok());
+}
+
+TEST(Conformity, DuplicatedNodesAtAnInterfaceAreHanging) {
+  MeshBuilder b;
+  add_box(b, {0, 0, 0}, {1, 1, 1});
+  add_box(b, {1, 0, 0}, {2, 1, 1});  // fresh nodes: the interface is two unrelated faces
+  const PolyMesh bad = finish_ok(b);
+  const CheckResult r = check_conformity(bad, compute_geometry(bad));
+  EXPECT_EQ(count_of(r, "hanging_nodes"), 8);
+  EXPECT_GT(r.violations, 0);
+  const PolyMesh good = box_grid(2, 1, 1);
+  EXPECT_EQ(count_of(check_conformity(good, compute_geometry(good)), "hanging_nodes"), 0);
+}
+
+TEST(Conformity, UnmatchedAndDuplicateFacesAndBuilderProblems) {
+  // An interior face without a partner.
+  MeshBuilder b;
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c) n[c] = b.add_node({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  std::vector<CellFace> f = box_faces(n);
+  f[0].patch = kInteriorFace;
+  CellAttributes at;
+  at.fv_center = {0.5, 0.5, 0.5};
+  b.add_cell(f, at);
+  BuildReport rep;
+  const PolyMesh m = b.finish(&rep);
+  const CheckResult r = check_conformity(m, compute_geometry(m));
+  EXPECT_EQ(count_of(r, "unmatched_faces"), 1);
+  EXPECT_EQ(r.violations, 1);
+
+  // A second cell over the same six node cycles, as separate face records.
+  PolyMesh d = box_grid(1, 1, 1);
+  const int nf = d.n_faces();
+  for (int q = 0; q < nf; ++q) {
+    d.face_nodes.insert(d.face_nodes.end(), d.face_begin(q), d.face_end(q));
+    d.face_node_ptr.push_back(static_cast<int32_t>(d.face_nodes.size()));
+    d.face_owner.push_back(1);
+    d.face_neighbour.push_back(-1);
+    d.face_patch.push_back(kOuterBoundary);
+    d.cell_faces.push_back(nf + q);
+  }
+  d.cell_face_ptr.push_back(static_cast<int32_t>(d.cell_faces.size()));
+  d.cell_region.push_back(0);
+  d.cell_fv_center.push_back({0.5, 0.5, 0.5});
+  d.cell_ijk.push_back({-1, -1, -1});
+  d.cell_perm.push_back({});
+  d.cell_porosity.push_back(0);
+  d.cell_radial.push_back({});
+  ASSERT_TRUE(check_csr_invariants(d).ok);
+  const CheckResult rd = check_conformity(d, compute_geometry(d));
+  EXPECT_EQ(count_of(rd, "duplicate_faces"), 6);
+  EXPECT_EQ(count_of(rd, "hanging_nodes"), 0);
+  EXPECT_EQ(rd.violations, 6);
+
+  // Problems the builder saw are folded in.
+  const PolyMesh g = box_grid(1, 1, 1);
+  BuildReport br;
+  br.overused_faces = 3;
+  br.misoriented_faces = 1;  // reported, but counted through the cells it breaks
+  const CheckResult rb = check_conformity(g, compute_geometry(g), {}, &br);
+  EXPECT_EQ(rb.violations, 3);
+  EXPECT_EQ(count_of(rb, "builder_misoriented_faces"), 1);
+}
+
+// ---------------------------------------------------------------- closure
+TEST(Closure, ClosedCellPassesOpenCellFailsWithExactRatio) {
+  const PolyMesh good = box_grid(1, 1, 1);
+  const CheckResult ok = check_closure(good, compute_geometry(good));
+  EXPECT_EQ(ok.violations, 0);
+  EXPECT_LT(ok.worst, 1e-15);
+
+  std::vector<Vec3> pts;
+  for (int c = 0; c < 8; ++c) pts.push_back({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  const int32_t n[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  std::vector<std::vector<int32_t>> faces;
+  for (const CellFace& f : box_faces(n)) faces.push_back(f.nodes);
+  faces.pop_back();  // no x = 1 face
+  const PolyMesh open = single_cell(pts, faces, {0.5, 0.5, 0.5});
+  const CheckResult r = check_closure(open, compute_geometry(open));
+  EXPECT_EQ(r.violations, 1);
+  EXPECT_NEAR(r.worst, 1.0 / 5.0, 1e-15);  // |missing unit face| / five unit faces
+  EXPECT_EQ(count_of(check_conformity(open, compute_geometry(open)), "open_cells"), 1);
+}
+
+// ---------------------------------------------------------------- volume
+TEST(Volume, PositivePassesInsideOutFailsWithExactValues) {
+  const PolyMesh good = box_grid(1, 1, 1);
+  const CheckResult ok = check_volume(good, compute_geometry(good));
+  EXPECT_EQ(ok.violations, 0);
+  EXPECT_NEAR(ok.worst, 1.0 / std::pow(3.0, 1.5), 1e-15);  // V / L^3, L = sqrt(3)
+  EXPECT_NEAR(measure_of(ok, "min_volume"), 1.0, 1e-15);
+
+  PolyMesh bad = good;  // every face reversed: an inside-out cell
+  for (int f = 0; f < bad.n_faces(); ++f)
+    std::reverse(bad.face_nodes.begin() + bad.face_node_ptr[f], bad.face_nodes.begin() + bad.face_node_ptr[f + 1]);
+  const CheckResult r = check_volume(bad, compute_geometry(bad));
+  EXPECT_EQ(r.violations, 1);
+  EXPECT_NEAR(measure_of(r, "min_volume"), -1.0, 1e-15);
+  EXPECT_NEAR(r.worst, -1.0 / std::pow(3.0, 1.5), 1e-15);
+
+  // A flat (zero-volume) cell fails too.
+  PolyMesh flat = good;
+  for (Vec3& p : flat.nodes) p.z = 0;
+  EXPECT_EQ(check_volume(flat, compute_geometry(flat)).violations, 1);
+}
+
+// ---------------------------------------------------------------- orthogonality
+TEST(Orthogonality, ExactAnglesAndThreshold) {
+  // Centres (0.5,0.5,0.5) and (1.5,1.5,0.5) across the face x = 1: 45 degrees.
+  MeshBuilder b;
+  const Vec3 c1{1.5, 1.5, 0.5};
+  int32_t id[12];
+  for (int i = 0; i < 12; ++i) id[i] = b.add_node({double(i % 3), double((i / 3) % 2), double(i / 6)});
+  auto node = [&](int i, int j, int k) { return id[k * 6 + j * 3 + i]; };
+  for (int cell = 0; cell < 2; ++cell) {
+    int32_t n[8];
+    for (int c = 0; c < 8; ++c) n[c] = node(cell + (c & 1), (c >> 1) & 1, (c >> 2) & 1);
+    std::vector<CellFace> f = box_faces(n);
+    CellAttributes at;
+    at.fv_center = cell == 0 ? Vec3{0.5, 0.5, 0.5} : c1;
+    b.add_cell(f, at);
+  }
+  const PolyMesh m = finish_ok(b);
+  const MeshGeometry g = compute_geometry(m);
+  const std::vector<double> q = face_orthogonality(m, g);
+  const int fi = face_between(m, 0, 1);
+  ASSERT_GE(fi, 0);
+  EXPECT_NEAR(q[fi], 45.0, 1e-12);
+  // Boundary faces of cell 0 (centre at its centroid) are exactly orthogonal.
+  for (const int32_t* f = m.cell_begin(0); f != m.cell_end(0); ++f)
+    if (*f != fi) {
+      EXPECT_NEAR(q[*f], 90.0, 1e-12);
+    }
+  // Cell 1's boundary face y = 0: centre (1.5,1.5,.5) to centroid (1.5,0,.5) is along -y: 90.
+  // Its face z = 0: centre to centroid (1.5,.5,0) = (0,-1,-.5): asin(.5 / sqrt(1.25)).
+  const double expect_z0 = std::asin(0.5 / std::sqrt(1.25)) * 180.0 / M_PI;
+  bool seen = false;
+  for (const int32_t* f = m.cell_begin(1); f != m.cell_end(1); ++f)
+    if (std::fabs(g.face_centroid[*f].z) < 1e-15) {
+      EXPECT_NEAR(q[*f], expect_z0, 1e-12);
+      seen = true;
+    }
+  EXPECT_TRUE(seen);
+  const std::vector<double> qc = cell_min_of_faces(m, q);
+  EXPECT_NEAR(qc[0], 45.0, 1e-12);
+  EXPECT_NEAR(qc[1], std::min(45.0, expect_z0), 1e-12);
+
+  CheckOptions strict;
+  strict.min_orthogonality_deg = 50;
+  const CheckResult fail = check_orthogonality(m, g, strict);
+  // Faces below 50 deg: the interior face (45) and cell 1's faces z = 0, z = 1 and x = 2
+  // (centre to centroid (0, -1, -/+.5) and (.5, -1, 0): 26.57 deg each).
+  EXPECT_EQ(fail.violations, 4);
+  EXPECT_NEAR(fail.worst, expect_z0, 1e-12);
+  CheckOptions loose;
+  loose.min_orthogonality_deg = 20;
+  EXPECT_TRUE(check_orthogonality(m, g, loose).ok());
+  EXPECT_TRUE(check_orthogonality(box_grid(2, 2, 2), compute_geometry(box_grid(2, 2, 2))).ok());
+}
+
+// ---------------------------------------------------------------- auto-centering
+TEST(AutoCentering, InsidePassesOutsideAndOnFaceFail) {
+  PolyMesh m = box_grid(1, 1, 1);
+  const MeshGeometry g = compute_geometry(m);
+  const CheckResult ok = check_auto_centering(m, g);
+  EXPECT_EQ(ok.violations, 0);
+  EXPECT_NEAR(ok.worst, -0.5 / std::sqrt(3.0), 1e-15);
+
+  m.cell_fv_center[0] = {1.5, 0.5, 0.5};
+  const CheckResult out = check_auto_centering(m, g);
+  EXPECT_EQ(out.violations, 1);
+  EXPECT_NEAR(out.worst, 0.5 / std::sqrt(3.0), 1e-15);
+
+  m.cell_fv_center[0] = {1.0, 0.5, 0.5};  // on the face: not strictly inside
+  EXPECT_EQ(check_auto_centering(m, g).violations, 1);
+  m.cell_fv_center[0] = {1.0 - 1e-6, 0.5, 0.5};
+  EXPECT_EQ(check_auto_centering(m, g).violations, 0);
+}
+
+// ---------------------------------------------------------------- planarity
+TEST(Planarity, ExactValueOfALiftedCorner) {
+  // Closed form: top face normal ~ (-t,-t,2); fan triangle normals ~ (0,-t,2), (-t,-2t,2),
+  // (-2t,-t,2), (-t,0,2).
+  auto expected = [](double t) {
+    const double a = std::acos((t * t + 4) / (std::sqrt(2 * t * t + 4) * std::sqrt(t * t + 4)));
+    const double b = std::acos((3 * t * t + 4) / (std::sqrt(2 * t * t + 4) * std::sqrt(5 * t * t + 4)));
+    return std::max(a, b) * 180.0 / M_PI;
+  };
+  for (double t : {0.5, 1.0}) {
+    const PolyMesh m = lifted_cube(t);
+    const MeshGeometry g = compute_geometry(m);
+    const std::vector<double> q = face_planarity(m, g);
+    EXPECT_NEAR(*std::max_element(q.begin(), q.end()), expected(t), 1e-10) << t;
+    EXPECT_EQ(std::count_if(q.begin(), q.end(), [](double x) { return x > 1e-12; }), 1);
+    EXPECT_NEAR(cell_max_of_faces(m, q)[0], expected(t), 1e-10);
+  }
+  // Default threshold 15 deg: t = 0.5 (13.6 deg) passes, t = 1 (24.1 deg) fails.
+  const PolyMesh a = lifted_cube(0.5), b = lifted_cube(1.0);
+  EXPECT_TRUE(check_planarity(a, compute_geometry(a)).ok());
+  const CheckResult r = check_planarity(b, compute_geometry(b));
+  EXPECT_EQ(r.violations, 1);
+  EXPECT_NEAR(r.worst, expected(1.0), 1e-10);
+  CheckOptions strict;
+  strict.max_planarity_deg = 10;
+  EXPECT_FALSE(check_planarity(a, compute_geometry(a), strict).ok());
+  const PolyMesh flat = box_grid(1, 1, 1);
+  EXPECT_EQ(check_planarity(flat, compute_geometry(flat)).worst, 0.0);
+}
+
+// ---------------------------------------------------------------- shape quality
+TEST(ShapeQuality, ExactValuesOnABox) {
+  MeshBuilder b;
+  add_box(b, {0, 0, 0}, {1, 2, 3});
+  const PolyMesh m = finish_ok(b);
+  EXPECT_NEAR(cell_mean_edge_length(m)[0], 2.0, 1e-15);
+  EXPECT_NEAR(cell_shape_quality(m, {2.0})[0], 0.5, 1e-15);   // edge 1 vs h = 2
+  EXPECT_NEAR(cell_shape_quality(m, {3.0})[0], 1.0 / 3.0, 1e-15);
+  EXPECT_NEAR(cell_shape_quality(m, {})[0], 0.5, 1e-15);      // h = mean edge = 2
+  EXPECT_NEAR(cell_shape_quality(m, {0.0})[0], 0.5, 1e-15);   // unusable h: fallback
+  EXPECT_NEAR(cell_shape_quality(box_grid(1, 1, 1), {})[0], 1.0, 1e-15);
+}
+
+TEST(QualityStats, PerRegionAndHistogram) {
+  const PolyMesh m = box_grid(3, 1, 1, true);  // regions 0, 1, 2
+  std::vector<double> qs{0.1, 0.5, 0.95};
+  const auto by = quality_by_region(m, qs, {90, 80, 70}, {0, 5, 10});
+  ASSERT_EQ(by.size(), 3u);
+  EXPECT_EQ(by[1].name, "transition");
+  EXPECT_EQ(by[1].cells, 1);
+  EXPECT_EQ(by[1].q_s.mean, 0.5);
+  EXPECT_EQ(by[2].q_o.min, 70);
+  const Stats s = stats_of(qs);
+  EXPECT_EQ(s.count, 3);
+  EXPECT_NEAR(s.mean, 0.5166666666666667, 1e-15);
+  const auto h = histogram(qs, {}, 0.0, 1.0, 10);
+  EXPECT_EQ(h[1], 1);
+  EXPECT_EQ(h[5], 1);
+  EXPECT_EQ(h[9], 1);
+}
+
+// ---------------------------------------------------------------- run_fvcheck and reports
+TEST(RunFvcheck, GoodGridHoldsAndReportsHaveTheDocumentedShape) {
+  const PolyMesh m = box_grid(3, 2, 2, true);
+  const FvReport r = run_fvcheck(m, {});
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.cells, 12);
+  const nlohmann::json j = report_json(r);
+  EXPECT_TRUE(j["ok"].get<bool>());
+  for (const char* k : {"convexity", "conformity", "closure", "volume", "orthogonality", "auto_centering", "planarity"}) {
+    ASSERT_TRUE(j["checks"].contains(k)) << k;
+    EXPECT_EQ(j["checks"][k]["violations"].get<int>(), 0) << k;
+    EXPECT_TRUE(j["checks"][k].contains("worst_ids")) << k;
+  }
+  EXPECT_NEAR(j["checks"]["orthogonality"]["min_deg"].get<double>(), 90.0, 1e-12);
+  EXPECT_NEAR(j["checks"]["planarity"]["max_deg"].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(j["quality"]["Q_S"]["min"].get<double>(), 1.0, 1e-15);
+  EXPECT_EQ(j["quality"]["by_region"]["well"]["cells"].get<int>(), 4);
+  EXPECT_FALSE(j.contains("transmissibility"));  // the caller adds it
+  const std::string html = report_html(r);
+  EXPECT_NE(html.find("<svg"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("src="), std::string::npos);
+  EXPECT_NE(html.find("ALL CHECKS HOLD"), std::string::npos);
+}
+
+TEST(RunFvcheck, BrokenStructureSkipsChecksAndFails) {
+  PolyMesh m = box_grid(2, 1, 1);
+  m.face_nodes[0] = 1000;  // out of range
+  const FvReport r = run_fvcheck(m, {});
+  EXPECT_FALSE(r.structure.ok);
+  EXPECT_FALSE(r.ok());
+  ASSERT_EQ(r.checks.size(), 7u);
+  for (const CheckResult& c : r.checks) EXPECT_TRUE(c.skipped);
+  const nlohmann::json j = report_json(r);
+  EXPECT_FALSE(j["ok"].get<bool>());
+  EXPECT_TRUE(j["checks"]["convexity"]["skipped"].get<bool>());
+  EXPECT_NE(report_html(r).find("checks were skipped"), std::string::npos);
+}
+
+TEST(RunFvcheck, CentreOutsideFailsOnlyAutoCentering) {
+  PolyMesh m = box_grid(2, 1, 1);
+  m.cell_fv_center[1] = {2.5, 0.5, 0.5};
+  const FvReport r = run_fvcheck(m, {});
+  EXPECT_FALSE(r.ok());
+  for (const CheckResult& c : r.checks) {
+    if (c.name == "auto_centering") {
+      EXPECT_EQ(c.violations, 1);
+      ASSERT_FALSE(c.worst_ids.empty());
+      EXPECT_EQ(c.worst_ids[0], 1);
+    } else if (c.name != "orthogonality") {
+      EXPECT_TRUE(c.ok()) << c.name;
+    }
+  }
+  EXPECT_NE(report_html(r).find("Failed checks"), std::string::npos);
+  EXPECT_NE(report_summary_text(r).find("FAILED"), std::string::npos);
+}
+
+TEST(Transmissibility, SummaryCountsNegativeAndNonFinite) {
+  const TransmissibilitySummary s = summarize_transmissibilities({0.0, 2.0, -1.0, 5.0, NAN});
+  EXPECT_TRUE(s.present);
+  EXPECT_EQ(s.count, 3);
+  EXPECT_EQ(s.min, -1.0);
+  EXPECT_EQ(s.max, 5.0);
+  EXPECT_EQ(s.negative, 2);
+  EXPECT_EQ(s.negative_faces, (std::vector<int32_t>{2, 4}));
+}

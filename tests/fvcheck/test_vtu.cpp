@@ -1,0 +1,498 @@
+// VTU writer and reader: exact round trip, every supported encoding, outward orientation of
+// faces, and malformed files (which must give an error, never a crash or a hang).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "exporters/vtu/vtu_reader.hpp"
+#include "exporters/vtu/vtu_writer.hpp"
+#include "fv_test_meshes.hpp"
+
+using namespace hm;
+using namespace fvtest;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("hm_vtu_" + std::to_string(::getpid()) + "_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+
+// ------------------------------------------------------------ an independent mini VTU encoder
+enum class Fmt { Ascii, BinaryJoint, BinarySplit, AppendedRaw, AppendedBase64 };
+
+struct Arr {
+  std::string name, type;
+  int comps = 1, elem = 8;
+  std::string bytes;  // host (little-endian) order
+  std::string ascii;
+};
+
+template <class T>
+Arr arr(const std::string& name, const std::string& type, int comps, const std::vector<T>& v) {
+  Arr a;
+  a.name = name;
+  a.type = type;
+  a.comps = comps;
+  a.elem = sizeof(T);
+  a.bytes.assign(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  std::ostringstream os;
+  os.precision(17);
+  for (const T& x : v) os << +x << ' ';
+  a.ascii = os.str();
+  return a;
+}
+
+std::string b64(const std::string& in) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string o;
+  size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    const uint32_t w = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8) | uint8_t(in[i + 2]);
+    o += t[w >> 18];
+    o += t[(w >> 12) & 63];
+    o += t[(w >> 6) & 63];
+    o += t[w & 63];
+  }
+  if (i + 1 == in.size()) {
+    const uint32_t w = uint8_t(in[i]) << 16;
+    o += t[w >> 18];
+    o += t[(w >> 12) & 63];
+    o += "==";
+  } else if (i + 2 == in.size()) {
+    const uint32_t w = (uint8_t(in[i]) << 16) | (uint8_t(in[i + 1]) << 8);
+    o += t[w >> 18];
+    o += t[(w >> 12) & 63];
+    o += t[(w >> 6) & 63];
+    o += '=';
+  }
+  return o;
+}
+
+std::string swap_elems(const std::string& s, int elem) {
+  std::string o = s;
+  for (size_t i = 0; i + elem <= o.size(); i += elem) std::reverse(o.begin() + i, o.begin() + i + elem);
+  return o;
+}
+
+struct RawGrid {
+  std::vector<double> pts;
+  std::vector<int64_t> conn, offsets, faces, faceoffsets;
+  std::vector<uint8_t> types;
+  std::vector<int32_t> region;
+  std::vector<double> center;
+  int n_points() const { return static_cast<int>(pts.size() / 3); }
+  int n_cells() const { return static_cast<int>(types.size()); }
+};
+
+std::string make_vtu(const RawGrid& g, Fmt fmt, bool header64, bool big_endian) {
+  std::vector<Arr> points{arr("Points", "Float64", 3, g.pts)};
+  std::vector<Arr> cells{arr("connectivity", "Int64", 1, g.conn), arr("offsets", "Int64", 1, g.offsets),
+                         arr("types", "UInt8", 1, g.types)};
+  if (!g.faces.empty()) {
+    cells.push_back(arr("faces", "Int64", 1, g.faces));
+    cells.push_back(arr("faceoffsets", "Int64", 1, g.faceoffsets));
+  }
+  std::vector<Arr> data;
+  if (!g.region.empty()) data.push_back(arr("region", "Int32", 1, g.region));
+  if (!g.center.empty()) data.push_back(arr("fv_center", "Float32", 3, std::vector<float>(g.center.begin(), g.center.end())));
+  auto header = [&](uint64_t n) {
+    std::string h;
+    if (header64) h.assign(reinterpret_cast<const char*>(&n), 8);
+    else {
+      const uint32_t m = static_cast<uint32_t>(n);
+      h.assign(reinterpret_cast<const char*>(&m), 4);
+    }
+    return big_endian ? swap_elems(h, static_cast<int>(h.size())) : h;
+  };
+  std::string appended;
+  std::ostringstream x;
+  auto emit = [&](const Arr& a) {
+    const std::string body = big_endian ? swap_elems(a.bytes, a.elem) : a.bytes;
+    x << "<DataArray type=\"" << a.type << "\" Name=\"" << a.name << "\" NumberOfComponents=\"" << a.comps << "\" ";
+    switch (fmt) {
+      case Fmt::Ascii: x << "format=\"ascii\">\n" << a.ascii << "\n</DataArray>\n"; break;
+      case Fmt::BinaryJoint: x << "format=\"binary\">\n" << b64(header(body.size()) + body) << "\n</DataArray>\n"; break;
+      case Fmt::BinarySplit: x << "format=\"binary\">" << b64(header(body.size())) << b64(body) << "</DataArray>\n"; break;
+      case Fmt::AppendedRaw:
+        x << "format=\"appended\" offset=\"" << appended.size() << "\"/>\n";
+        appended += header(body.size()) + body;
+        break;
+      case Fmt::AppendedBase64:
+        x << "format=\"appended\" offset=\"" << appended.size() << "\"/>\n";
+        appended += b64(header(body.size()) + body);
+        break;
+    }
+  };
+  x << "<?xml version=\"1.0\"?>\n<!-- test file -->\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\""
+    << (big_endian ? "BigEndian" : "LittleEndian") << "\" header_type=\"" << (header64 ? "UInt64" : "UInt32")
+    << "\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << g.n_points() << "\" NumberOfCells=\"" << g.n_cells()
+    << "\">\n<Points>\n";
+  for (const Arr& a : points) emit(a);
+  x << "</Points>\n<Cells>\n";
+  for (const Arr& a : cells) emit(a);
+  x << "</Cells>\n<CellData>\n";
+  for (const Arr& a : data) emit(a);
+  x << "</CellData>\n</Piece>\n</UnstructuredGrid>\n";
+  if (fmt == Fmt::AppendedRaw || fmt == Fmt::AppendedBase64)
+    x << "<AppendedData encoding=\"" << (fmt == Fmt::AppendedRaw ? "raw" : "base64") << "\">\n _" << appended
+      << "\n</AppendedData>\n";
+  x << "</VTKFile>\n";
+  return x.str();
+}
+
+// Two unit cubes along x: cell 0 a VTK_HEXAHEDRON, cell 1 a VTK_POLYHEDRON whose faces are
+// given in mixed orientation (two of them inward) to exercise the reorientation.
+RawGrid two_cubes() {
+  RawGrid g;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 3; ++i) g.pts.insert(g.pts.end(), {double(i), double(j), double(k)});
+  auto P = [](int i, int j, int k) { return int64_t(k * 6 + j * 3 + i); };
+  // Hexahedron: VTK order (bottom counter-clockwise, then top).
+  g.conn = {P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), P(0, 0, 1), P(1, 0, 1), P(1, 1, 1), P(0, 1, 1)};
+  g.offsets = {8};
+  g.types = {12};
+  g.faceoffsets = {-1};
+  const std::vector<std::vector<int64_t>> f{
+      {P(1, 0, 0), P(1, 1, 0), P(1, 1, 1), P(1, 0, 1)},  // x = 1, inward (+x)
+      {P(2, 0, 0), P(2, 1, 0), P(2, 1, 1), P(2, 0, 1)},  // x = 2, outward (+x)
+      {P(1, 0, 0), P(2, 0, 0), P(2, 0, 1), P(1, 0, 1)},  // y = 0, outward (-y)
+      {P(1, 1, 0), P(1, 1, 1), P(2, 1, 1), P(2, 1, 0)},  // y = 1, outward (+y)
+      {P(1, 0, 0), P(2, 0, 0), P(2, 1, 0), P(1, 1, 0)},  // z = 0, inward (+z)
+      {P(1, 0, 1), P(2, 0, 1), P(2, 1, 1), P(1, 1, 1)}}; // z = 1, outward (+z)
+  std::vector<int64_t> conn1;
+  g.faces.push_back(6);
+  for (const auto& face : f) {
+    g.faces.push_back(static_cast<int64_t>(face.size()));
+    for (int64_t v : face) {
+      g.faces.push_back(v);
+      if (std::find(conn1.begin(), conn1.end(), v) == conn1.end()) conn1.push_back(v);
+    }
+  }
+  g.conn.insert(g.conn.end(), conn1.begin(), conn1.end());
+  g.offsets.push_back(static_cast<int64_t>(g.conn.size()));
+  g.types.push_back(42);
+  g.faceoffsets.push_back(static_cast<int64_t>(g.faces.size()));
+  g.region = {0, 1};
+  g.center = {0.5, 0.5, 0.5, 1.5, 0.25, 0.5};
+  return g;
+}
+
+void expect_two_cubes(const ReadResult& r, const std::string& what) {
+  ASSERT_TRUE(r.ok) << what << ": " << r.error;
+  EXPECT_TRUE(r.build.ok) << what;
+  const PolyMesh& m = r.mesh;
+  EXPECT_EQ(m.n_cells(), 2) << what;
+  EXPECT_EQ(m.n_faces(), 11) << what;
+  EXPECT_EQ(m.n_nodes(), 12) << what;
+  EXPECT_TRUE(check_csr_invariants(m).ok) << what;
+  const MeshGeometry g = compute_geometry(m);
+  EXPECT_NEAR(g.cell_volume[0], 1.0, 1e-14) << what;
+  EXPECT_NEAR(g.cell_volume[1], 1.0, 1e-14) << what;
+  for (int c = 0; c < 2; ++c) EXPECT_LT(norm(cell_area_sum(m, g, c)), 1e-14) << what;
+  EXPECT_EQ(m.cell_region[1], 1) << what;
+  EXPECT_TRUE(m.cell_fv_center[1] == (Vec3{1.5, 0.25, 0.5})) << what;
+  EXPECT_EQ(r.flipped_faces, 2) << what;  // the inward faces x = 1 and z = 0 of cell 1
+}
+
+}  // namespace
+
+// ------------------------------------------------------------ writer + reader round trip
+TEST(VtuRoundTrip, TopologyCoordinatesAndArraysAreIdentical) {
+  PolyMesh m = box_grid(3, 2, 2, true);
+  // Distinct coordinates that are not exactly representable in decimal, and one wellbore face.
+  for (Vec3& p : m.nodes) p = {p.x * 0.1 + 1e5 / 3.0, p.y * 0.7 + 0.3, 1000 + p.z * 1.0 / 3.0};
+  for (int c = 0; c < m.n_cells(); ++c) m.cell_fv_center[c] = compute_geometry(m).cell_centroid[c];
+  int wb = -1;
+  for (int f = 0; f < m.n_faces() && wb < 0; ++f)
+    if (m.face_neighbour[f] < 0) wb = f;
+  m.face_patch[wb] = wellbore_patch(0);
+  const MeshGeometry g = compute_geometry(m);
+  std::vector<int32_t> ijk;
+  for (int c = 0; c < m.n_cells(); ++c) ijk.insert(ijk.end(), {c, 2 * c, 3 * c});
+
+  const fs::path d = temp_dir("roundtrip");
+  const std::string path = (d / "mesh.vtu").string();
+  const WriteStatus st = write_vtu(path, m, {VtuCellArray::real("volume", 1, g.cell_volume), VtuCellArray::int32("ijk", 3, ijk)});
+  ASSERT_TRUE(st.ok) << st.message;
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+
+  const ReadResult r = read_vtu(path);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_TRUE(r.build.ok);
+  EXPECT_TRUE(r.has_region && r.has_fv_center && r.has_face_patch);
+  EXPECT_EQ(r.flipped_faces, 0);
+  const PolyMesh& q = r.mesh;
+  EXPECT_EQ(q.nodes.size(), m.nodes.size());
+  EXPECT_TRUE(std::equal(q.nodes.begin(), q.nodes.end(), m.nodes.begin(), m.nodes.end()));
+  EXPECT_EQ(q.face_node_ptr, m.face_node_ptr);
+  EXPECT_EQ(q.face_nodes, m.face_nodes);
+  EXPECT_EQ(q.face_owner, m.face_owner);
+  EXPECT_EQ(q.face_neighbour, m.face_neighbour);
+  EXPECT_EQ(q.face_patch, m.face_patch);
+  EXPECT_EQ(q.cell_face_ptr, m.cell_face_ptr);
+  EXPECT_EQ(q.cell_faces, m.cell_faces);
+  EXPECT_EQ(q.cell_region, m.cell_region);
+  EXPECT_TRUE(std::equal(q.cell_fv_center.begin(), q.cell_fv_center.end(), m.cell_fv_center.begin()));
+  const VtuCellArray* vol = r.find("volume");
+  ASSERT_NE(vol, nullptr);
+  EXPECT_EQ(vol->values, g.cell_volume);
+  for (int c = 0; c < m.n_cells(); ++c) EXPECT_EQ(q.cell_ijk[c], (std::array<int32_t, 3>{c, 2 * c, 3 * c}));
+  fs::remove_all(d);
+}
+
+TEST(VtuWriter, UnwritablePathGivesAStatusAndLeavesNoFile) {
+  const PolyMesh m = box_grid(1, 1, 1);
+  const WriteStatus a = write_vtu("/nonexistent_dir_hm/x.vtu", m);
+  EXPECT_FALSE(a.ok);
+  EXPECT_NE(a.message.find("cannot open"), std::string::npos) << a.message;
+  // A directory as target: the temporary file is written but the rename fails.
+  const fs::path d = temp_dir("unwritable");
+  const WriteStatus b = write_vtu(d.string(), m);
+  EXPECT_FALSE(b.ok);
+  EXPECT_NE(b.message.find("rename"), std::string::npos) << b.message;
+  EXPECT_FALSE(fs::exists(d.string() + ".tmp"));
+  EXPECT_TRUE(fs::is_directory(d));
+  fs::remove_all(d);
+}
+
+TEST(VtuWriter, RejectsBadArraysAndInvalidMeshes) {
+  const PolyMesh m = box_grid(2, 1, 1);
+  const fs::path d = temp_dir("bad_arrays");
+  const std::string path = (d / "m.vtu").string();
+  EXPECT_FALSE(write_vtu(path, m, {VtuCellArray::real("volume", 1, {1.0})}).ok);           // 1 value, 2 cells
+  EXPECT_FALSE(write_vtu(path, m, {VtuCellArray::real("region", 1, {1.0, 2.0})}).ok);      // reserved name
+  EXPECT_FALSE(write_vtu(path, m, {VtuCellArray::real("", 1, {1.0, 2.0})}).ok);
+  PolyMesh broken = m;
+  broken.face_nodes[0] = 99;
+  const WriteStatus s = write_vtu(path, broken);
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("invalid mesh"), std::string::npos);
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_TRUE(write_vtu(path, m, {VtuCellArray::real("volume", 1, {1.0, 1.0})}).ok);
+  fs::remove_all(d);
+}
+
+// ------------------------------------------------------------ reader: encodings
+TEST(VtuReader, EveryEncodingHeaderTypeAndByteOrder) {
+  const RawGrid g = two_cubes();
+  for (Fmt f : {Fmt::Ascii, Fmt::BinaryJoint, Fmt::BinarySplit, Fmt::AppendedRaw, Fmt::AppendedBase64})
+    for (bool h64 : {false, true})
+      for (bool be : {false, true}) {
+        if (f == Fmt::Ascii && (h64 || be)) continue;
+        const std::string what = "format " + std::to_string(int(f)) + " h64 " + std::to_string(h64) + " be " + std::to_string(be);
+        expect_two_cubes(read_vtu_buffer(make_vtu(g, f, h64, be)), what);
+      }
+}
+
+TEST(VtuReader, MissingRegionAndCentreGetDefaults) {
+  RawGrid g = two_cubes();
+  g.region.clear();
+  g.center.clear();
+  const ReadResult r = read_vtu_buffer(make_vtu(g, Fmt::Ascii, false, false));
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_FALSE(r.has_region);
+  EXPECT_FALSE(r.has_fv_center);
+  EXPECT_EQ(r.mesh.cell_region, (std::vector<int32_t>{0, 0}));
+  EXPECT_NEAR(r.mesh.cell_fv_center[1].x, 1.5, 1e-14);
+  EXPECT_NEAR(r.mesh.cell_fv_center[1].y, 0.5, 1e-14);
+}
+
+TEST(VtuReader, InsideOutPolyhedronIsTurnedOutward) {
+  RawGrid g = two_cubes();
+  // Reverse every face of the polyhedron: all six now point inward.
+  size_t p = 1;
+  for (int k = 0; k < 6; ++k) {
+    const int64_t n = g.faces[p];
+    std::reverse(g.faces.begin() + p + 1, g.faces.begin() + p + 1 + n);
+    p += 1 + n;
+  }
+  const ReadResult r = read_vtu_buffer(make_vtu(g, Fmt::Ascii, false, false));
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.flipped_faces, 4);  // all but the two that were inward before
+  EXPECT_NEAR(compute_geometry(r.mesh).cell_volume[1], 1.0, 1e-14);
+  EXPECT_TRUE(r.build.ok);
+}
+
+TEST(VtuReader, StandardCellTypesHaveExactVolumes) {
+  struct Case {
+    uint8_t type;
+    std::vector<double> pts;
+    double volume;
+  };
+  const std::vector<Case> cases{
+      {10, {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}, 1.0 / 6.0},
+      {11, {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1}, 1.0},
+      {12, {0, 0, 0, 2, 0, 0, 2, 1, 0, 0, 1, 0, 0, 0, 3, 2, 0, 3, 2, 1, 3, 0, 1, 3}, 6.0},
+      {13, {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 2, 1, 0, 2, 0, 1, 2}, 1.0},
+      {14, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 1}, 1.0 / 3.0}};
+  for (const Case& c : cases) {
+    RawGrid g;
+    g.pts = c.pts;
+    for (int i = 0; i < g.n_points(); ++i) g.conn.push_back(i);
+    g.offsets = {static_cast<int64_t>(g.conn.size())};
+    g.types = {c.type};
+    const ReadResult r = read_vtu_buffer(make_vtu(g, Fmt::Ascii, false, false));
+    ASSERT_TRUE(r.ok) << int(c.type) << ": " << r.error;
+    const MeshGeometry geo = compute_geometry(r.mesh);
+    EXPECT_NEAR(geo.cell_volume[0], c.volume, 1e-14) << int(c.type);
+    EXPECT_LT(norm(cell_area_sum(r.mesh, geo, 0)), 1e-14) << int(c.type);
+    EXPECT_TRUE(check_csr_invariants(r.mesh).ok);
+  }
+}
+
+// ------------------------------------------------------------ reader: malformed input
+TEST(VtuReaderMalformed, ClearErrorsForBrokenFiles) {
+  auto err = [](const std::string& text) {
+    const ReadResult r = read_vtu_buffer(text);
+    EXPECT_FALSE(r.ok);
+    return r.error;
+  };
+  EXPECT_EQ(err(""), "empty file");
+  EXPECT_NE(err("hello").find("not a VTK XML file"), std::string::npos);
+  EXPECT_NE(err("<VTKFile type=\"PolyData\"></VTKFile>").find("not an UnstructuredGrid"), std::string::npos);
+  EXPECT_NE(err("<VTKFile type=\"UnstructuredGrid\" compressor=\"vtkZLibDataCompressor\"><UnstructuredGrid/></VTKFile>")
+                .find("not supported"),
+            std::string::npos);
+  EXPECT_NE(err("<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid>").find("not closed"), std::string::npos);
+
+  const RawGrid good = two_cubes();
+  {  // a point id out of range in the faces stream
+    RawGrid g = good;
+    g.faces[2] = 99;
+    const std::string e = err(make_vtu(g, Fmt::Ascii, false, false));
+    EXPECT_NE(e.find("cell 1: point id 99 out of range [0, 12)"), std::string::npos) << e;
+  }
+  {  // negative id in connectivity of the hexahedron
+    RawGrid g = good;
+    g.conn[3] = -1;
+    EXPECT_NE(err(make_vtu(g, Fmt::AppendedRaw, true, false)).find("out of range"), std::string::npos);
+  }
+  {  // faceoffsets beyond the faces array
+    RawGrid g = good;
+    g.faceoffsets[1] = 1000;
+    EXPECT_NE(err(make_vtu(g, Fmt::Ascii, false, false)).find("bad faceoffsets"), std::string::npos);
+  }
+  {  // a face claiming more nodes than the stream holds
+    RawGrid g = good;
+    g.faces[1] = 40;
+    EXPECT_NE(err(make_vtu(g, Fmt::Ascii, false, false)).find("bad face size"), std::string::npos);
+  }
+  {  // decreasing offsets
+    RawGrid g = good;
+    g.offsets[1] = 3;
+    EXPECT_NE(err(make_vtu(g, Fmt::Ascii, false, false)).find("bad offsets"), std::string::npos);
+  }
+  {  // wrong counts: NumberOfCells far larger than the arrays (must not allocate for it)
+    std::string t = make_vtu(good, Fmt::AppendedRaw, true, false);
+    const size_t p = t.find("NumberOfCells=\"2\"");
+    ASSERT_NE(p, std::string::npos);
+    t.replace(p, 17, "NumberOfCells=\"2000000000\"");
+    EXPECT_NE(err(t).find("expected 2000000000"), std::string::npos);
+  }
+  {  // an appended offset past the end
+    std::string t = make_vtu(good, Fmt::AppendedRaw, false, false);
+    const size_t p = t.find("offset=\"0\"");
+    ASSERT_NE(p, std::string::npos);
+    t.replace(p, 10, "offset=\"999999\"");
+    EXPECT_NE(err(t).find("beyond the end"), std::string::npos);
+  }
+  {  // missing faceoffsets for polyhedra
+    std::string t = make_vtu(good, Fmt::Ascii, false, false);
+    const size_t p = t.find("Name=\"faceoffsets\"");
+    t.replace(p, 18, "Name=\"faceoffsetz\"");
+    EXPECT_NE(err(t).find("faceoffsets"), std::string::npos);
+  }
+  {  // garbage number in ascii
+    std::string t = make_vtu(good, Fmt::Ascii, false, false);
+    const size_t p = t.find("0.5 0.5 0.5");
+    t.replace(p, 3, "0.x");
+    EXPECT_NE(err(t).find("bad ascii number"), std::string::npos);
+  }
+  {  // unsupported cell type
+    RawGrid g = good;
+    g.types[0] = 7;
+    EXPECT_NE(err(make_vtu(g, Fmt::Ascii, false, false)).find("unsupported VTK cell type 7"), std::string::npos);
+  }
+}
+
+TEST(VtuReaderMalformed, EveryTruncationFailsCleanly) {
+  for (Fmt f : {Fmt::AppendedRaw, Fmt::AppendedBase64, Fmt::BinaryJoint, Fmt::Ascii}) {
+    const std::string full = make_vtu(two_cubes(), f, f == Fmt::AppendedRaw, false);
+    ASSERT_TRUE(read_vtu_buffer(full).ok);
+    // The appended sections end with the data; after it only closing tags follow, which a
+    // reader of appended data does not need. Every cut before the end of the data must fail.
+    const size_t data_end = f == Fmt::AppendedRaw || f == Fmt::AppendedBase64 ? full.rfind("\n</AppendedData>") : full.size() - std::strlen("</VTKFile>\n");
+    for (size_t cut = 0; cut < data_end; ++cut) {
+      const ReadResult r = read_vtu_buffer(full.substr(0, cut));
+      EXPECT_FALSE(r.ok) << "format " << int(f) << " cut at " << cut;
+      EXPECT_FALSE(r.error.empty());
+    }
+  }
+}
+
+TEST(VtuReaderMalformed, RandomByteCorruptionNeverCrashes) {
+  // Deterministic fuzzing: single and multiple byte changes of valid files. The reader must
+  // return (ok or a message) every time; ASan/UBSan builds check memory safety.
+  std::mt19937 rng(12345);
+  int failures = 0, runs = 0;
+  for (Fmt f : {Fmt::AppendedRaw, Fmt::Ascii, Fmt::BinarySplit}) {
+    const std::string full = make_vtu(two_cubes(), f, true, false);
+    for (int k = 0; k < 1500; ++k) {
+      std::string t = full;
+      const int changes = 1 + static_cast<int>(rng() % 4);
+      for (int c = 0; c < changes; ++c) t[rng() % t.size()] = static_cast<char>(rng() % 256);
+      const ReadResult r = read_vtu_buffer(t);
+      ++runs;
+      if (!r.ok) {
+        ++failures;
+        EXPECT_FALSE(r.error.empty());
+      } else {
+        EXPECT_EQ(r.mesh.n_cells(), 2);
+      }
+    }
+  }
+  EXPECT_GT(failures, 0);
+  EXPECT_EQ(runs, 4500);
+}
+
+TEST(VtuReader, MissingFileAndDirectoryGiveErrors) {
+  const ReadResult a = read_vtu("/nonexistent_dir_hm/none.vtu");
+  EXPECT_FALSE(a.ok);
+  EXPECT_NE(a.error.find("cannot open"), std::string::npos);
+  const ReadResult b = read_vtu(fs::temp_directory_path().string());
+  EXPECT_FALSE(b.ok);
+  EXPECT_NE(b.error.find("directory"), std::string::npos);
+}
+
+TEST(VtuReader, OrientCellFacesMakesAClosedOutwardSurface) {
+  std::vector<Vec3> pts;
+  for (int c = 0; c < 8; ++c) pts.push_back({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  const int32_t n[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  std::vector<std::vector<int32_t>> faces;
+  for (const CellFace& f : box_faces(n)) faces.push_back(f.nodes);
+  std::reverse(faces[2].begin(), faces[2].end());
+  std::reverse(faces[5].begin(), faces[5].end());
+  bool consistent = false;
+  EXPECT_EQ(orient_cell_faces(faces, pts, &consistent), 2);
+  EXPECT_TRUE(consistent);
+  std::vector<std::vector<int32_t>> ref;
+  for (const CellFace& f : box_faces(n)) ref.push_back(f.nodes);
+  for (int k = 0; k < 6; ++k) {
+    bool r1 = false, r2 = false;
+    EXPECT_EQ(canonical_cycle(faces[k], &r1), canonical_cycle(ref[k], &r2));
+    EXPECT_EQ(r1, r2) << k;  // same orientation as the outward reference
+  }
+}
