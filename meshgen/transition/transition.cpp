@@ -24,6 +24,17 @@ std::vector<PolygonFrame> frames_of(const Cavity& cavity, const std::vector<Vec3
   attach_voronoi_edges(cavity, coords, frames, notes);
   return frames;
 }
+
+// A polygon's external site is a reflection unless it faces an active reservoir cell.
+bool mirrored(const ConstrainedFace& f) { return !(f.side == FaceSide::Reservoir && f.outside_cell >= 0); }
+
+std::vector<int> non_admissible(const Cavity& cavity, const std::vector<PolygonFrame>& frames) {
+  std::vector<int> bad;
+  for (size_t q = 0; q < frames.size(); ++q)
+    if (!(frames[q].t_in > 0) || (mirrored(cavity.faces[q]) && !(frames[q].t_out < 0)))
+      bad.push_back(static_cast<int>(q));
+  return bad;
+}
 }  // namespace
 
 std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<Vec3>& node_coords) {
@@ -35,11 +46,25 @@ std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<V
   return out;
 }
 
+std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector<Vec3>& node_coords) {
+  std::vector<std::string> notes;
+  return non_admissible(cavity, frames_of(cavity, node_coords, notes));
+}
+
 TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
                                  const ReservoirGrid& grid, const std::vector<WellBlock>& /*blocks*/,
                                  int32_t base_node_id) {
   TransitionReport report;
   const std::vector<PolygonFrame> frames = frames_of(cavity, node_coords, report.notes);
+  const std::vector<int> bad = non_admissible(cavity, frames);
+  if (!bad.empty()) {
+    const PolygonFrame& f = frames[bad.front()];
+    std::ostringstream os;
+    os << "transition: " << bad.size() << " constrained polygons are not Delaunay admissible (first: polygon "
+       << bad.front() << ", t_in = " << f.t_in << ", t_out = " << f.t_out << ", radius " << f.radius
+       << "): a cavity vertex lies in its diametral sphere; the cavity must be enlarged";
+    throw std::runtime_error(os.str());
+  }
   SiteSet set = make_sites(cavity, node_coords, grid, frames, report.notes);
   enforce_empty_spheres(set, cavity, node_coords, grid, frames);
   int iterations = 0;

@@ -26,11 +26,15 @@ struct TransitionReport {
   int hidden_repairs = 0;       ///< rebuilds after moving hidden internal sites
   int power_vertices = 0;       ///< distinct power vertices used by the cells (after exact merging)
   int merged_cells = 0;         ///< RT cells merged into another's power vertex (co-spherical sites)
+  int coincident_vertices = 0;  ///< power vertices merged because they coincide numerically (< 1e-9 x size)
   int identified_vertices = 0;  ///< power vertices identified with a constrained vertex combinatorially
+  int ambiguous_vertices = 0;   ///< of those, vertices whose sites shared an edge AB (nearest end taken)
   int free_vertices = 0;        ///< new nodes (transition-only vertices)
   int unmatched_external_faces = 0;  ///< external faces that are not exactly a constrained polygon (bug)
   int missing_polygons = 0;     ///< constrained polygons that are no face of any cell (bug)
   int faces = 0;                ///< distinct faces of the transition cells
+  double max_identification_shift = 0;  ///< max distance power vertex -> identified constrained node (m)
+  double max_snap_shift = 0;    ///< max distance power vertex -> snapped constrained node (m)
 };
 
 /// Transition cells of one cavity, ready for the builder.
@@ -66,5 +70,12 @@ struct PolygonDual {
   int inner_tets = 0, outer_tets = 0;
 };
 std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<Vec3>& node_coords);
+
+/// Constrained polygons whose internal Voronoi vertex is not inside the cavity (t_in <= 0:
+/// a cavity vertex lies in the polygon's diametral sphere on the cavity side), or, for
+/// polygons whose external site is a reflection (well side, outer boundary), whose
+/// external Voronoi vertex is not outside (t_out >= 0). No site on the dual line can then
+/// have an empty sphere, so build_transition refuses such a cavity; the caller enlarges it.
+std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector<Vec3>& node_coords);
 
 }  // namespace hm

@@ -154,7 +154,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
   const int nc = static_cast<int>(cells.size());
   UnionFind uf(nc);
   const auto power_side = rt.geom_traits().power_side_of_oriented_power_sphere_3_object();
-  int merged = 0;
+  int merged_count = 0;
   for (int a = 0; a < nc; ++a) {
     const Regular::Cell_handle c = cells[a];
     for (int i = 0; i < 4; ++i) {
@@ -163,10 +163,10 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
       const Regular::Vertex_handle opp = n->vertex(n->index(c));
       if (power_side(c->vertex(0)->point(), c->vertex(1)->point(), c->vertex(2)->point(), c->vertex(3)->point(),
                         opp->point()) == CGAL::ON_ORIENTED_BOUNDARY)
-        merged += uf.unite(a, n->info()) ? 1 : 0;
+        merged_count += uf.unite(a, n->info()) ? 1 : 0;
     }
   }
-  rep.merged_cells = merged;
+  rep.merged_cells = merged_count;
 
   // Per class (lazily, for classes used by a face of an internal site): a deterministic
   // key (smallest sorted site tuple of its cells), coordinates, identified node.
@@ -180,7 +180,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
   std::vector<ClassInfo> info(nc);
   std::map<int, std::vector<int>> class_cells;
   for (int a = 0; a < nc; ++a) class_cells[uf.find(a)].push_back(a);
-  auto class_info = [&](int cls) -> ClassInfo& {
+  auto cell_class_info = [&](int cls) -> ClassInfo& {
     ClassInfo& ci = info[cls];
     if (ci.done) return ci;
     ci.done = true;
@@ -200,7 +200,9 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
       }
       if (has_guard) continue;
       if (common.size() == 1) candidates.push_back(common[0]);
-      else if (common.size() > 1) ++ci.ambiguous, candidates.insert(candidates.end(), common.begin(), common.end());
+      else if (common.size() > 1) {
+        ++ci.ambiguous, candidates.insert(candidates.end(), common.begin(), common.end());
+      }
     }
     ci.point = exact_power_center(cells[rep_cell]);
     std::sort(candidates.begin(), candidates.end());
@@ -208,8 +210,13 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     if (!candidates.empty()) {
       if (candidates.size() > 1) ++ci.ambiguous;
       ci.node = candidates[0];
+      // Several candidates: the cell's sites share an edge AB (rounding made a sliver of
+      // sites that are coplanar in exact geometry); its power centre lies on line AB and
+      // the nearest end is the vertex it stands for.
       for (int32_t v : candidates)
         if (norm2(coords[v] - ci.point) < norm2(coords[ci.node] - ci.point)) ci.node = v;
+      if (!ci.ambiguous)
+        rep.max_identification_shift = std::max(rep.max_identification_shift, norm(coords[ci.node] - ci.point));
     }
     return ci;
   };
@@ -241,7 +248,9 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     if (f.classes.size() < 3) continue;
     // The circulator turns positively around the oriented edge s -> t, so the cycle's
     // right-hand normal points from s to t: outward for s.
-    if (!si) {
+    // Internal site first; between two internal sites, the smaller id first (the edge's
+    // direction comes from the triangulation's memory layout, not from the input).
+    if (!si || (ti && t < s)) {
       std::swap(s, t);
       std::reverse(f.classes.begin(), f.classes.end());
     }
@@ -254,6 +263,73 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
   std::sort(faces.begin(), faces.end(), [](const RawFace& a, const RawFace& b) {
     return a.s != b.s ? a.s < b.s : a.t < b.t;
   });
+
+  // ---- numerically coincident power vertices. Sites that are co-spherical in exact
+  // geometry (lattice nodes, coplanar polygons) stop being so once their coordinates are
+  // rounded to doubles: the exact predicates then see several power vertices a few ulps
+  // apart, joined by zero-area faces whose normals are noise. Vertices closer than
+  // kCoincidence x (cavity size) are one vertex (the same point is the same vertex of a
+  // power diagram).
+  constexpr double kCoincidence = 1e-9;
+  std::vector<int> used;
+  for (const RawFace& f : faces) used.insert(used.end(), f.classes.begin(), f.classes.end());
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  double scale = 0;
+  {
+    Vec3 clo = coords[cavity.vertices.front()], chi = clo;
+    for (int32_t v : cavity.vertices)
+      for (int k = 0; k < 3; ++k) clo[k] = std::min(clo[k], coords[v][k]), chi[k] = std::max(chi[k], coords[v][k]);
+    scale = norm(chi - clo);
+  }
+  const double eps = kCoincidence * scale;
+  std::vector<int> by_x = used;
+  std::sort(by_x.begin(), by_x.end(), [&](int a, int b) {
+    const double xa = cell_class_info(a).point.x, xb = cell_class_info(b).point.x;
+    return xa != xb ? xa < xb : a < b;
+  });
+  int coincident = 0;
+  for (size_t i = 0; i < by_x.size(); ++i) {
+    const Vec3 pi = cell_class_info(by_x[i]).point;
+    for (size_t j = i + 1; j < by_x.size(); ++j) {
+      const Vec3 pj = cell_class_info(by_x[j]).point;
+      if (pj.x - pi.x > eps) break;
+      if (norm(pj - pi) <= eps) coincident += uf.unite(by_x[i], by_x[j]) ? 1 : 0;
+    }
+  }
+  rep.coincident_vertices = coincident;
+  // Merged classes: smallest key, its point; identified node if any member has one.
+  std::map<int, ClassInfo> merged;
+  for (int cls : used) {
+    const ClassInfo& ci = cell_class_info(cls);
+    const int root = uf.find(cls);
+    auto it = merged.find(root);
+    if (it == merged.end()) {
+      merged[root] = ci;
+      continue;
+    }
+    ClassInfo& m = it->second;
+    if (ci.node >= 0 && m.node >= 0 && ci.node != m.node) ++m.ambiguous;
+    if (ci.key < m.key) {
+      const int32_t node = m.node >= 0 ? m.node : ci.node;
+      const int amb = m.ambiguous + ci.ambiguous;
+      m = ci;
+      m.node = node, m.ambiguous = amb;
+    } else if (m.node < 0) {
+      m.node = ci.node;
+    }
+  }
+  auto class_info = [&](int cls) -> ClassInfo& { return merged.at(cls); };
+  {
+    std::vector<RawFace> kept;
+    for (RawFace& f : faces) {
+      for (int& cls : f.classes) cls = uf.find(cls);
+      f.classes.erase(std::unique(f.classes.begin(), f.classes.end()), f.classes.end());
+      while (f.classes.size() > 1 && f.classes.front() == f.classes.back()) f.classes.pop_back();
+      if (f.classes.size() >= 3) kept.push_back(std::move(f));
+    }
+    faces.swap(kept);
+  }
 
   // ---- conformity (5.7): vertices of external faces become constrained vertices
   std::map<int, std::vector<int32_t>> snap_candidates;  // free class -> candidate nodes
@@ -285,6 +361,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     for (int32_t v : cand)
       if (norm2(coords[v] - p) < norm2(coords[best] - p)) best = v;
     snapped[cls] = best;
+    rep.max_snap_shift = std::max(rep.max_snap_shift, norm(coords[best] - p));
   }
   rep.snapped_vertices = static_cast<int>(snapped.size());
 
@@ -335,11 +412,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
   }
   rep.identified_vertices = identified;
   rep.free_vertices = static_cast<int>(out.new_nodes.size());
-  if (ambiguous) {
-    std::ostringstream os;
-    os << ambiguous << " power vertices had several candidate constrained nodes (nearest taken)";
-    rep.notes.push_back(os.str());
-  }
+  rep.ambiguous_vertices = ambiguous;
   auto node_of = [&](Token tk) -> int32_t { return tk >= 0 ? static_cast<int32_t>(tk) : free_id.at(static_cast<int>(-1 - tk)); };
 
   // ---- cells

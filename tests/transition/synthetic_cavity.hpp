@@ -49,9 +49,11 @@ struct Scene {
   double box_volume = 0;
 };
 
-/// Builds the scene: deactivates `inactive(i,j,k)`, places the blocks, runs the transition.
-inline void build_scene(Scene& sc, std::vector<double> x, std::vector<double> y, std::vector<double> z,
-                        const std::function<bool(int, int, int)>& inactive, const std::vector<InnerBlock>& blocks) {
+/// Builds the scene: deactivates `inactive(i,j,k)`, places the blocks, lets `tamper` edit
+/// the cavity (failure tests), runs the transition and assembles everything.
+inline void build_scene_with(Scene& sc, std::vector<double> x, std::vector<double> y, std::vector<double> z,
+                             const std::function<bool(int, int, int)>& inactive, const std::vector<InnerBlock>& blocks,
+                             const std::function<void(Cavity&)>& tamper) {
   ReservoirGrid& g = sc.grid;
   g.x = std::move(x), g.y = std::move(y), g.z = std::move(z);
   sc.box_volume = g.box_volume();
@@ -139,6 +141,7 @@ inline void build_scene(Scene& sc, std::vector<double> x, std::vector<double> y,
   std::sort(sc.cavity.vertices.begin(), sc.cavity.vertices.end());
   sc.cavity.vertices.erase(std::unique(sc.cavity.vertices.begin(), sc.cavity.vertices.end()), sc.cavity.vertices.end());
   for (int32_t i = 0; i < sc.builder.n_nodes(); ++i) sc.coords.push_back(sc.builder.node(i));
+  if (tamper) tamper(sc.cavity);
 
   sc.transition = build_transition(sc.cavity, sc.coords, g, {}, sc.builder.n_nodes());
   for (const Vec3& p : sc.transition.new_nodes) sc.builder.add_node(p);
@@ -166,6 +169,11 @@ inline void build_scene(Scene& sc, std::vector<double> x, std::vector<double> y,
     sc.transition_cell.push_back(sc.builder.add_cell(sc.transition.cells[c], a));
   }
   sc.mesh = sc.builder.finish(&sc.report);
+}
+
+inline void build_scene(Scene& sc, std::vector<double> x, std::vector<double> y, std::vector<double> z,
+                        const std::function<bool(int, int, int)>& inactive, const std::vector<InnerBlock>& blocks) {
+  build_scene_with(sc, std::move(x), std::move(y), std::move(z), inactive, blocks, nullptr);
 }
 
 /// Properties measured on the assembled mesh (issue #3 acceptance criteria).
