@@ -1,0 +1,334 @@
+// Eclipse deck writer (docs/export-eclipse.md explains every keyword choice).
+#include "eclipse_deck.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include "meshgen/core/mesh_builder.hpp"
+#include "staged_files.hpp"
+#include "text_out.hpp"
+
+namespace hm {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+// COORD of vertical pillars at (px[i], py[j]), i fastest.
+void write_coord(TextOut& o, const std::vector<double>& px, const std::vector<double>& py, double ztop, double zbot) {
+  o << "COORD\n";
+  for (double y : py)
+    for (double x : px) o << x << ' ' << y << ' ' << ztop << ' ' << x << ' ' << y << ' ' << zbot << '\n';
+  o << "/\n\n";
+}
+
+// ZCORN of flat-topped cells: per layer k, the top face then the bottom face; each face row j
+// written twice (near and far corners), each cell's value twice along i.
+void write_zcorn(TextOut& o, int nx, int ny, int nz, const std::vector<double>& top, const std::vector<double>& bottom) {
+  std::vector<double> z;
+  z.reserve(static_cast<size_t>(8) * nx * ny * nz);
+  for (int k = 0; k < nz; ++k)
+    for (int side = 0; side < 2; ++side)
+      for (int j = 0; j < ny; ++j)
+        for (int rep = 0; rep < 2; ++rep)
+          for (int i = 0; i < nx; ++i) {
+            const size_t g = i + static_cast<size_t>(nx) * (j + static_cast<size_t>(ny) * k);
+            const double v = side == 0 ? top[g] : bottom[g];
+            z.push_back(v);
+            z.push_back(v);
+          }
+  o.eclipse_array("ZCORN", z);
+}
+
+std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::string* error) {
+  const int nx = static_cast<int>(res.x.size()) - 1, ny = static_cast<int>(res.y.size()) - 1,
+            nz = static_cast<int>(res.z.size()) - 1;
+  if (nx < 1 || ny < 1 || nz < 1) {
+    *error = "reservoir lattice needs at least 2 nodes per axis";
+    return {};
+  }
+  const size_t n = static_cast<size_t>(nx) * ny * nz;
+  std::vector<int> actnum(n, 0);
+  std::vector<double> poro(n, res.porosity), kx(n, res.permeability.x), ky(n, res.permeability.y),
+      kz(n, res.permeability.z), top(n), bottom(n);
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    const auto& ijk = mesh.cell_ijk[c];
+    if (mesh.cell_region[c] != kReservoir || ijk[0] < 0) continue;
+    if (ijk[0] >= nx || ijk[1] < 0 || ijk[1] >= ny || ijk[2] < 0 || ijk[2] >= nz) {
+      *error = "cell " + std::to_string(c) + ": (i,j,k) outside the reservoir lattice";
+      return {};
+    }
+    const size_t g = ijk[0] + static_cast<size_t>(nx) * (ijk[1] + static_cast<size_t>(ny) * ijk[2]);
+    actnum[g] = 1;
+    poro[g] = mesh.cell_porosity[c];
+    kx[g] = mesh.cell_perm[c].x;
+    ky[g] = mesh.cell_perm[c].y;
+    kz[g] = mesh.cell_perm[c].z;
+  }
+  for (size_t g = 0; g < n; ++g) {
+    const int k = static_cast<int>(g / (static_cast<size_t>(nx) * ny));
+    top[g] = res.z[k];
+    bottom[g] = res.z[k + 1];
+  }
+  TextOut o;
+  o << "-- Structured reservoir of the hybrid mesh (HybridMesh). Cells replaced by the\n"
+    << "-- near-well (cavity) mesh have ACTNUM 0. Units: METRIC (m, mD); depth positive down.\n"
+    << "SPECGRID\n" << nx << ' ' << ny << ' ' << nz << " 1 F /\n\n";
+  write_coord(o, res.x, res.y, res.z.front(), res.z.back());
+  write_zcorn(o, nx, ny, nz, top, bottom);
+  o.eclipse_array("ACTNUM", actnum);
+  o.eclipse_array("PORO", poro);
+  o.eclipse_array("PERMX", kx);
+  o.eclipse_array("PERMY", ky);
+  o.eclipse_array("PERMZ", kz);
+  return std::move(o.text);
+}
+
+std::string upper(std::string s) {
+  for (char& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  return s;
+}
+
+}  // namespace
+
+std::string eclipse_deck_name(const CaseSpec& cs) { return upper(cs.name); }
+
+std::vector<std::string> flow_steady_state_options() {
+  return {"--enable-adaptive-time-stepping=false", "--time-step-control=newtoniterationcount",
+          "--max-residual-allowed=1e30",           "--tolerance-mb=1e-12",
+          "--tolerance-cnv=1e-9",                  "--tolerance-wells=1e-12",
+          "--linear-solver-reduction=1e-12",       "--linear-solver-max-iter=2000",
+          "--newton-min-iterations=2",             "--newton-max-iterations=30"};
+}
+
+WriteStatus write_reservoir_grdecl(const std::string& path, const ReservoirSpec& reservoir, const PolyMesh& mesh) {
+  auto fail = [&](const std::string& why) { return WriteStatus{false, "write_reservoir_grdecl " + path + ": " + why}; };
+  if (path.empty()) return WriteStatus{false, "write_reservoir_grdecl: empty path"};
+  std::string error;
+  const std::string text = grdecl_text(reservoir, mesh, &error);
+  if (!error.empty()) return fail(error);
+  const fs::path p(path);
+  if (p.has_parent_path() && !StagedFiles::make_directory(p.parent_path().string(), &error)) return fail(error);
+  StagedFiles files;
+  if (!files.stage(path, text) || !files.commit()) return fail(files.error());
+  return {};
+}
+
+WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const PolyMesh& mesh,
+                               const MeshGeometry& geo, const Transmissibilities& trans,
+                               const EclipseDeckOptions& options, EclipseDeckInfo* info) {
+  const std::string name = eclipse_deck_name(cs);
+  auto fail = [&](const std::string& why) { return WriteStatus{false, "write_eclipse_deck " + dir + ": " + why}; };
+  if (name.empty()) return fail("the case has no name");
+  const int nc = mesh.n_cells();
+  const CsrReport csr = check_csr_invariants(mesh);
+  if (!csr.ok) return fail("invalid mesh: " + (csr.problems.empty() ? std::string("?") : csr.problems[0]));
+  if (static_cast<int>(geo.cell_volume.size()) != nc || static_cast<int>(trans.face.size()) != mesh.n_faces())
+    return fail("geometry or transmissibilities do not belong to this mesh (sizes differ)");
+  for (int c = 0; c < nc; ++c)
+    if (!(geo.cell_volume[c] > 0))
+      return fail("cell " + std::to_string(c) + " has a non-positive volume " + std::to_string(geo.cell_volume[c]));
+  if (!(options.tstep_days > 0)) return fail("tstep_days must be > 0");
+
+  EclipseLayout L;
+  std::string error;
+  if (!make_eclipse_layout(cs.reservoir, mesh, options, &L, &error)) return fail(error);
+  const EclipseConnections conn = make_eclipse_connections(mesh, L, trans);
+  const int n_wells = static_cast<int>(cs.wells.size());
+  const auto wells = well_connection_factors(mesh, trans, n_wells);
+  for (int w = 0; w < n_wells; ++w) {
+    if (wells[w].empty()) return fail("well " + cs.wells[w].name + " has no cell on its wellbore");
+    if (cs.wells[w].trajectory.empty()) return fail("well " + cs.wells[w].name + " has no trajectory");
+  }
+  std::vector<std::string> warnings;
+  if (conn.negative_faces > 0)
+    warnings.push_back(std::to_string(conn.negative_faces) +
+                       " interior faces have a negative or non-finite transmissibility (written as computed)");
+  if (conn.zero_faces > 0)
+    warnings.push_back(std::to_string(conn.zero_faces) + " interior faces have a zero transmissibility (no connection)");
+
+  const size_t nd = static_cast<size_t>(L.n_deck_cells());
+  const fs::path out(dir);
+  const std::string grid_inc = name + "_GRID.INC", nnc_inc = name + "_NNC.INC", edit_inc = name + "_EDIT.INC",
+                    sched_inc = name + "_SCHEDULE.INC";
+
+  // ---- GRID include: the corner-point grid and rock properties of every deck cell.
+  std::string grid_text;
+  {
+    TextOut o;
+    o << "-- Deck grid: reservoir columns 1.." << L.nx;
+    if (L.extra_columns > 0)
+      o << ", separator column " << L.nx + 1 << " (inactive), well/transition cells in columns " << L.nx + 2 << ".."
+        << L.deck_nx << " (thin boxes at their FV-centre depth)";
+    o << ".\n\n";
+    write_coord(o, L.pillar_x, L.pillar_y, L.pillar_top, L.pillar_bottom);
+    write_zcorn(o, L.deck_nx, L.ny, L.nz, L.top, L.bottom);
+    std::vector<int> actnum(nd, 0);
+    std::vector<double> poro(nd, 0.0), kx(nd, 0.0), ky(nd, 0.0), kz(nd, 0.0);
+    for (size_t g = 0; g < nd; ++g) {
+      const int32_t c = L.deck_cell[g];
+      if (c < 0) continue;
+      actnum[g] = 1;
+      poro[g] = mesh.cell_porosity[c];
+      kx[g] = mesh.cell_perm[c].x;
+      ky[g] = mesh.cell_perm[c].y;
+      kz[g] = mesh.cell_perm[c].z;
+    }
+    o.eclipse_array("ACTNUM", actnum);
+    o.eclipse_array("PORO", poro);
+    o << "-- PERMX/Y/Z are required by flow; the transmissibilities used are TRANX/Y/Z and NNC.\n";
+    o.eclipse_array("PERMX", kx);
+    o.eclipse_array("PERMY", ky);
+    o.eclipse_array("PERMZ", kz);
+    grid_text = std::move(o.text);
+  }
+
+  // ---- NNC include: every connection that is not between logical reservoir neighbours.
+  std::string nnc_text;
+  {
+    TextOut o;
+    o << "-- Non-neighbour connections (I1 J1 K1 I2 J2 K2 T), T in cP.rm3/day/bar, from HybridMesh's\n"
+      << "-- two-point transmissibilities (faces joining the same two cells summed).\n";
+    if (!conn.nnc.empty()) {
+      o << "NNC\n";
+      for (const auto& r : conn.nnc) {
+        const auto a = L.deck_ijk(r.a), b = L.deck_ijk(r.b);
+        o << a[0] + 1 << ' ' << a[1] + 1 << ' ' << a[2] + 1 << ' ' << b[0] + 1 << ' ' << b[1] + 1 << ' ' << b[2] + 1
+          << ' ' << r.t << " /\n";
+      }
+      o << "/\n";
+    }
+    nnc_text = std::move(o.text);
+  }
+
+  // ---- EDIT include: pore volumes and transmissibilities replace flow's geometric ones.
+  std::string edit_text;
+  int tran_connections = 0;
+  {
+    TextOut o;
+    std::vector<double> porv(nd, 0.0);
+    for (int c = 0; c < nc; ++c) porv[L.cell_deck_index[c]] = geo.cell_volume[c] * mesh.cell_porosity[c];
+    o << "-- Pore volume = cell volume * porosity (rm3).\n";
+    o.eclipse_array("PORV", porv);
+    o << "-- Transmissibilities (cP.rm3/day/bar) between logical reservoir neighbours; 0 elsewhere,\n"
+      << "-- which removes flow's own geometric values (all other connections are NNC).\n";
+    o.eclipse_array("TRANX", conn.tranx);
+    o.eclipse_array("TRANY", conn.trany);
+    o.eclipse_array("TRANZ", conn.tranz);
+    for (size_t g = 0; g < nd; ++g)
+      tran_connections += (conn.tranx[g] != 0) + (conn.trany[g] != 0) + (conn.tranz[g] != 0);
+    edit_text = std::move(o.text);
+  }
+
+  // ---- SCHEDULE include: wells under BHP control, one COMPDAT record per connected cell.
+  int max_connections = 1;
+  std::string sched_text;
+  {
+    TextOut o;
+    o << "WELSPECS\n";
+    for (int w = 0; w < n_wells; ++w) {
+      const auto head = L.deck_ijk(L.cell_deck_index[wells[w][0].first]);
+      // Item 5: BHP reference depth = first trajectory point (the wellhead end of the well).
+      o << quoted(cs.wells[w].name) << " 'G1' " << head[0] + 1 << ' ' << head[1] + 1 << ' '
+        << cs.wells[w].trajectory.front().z << " 'WATER' /\n";
+    }
+    o << "/\n\nCOMPDAT\n-- WELL I J K1 K2 STATUS SATNUM CF: CF = HybridMesh's wellbore connection factor.\n";
+    for (int w = 0; w < n_wells; ++w) {
+      max_connections = std::max(max_connections, static_cast<int>(wells[w].size()));
+      for (const auto& [cell, cf] : wells[w]) {
+        const auto ijk = L.deck_ijk(L.cell_deck_index[cell]);
+        o << quoted(cs.wells[w].name) << ' ' << ijk[0] + 1 << ' ' << ijk[1] + 1 << ' ' << ijk[2] + 1 << ' '
+          << ijk[2] + 1 << " 'OPEN' 1* " << cf << " /\n";
+      }
+    }
+    o << "/\n\n";
+    bool any_prod = false, any_inj = false;
+    for (const WellSpec& w : cs.wells) (w.type == WellType::Producer ? any_prod : any_inj) = true;
+    if (any_prod) {
+      o << "WCONPROD\n";
+      for (const WellSpec& w : cs.wells)
+        if (w.type == WellType::Producer) o << quoted(w.name) << " 'OPEN' 'BHP' 5* " << w.bhp << " /\n";
+      o << "/\n\n";
+    }
+    if (any_inj) {
+      o << "WCONINJE\n";
+      for (const WellSpec& w : cs.wells)
+        if (w.type == WellType::Injector) o << quoted(w.name) << " 'WATER' 'OPEN' 'BHP' 2* " << w.bhp << " /\n";
+      o << "/\n\n";
+    }
+    sched_text = std::move(o.text);
+  }
+
+  // ---- main deck
+  std::string data_text;
+  {
+    const FluidSpec& fl = cs.fluid;
+    // Flow needs Cw > 0 (Cw = 0 with one large step gave NaN); 1e-8 /bar changes nothing steady.
+    const double cw = std::max(fl.compressibility, 1e-8);
+    if (fl.compressibility < 1e-8)
+      warnings.push_back("fluid compressibility raised to 1e-8 /bar in PVTW (flow needs Cw > 0)");
+    TextOut o;
+    o << "-- " << name << ": single-phase steady-state deck written by HybridMesh (docs/export-eclipse.md).\n"
+      << "-- Run: flow";
+    for (const std::string& a : flow_steady_state_options()) o << ' ' << a;
+    o << ' ' << name << ".DATA\n\n"
+      << "RUNSPEC\n\nTITLE\n" << name << "\n\n"
+      << "DIMENS\n" << L.deck_nx << ' ' << L.ny << ' ' << L.nz << " /\n\n"
+      << "WATER\n\nMETRIC\n\n"
+      << "START\n1 'JAN' 2000 /\n\n"
+      << "-- max wells, max connections per well, max groups, max wells per group\n"
+      << "WELLDIMS\n" << std::max(n_wells, 1) << ' ' << max_connections << " 1 " << std::max(n_wells, 1) << " /\n\n"
+      << "UNIFOUT\n\n"
+      << "GRID\n\nINIT\n\n"
+      << "INCLUDE\n" << quoted(grid_inc) << " /\n\n"
+      << "INCLUDE\n" << quoted(nnc_inc) << " /\n\n"
+      << "EDIT\n\n"
+      << "INCLUDE\n" << quoted(edit_inc) << " /\n\n"
+      << "PROPS\n\n"
+      << "-- Pref (bar) Bw Cw (1/bar) viscosity (cP) viscosibility\n"
+      << "PVTW\n" << cs.reservoir.initial_pressure << " 1.0 " << cw << ' ' << fl.viscosity << " 0.0 /\n\n"
+      << "-- surface densities: oil water gas (kg/m3); only water is used\n"
+      << "DENSITY\n1* " << fl.density << " 1* /\n\n"
+      << "-- incompressible rock: pore volumes stay the exported PORV\n"
+      << "ROCK\n" << cs.reservoir.initial_pressure << " 0.0 /\n\n"
+      << "SOLUTION\n\n"
+      << "PRESSURE\n" << static_cast<long long>(nd) << '*' << cs.reservoir.initial_pressure << " /\n\n"
+      << "SUMMARY\n\nWBHP\n/\nWWPR\n/\nWWIR\n/\nFWPR\nFWIR\n\n"
+      << "SCHEDULE\n\n"
+      << "RPTRST\n'BASIC=2' /\n\n"
+      << "INCLUDE\n" << quoted(sched_inc) << " /\n\n"
+      << "-- One long step: backward Euler then gives the steady state.\n"
+      << "TSTEP\n" << options.tstep_days << " /\n\nEND\n";
+    data_text = std::move(o.text);
+  }
+
+  std::string grdecl = grdecl_text(cs.reservoir, mesh, &error);
+  if (!error.empty()) return fail(error);
+
+  if (!StagedFiles::make_directory(dir, &error)) return fail(error);
+  StagedFiles files;
+  const bool staged = files.stage((out / grid_inc).string(), grid_text) &&
+                      files.stage((out / nnc_inc).string(), nnc_text) &&
+                      files.stage((out / edit_inc).string(), edit_text) &&
+                      files.stage((out / sched_inc).string(), sched_text) &&
+                      files.stage((out / (name + "_GRID.GRDECL")).string(), grdecl) &&
+                      files.stage((out / (name + ".DATA")).string(), data_text);
+  if (!staged || !files.commit()) return fail(files.error());
+
+  if (info) {
+    info->data_file = (out / (name + ".DATA")).string();
+    info->files = files.paths();
+    info->layout = std::move(L);
+    info->nnc = static_cast<int>(conn.nnc.size());
+    info->tran_connections = tran_connections;
+    info->well_connections = wells;
+    info->warnings = warnings;
+  }
+  return {};
+}
+
+}  // namespace hm

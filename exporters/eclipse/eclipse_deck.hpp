@@ -1,0 +1,109 @@
+// Eclipse/OPM Flow export of a hybrid mesh (docs/export-eclipse.md).
+//
+// Deck layout ("layout 2" of shared/reference/opm-flow-deck.md): the structured reservoir keeps
+// its (i,j,k) in columns 1..NX of a corner-point grid; reservoir cells replaced by the cavity are
+// inactive; column NX+1 is an inactive separator; every other cell (well and transition cells)
+// is a thin box at its true FV-centre depth in the extra columns NX+2..NX+1+MX. Flow then uses
+// OUR numbers: TRANX/Y/Z (EDIT) for logical reservoir neighbours, NNC for every other connection,
+// PORV (EDIT) = volume * porosity, COMPDAT CF = wellbore connection factors, depths = FV centres.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "exporters/vtu/vtu_writer.hpp"  // WriteStatus (shared by the exporters)
+#include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/case/case.hpp"
+#include "meshgen/core/geometry.hpp"
+#include "meshgen/core/polymesh.hpp"
+
+namespace hm {
+
+struct EclipseDeckOptions {
+  /// Length of the single report step (days). Long enough that the compressible accumulation
+  /// left after one backward-Euler step is negligible: the run is a steady-state solve.
+  double tstep_days = 1.0e6;
+  /// Thickness (m) of the thin boxes that carry the non-reservoir cells. Their depth (centre)
+  /// is exact; the thickness only decides how many fit in one column.
+  double thin_cell_thickness = 1.0e-3;
+  /// Width (m) of each extra column (and of the separator column); geometry only, no physics.
+  double extra_column_width = 1.0;
+};
+
+/// Where every mesh cell sits in the deck's corner-point grid.
+struct EclipseLayout {
+  int nx = 0, ny = 0, nz = 0;   ///< the reservoir lattice of the case
+  int extra_columns = 0;        ///< MX: extra i-columns for the non-reservoir cells (0: none)
+  int deck_nx = 0;              ///< NX of DIMENS: nx, or nx + 1 + extra_columns
+  /// n_cells: 0-based natural deck index I + deck_nx (J + ny K) of each mesh cell.
+  std::vector<int32_t> cell_deck_index;
+  /// deck_nx * ny * nz: the mesh cell at each deck cell, -1 where inactive (ACTNUM 0).
+  std::vector<int32_t> deck_cell;
+  /// deck_nx * ny * nz: top and bottom depth of each deck cell (flat top and bottom).
+  std::vector<double> top, bottom;
+  /// deck_nx + 1 pillar x positions; pillar y positions are the lattice's y.
+  std::vector<double> pillar_x, pillar_y;
+  double pillar_top = 0, pillar_bottom = 0;  ///< depth range of the vertical pillars
+
+  int n_deck_cells() const { return deck_nx * ny * nz; }
+  std::array<int, 3> deck_ijk(int32_t g) const { return {g % deck_nx, (g / deck_nx) % ny, g / (deck_nx * ny)}; }
+};
+
+/// Places the cells. Reservoir cells (cell_ijk valid) keep their (i,j,k) and must have their FV
+/// centre at the lattice cell's centre depth; the others are packed, deepest last, into extra
+/// columns so that no two boxes of one column overlap. Returns false with `error` set if the
+/// mesh does not fit the case's lattice (bad or duplicate ijk, wrong depth, sizes).
+bool make_eclipse_layout(const ReservoirSpec& reservoir, const PolyMesh& mesh, const EclipseDeckOptions& options,
+                         EclipseLayout* layout, std::string* error);
+
+/// The transmissibilities as the deck carries them (METRIC, cP.rm3/day/bar).
+struct EclipseConnections {
+  /// deck cells: transmissibility to the +I / +J / +K neighbour, for logical neighbours that are
+  /// both reservoir cells; 0 everywhere else (this also zeroes flow's geometric values).
+  std::vector<double> tranx, trany, tranz;
+  struct Nnc {
+    int32_t a = 0, b = 0;  ///< deck natural indices, a < b
+    double t = 0;          ///< summed over the faces joining the two cells
+  };
+  std::vector<Nnc> nnc;      ///< every other connection, sorted by (a, b), t != 0
+  int zero_faces = 0;        ///< interior faces with T == 0 (nothing to write)
+  int negative_faces = 0;    ///< interior faces with T < 0 or not finite (written as computed)
+  double total = 0;          ///< sum of all interior face transmissibilities (for checks)
+};
+
+EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseLayout& layout,
+                                            const Transmissibilities& trans);
+
+/// What write_eclipse_deck wrote.
+struct EclipseDeckInfo {
+  std::string data_file;              ///< dir/NAME.DATA
+  std::vector<std::string> files;     ///< every file written, NAME.DATA last
+  EclipseLayout layout;
+  int nnc = 0;                        ///< NNC records written
+  int tran_connections = 0;           ///< non-zero TRANX/Y/Z entries written
+  std::vector<std::vector<std::pair<int32_t, double>>> well_connections;  ///< per well: (cell, CF)
+  std::vector<std::string> warnings;  ///< e.g. negative transmissibilities written as computed
+};
+
+/// NAME of the deck: the case name upper-cased.
+std::string eclipse_deck_name(const CaseSpec& cs);
+
+/// Writes dir/NAME.DATA with its includes NAME_GRID.INC, NAME_NNC.INC, NAME_EDIT.INC,
+/// NAME_SCHEDULE.INC, plus NAME_GRID.GRDECL (the structured reservoir alone, for viewers).
+/// `trans` must come from compute_transmissibilities(mesh, geo) with metric_units = true.
+/// Creates `dir` if needed. All files are written under temporary names and renamed at the end
+/// (NAME.DATA last): on failure nothing complete-looking is left. Never throws for I/O.
+WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const PolyMesh& mesh,
+                               const MeshGeometry& geo, const Transmissibilities& trans,
+                               const EclipseDeckOptions& options = {}, EclipseDeckInfo* info = nullptr);
+
+/// The structured reservoir alone as GRDECL (SPECGRID, COORD, ZCORN, ACTNUM, PORO, PERMX/Y/Z):
+/// ACTNUM 1 where the mesh has the reservoir cell, 0 where the cavity replaced it.
+WriteStatus write_reservoir_grdecl(const std::string& path, const ReservoirSpec& reservoir, const PolyMesh& mesh);
+
+/// Command-line options for `flow` that make the one-step deck a steady-state solve and make it
+/// converge to the accuracy of its float32 output (docs/export-eclipse.md explains each).
+std::vector<std::string> flow_steady_state_options();
+
+}  // namespace hm

@@ -1,0 +1,211 @@
+// Deck layout and deck connections (docs/export-eclipse.md, "Layout").
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <queue>
+#include <sstream>
+#include <utility>
+
+#include "eclipse_deck.hpp"
+
+namespace hm {
+
+namespace {
+
+std::string cell_text(int c) { return "cell " + std::to_string(c); }
+
+}  // namespace
+
+bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const EclipseDeckOptions& opt,
+                         EclipseLayout* out, std::string* error) {
+  EclipseLayout L;
+  L.nx = static_cast<int>(res.x.size()) - 1;
+  L.ny = static_cast<int>(res.y.size()) - 1;
+  L.nz = static_cast<int>(res.z.size()) - 1;
+  if (L.nx < 1 || L.ny < 1 || L.nz < 1) {
+    *error = "reservoir lattice needs at least 2 nodes per axis";
+    return false;
+  }
+  const int nc = mesh.n_cells();
+  if (static_cast<int>(mesh.cell_fv_center.size()) != nc || static_cast<int>(mesh.cell_ijk.size()) != nc) {
+    *error = "mesh per-cell arrays have the wrong size";
+    return false;
+  }
+  if (!(opt.thin_cell_thickness > 0) || !(opt.extra_column_width > 0)) {
+    *error = "thin_cell_thickness and extra_column_width must be > 0";
+    return false;
+  }
+  const double h = opt.thin_cell_thickness;
+
+  // Reservoir cells keep (i,j,k); everything else goes to the extra columns.
+  std::vector<int32_t> res_cell(static_cast<size_t>(L.nx) * L.ny * L.nz, -1);
+  std::vector<int32_t> extra;
+  for (int c = 0; c < nc; ++c) {
+    const auto& ijk = mesh.cell_ijk[c];
+    if (mesh.cell_region[c] != kReservoir || ijk[0] < 0) {
+      extra.push_back(c);
+      continue;
+    }
+    if (ijk[0] >= L.nx || ijk[1] < 0 || ijk[1] >= L.ny || ijk[2] < 0 || ijk[2] >= L.nz) {
+      *error = cell_text(c) + ": (i,j,k) = (" + std::to_string(ijk[0]) + "," + std::to_string(ijk[1]) + "," +
+               std::to_string(ijk[2]) + ") is outside the " + std::to_string(L.nx) + "x" + std::to_string(L.ny) +
+               "x" + std::to_string(L.nz) + " reservoir lattice";
+      return false;
+    }
+    const size_t r = ijk[0] + static_cast<size_t>(L.nx) * (ijk[1] + static_cast<size_t>(L.ny) * ijk[2]);
+    if (res_cell[r] >= 0) {
+      *error = cell_text(c) + " and " + cell_text(res_cell[r]) + " have the same (i,j,k)";
+      return false;
+    }
+    // Flow takes a reservoir cell's depth from its corner points: the FV centre must be there.
+    const double zc = 0.5 * (res.z[ijk[2]] + res.z[ijk[2] + 1]);
+    if (std::abs(mesh.cell_fv_center[c].z - zc) > 1e-9 * (std::abs(zc) + 1.0)) {
+      std::ostringstream s;
+      s.precision(17);
+      s << cell_text(c) << ": FV centre depth " << mesh.cell_fv_center[c].z << " is not the lattice cell centre depth "
+        << zc;
+      *error = s.str();
+      return false;
+    }
+    res_cell[r] = c;
+  }
+
+  // Pack the extra cells by depth: a min-heap of open columns keyed by their current bottom. Cells
+  // come in increasing depth, so if the column with the shallowest bottom cannot take a cell, no
+  // open column can, and a new one is opened (greedy interval colouring: the fewest columns).
+  std::vector<std::pair<double, int32_t>> by_depth;
+  by_depth.reserve(extra.size());
+  for (int32_t c : extra) {
+    const double z = mesh.cell_fv_center[c].z;
+    if (!std::isfinite(z)) {
+      *error = cell_text(c) + ": FV centre is not finite";
+      return false;
+    }
+    by_depth.push_back({z, c});
+  }
+  std::sort(by_depth.begin(), by_depth.end());
+  struct Column {
+    std::vector<int32_t> cells;
+    double bottom = 0;
+  };
+  std::vector<Column> columns;
+  using Key = std::pair<double, int>;  // (bottom, column)
+  std::priority_queue<Key, std::vector<Key>, std::greater<Key>> open;
+  for (const auto& [z, c] : by_depth) {
+    const double top = z - 0.5 * h;
+    int col = -1;
+    // A gap of one thickness between boxes keeps them from touching (no geometric face).
+    if (!open.empty() && open.top().first + h <= top) {
+      col = open.top().second;
+      open.pop();
+    } else {
+      col = static_cast<int>(columns.size());
+      columns.push_back({});
+    }
+    columns[col].cells.push_back(c);
+    columns[col].bottom = z + 0.5 * h;
+    if (static_cast<int>(columns[col].cells.size()) < L.nz) open.push({columns[col].bottom, col});
+  }
+  L.extra_columns = columns.empty() ? 0 : static_cast<int>((columns.size() + L.ny - 1) / L.ny);
+  L.deck_nx = L.extra_columns == 0 ? L.nx : L.nx + 1 + L.extra_columns;
+
+  const size_t nd = static_cast<size_t>(L.deck_nx) * L.ny * L.nz;
+  L.deck_cell.assign(nd, -1);
+  L.top.assign(nd, 0.0);
+  L.bottom.assign(nd, 0.0);
+  L.cell_deck_index.assign(nc, -1);
+  auto deck_index = [&](int i, int j, int k) { return i + static_cast<size_t>(L.deck_nx) * (j + static_cast<size_t>(L.ny) * k); };
+  // Reservoir and separator columns follow the lattice.
+  const int lattice_columns = L.extra_columns == 0 ? L.nx : L.nx + 1;
+  for (int k = 0; k < L.nz; ++k)
+    for (int j = 0; j < L.ny; ++j)
+      for (int i = 0; i < lattice_columns; ++i) {
+        const size_t g = deck_index(i, j, k);
+        L.top[g] = res.z[k];
+        L.bottom[g] = res.z[k + 1];
+        if (i < L.nx) {
+          const int32_t c = res_cell[i + static_cast<size_t>(L.nx) * (j + static_cast<size_t>(L.ny) * k)];
+          L.deck_cell[g] = c;
+          if (c >= 0) L.cell_deck_index[c] = static_cast<int32_t>(g);
+        }
+      }
+  // Extra columns: column m is (i, j) = (nx + 1 + m / ny, m % ny), its cells in k order; unused
+  // slots are zero-thickness boxes at the last bottom (or at the reservoir top).
+  const int n_extra_slots = L.extra_columns * L.ny;
+  for (int m = 0; m < n_extra_slots; ++m) {
+    const int i = L.nx + 1 + m / L.ny, j = m % L.ny;
+    double last = res.z.front();
+    for (int k = 0; k < L.nz; ++k) {
+      const size_t g = deck_index(i, j, k);
+      if (m < static_cast<int>(columns.size()) && k < static_cast<int>(columns[m].cells.size())) {
+        const int32_t c = columns[m].cells[k];
+        const double z = mesh.cell_fv_center[c].z;
+        L.top[g] = z - 0.5 * h;
+        L.bottom[g] = z + 0.5 * h;
+        last = L.bottom[g];
+        L.deck_cell[g] = c;
+        L.cell_deck_index[c] = static_cast<int32_t>(g);
+      } else {
+        L.top[g] = last;
+        L.bottom[g] = last;
+      }
+    }
+  }
+
+  L.pillar_x.assign(res.x.begin(), res.x.end());
+  if (L.extra_columns > 0)
+    for (int m = 1; m <= 1 + L.extra_columns; ++m) L.pillar_x.push_back(res.x.back() + m * opt.extra_column_width);
+  L.pillar_y.assign(res.y.begin(), res.y.end());
+  double zmin = res.z.front(), zmax = res.z.back();
+  for (size_t g = 0; g < nd; ++g) {
+    zmin = std::min(zmin, L.top[g]);
+    zmax = std::max(zmax, L.bottom[g]);
+  }
+  L.pillar_top = zmin - 1.0;
+  L.pillar_bottom = zmax + 1.0;
+  *out = std::move(L);
+  return true;
+}
+
+EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseLayout& L,
+                                            const Transmissibilities& trans) {
+  EclipseConnections out;
+  const size_t nd = static_cast<size_t>(L.n_deck_cells());
+  out.tranx.assign(nd, 0.0);
+  out.trany.assign(nd, 0.0);
+  out.tranz.assign(nd, 0.0);
+  std::vector<EclipseConnections::Nnc> raw;
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    const int32_t o = mesh.face_owner[f], n = mesh.face_neighbour[f];
+    if (n < 0) continue;
+    const double t = trans.face[f];
+    if (t == 0) {
+      ++out.zero_faces;
+      continue;
+    }
+    if (!(t > 0)) ++out.negative_faces;
+    out.total += t;
+    int32_t a = L.cell_deck_index[o], b = L.cell_deck_index[n];
+    if (a > b) std::swap(a, b);
+    const bool both_reservoir = mesh.cell_region[o] == kReservoir && mesh.cell_region[n] == kReservoir &&
+                                mesh.cell_ijk[o][0] >= 0 && mesh.cell_ijk[n][0] >= 0;
+    if (both_reservoir) {
+      const auto ia = L.deck_ijk(a), ib = L.deck_ijk(b);
+      const int d0 = ib[0] - ia[0], d1 = ib[1] - ia[1], d2 = ib[2] - ia[2];
+      if (d0 == 1 && d1 == 0 && d2 == 0) { out.tranx[a] += t; continue; }
+      if (d0 == 0 && d1 == 1 && d2 == 0) { out.trany[a] += t; continue; }
+      if (d0 == 0 && d1 == 0 && d2 == 1) { out.tranz[a] += t; continue; }
+    }
+    raw.push_back({a, b, t});
+  }
+  std::sort(raw.begin(), raw.end(), [](const auto& x, const auto& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  for (const auto& r : raw) {
+    if (!out.nnc.empty() && out.nnc.back().a == r.a && out.nnc.back().b == r.b)
+      out.nnc.back().t += r.t;
+    else
+      out.nnc.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace hm

@@ -1,0 +1,164 @@
+// Running OPM Flow on an exported deck and comparing it with the reference TPFA solve.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include "exporter_test_support.hpp"
+#include "exporters/eclipse/eclipse_deck.hpp"
+
+namespace hmtest {
+
+#define REQUIRE_FLOW()                                                                                 \
+  if (!hmtest::have_executable("flow") || !hmtest::fs::exists("/usr/bin/python3"))                    \
+  GTEST_SKIP() << "OPM Flow (Debian packages libopm-simulators-bin, python3-opm-common) is not "       \
+                  "installed; scripts/install-deps.sh --validators installs it"
+
+struct FlowRun {
+  CommandResult flow;
+  CommandResult reader;
+  nlohmann::json results;  ///< scripts/validate_flow.py output (null if it failed)
+  double seconds = 0;      ///< wall time of the flow run
+};
+
+/// Runs flow with the exporter's steady-state options on dir/NAME.DATA (output in dir/out),
+/// then reads the results back with scripts/validate_flow.py.
+inline FlowRun run_flow(const fs::path& dir, const std::string& name, int timeout_s = 900) {
+  FlowRun r;
+  std::string cmd = "cd " + shell_quote(dir.string()) + " && flow";
+  for (const std::string& a : hm::flow_steady_state_options()) cmd += " " + a;
+  cmd += " --output-dir=out " + shell_quote(name + ".DATA");
+  const auto t0 = std::chrono::steady_clock::now();
+  r.flow = run_command(cmd, timeout_s);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (r.flow.exit_code != 0) return r;
+  r.reader = run_command("/usr/bin/python3 " + shell_quote(std::string(HM_SOURCE_DIR) + "/scripts/validate_flow.py") +
+                             " " + shell_quote((dir / "out").string()) + " " + shell_quote(name) + " 2>/dev/null",
+                         300);
+  if (r.reader.exit_code == 0) r.results = nlohmann::json::parse(r.reader.output, nullptr, false);
+  return r;
+}
+
+/// Debugging aid: with HM_KEEP_TEST_OUTPUT set, writes our solution in flow's active order
+/// (dir/ours.json: "pressure", "rates" by well name) next to the kept deck.
+inline void dump_ours_if_kept(const fs::path& dir, const hm::CaseSpec& cs, const hm::EclipseLayout& L,
+                              const TpfaSolution& ours) {
+  if (std::getenv("HM_KEEP_TEST_OUTPUT") == nullptr) return;
+  nlohmann::json j;
+  std::vector<double> p;
+  for (int32_t c : L.deck_cell)
+    if (c >= 0) p.push_back(ours.pressure[c]);
+  j["pressure"] = p;
+  for (size_t w = 0; w < cs.wells.size(); ++w) j["rates"][cs.wells[w].name] = ours.well_rate[w];
+  std::ofstream(dir / "ours.json") << j.dump();
+}
+
+struct FlowComparison {
+  double max_rel_pressure = 0;  ///< max |p_flow - p_ours| / |p_ours| over cells
+  double max_rel_rate = 0;      ///< max |q_flow - q_ours| / |q_ours| over wells
+  double max_rel_porv = 0;      ///< INIT PORV vs ours
+  double max_depth_diff = 0;    ///< |INIT DEPTH - FV centre z| (m)
+  double max_rel_nnc = 0;       ///< INIT TRANNNC vs our NNC values, matched by cell pair
+  double max_rel_tran = 0;      ///< INIT TRANX/Y/Z vs ours (relative; zeros must stay zeros)
+  size_t flow_nnc = 0;          ///< number of TRANNNC entries flow kept
+  std::string problem;          ///< structural mismatch (counts, missing arrays), empty if none
+};
+
+/// Compares a flow run with the reference solve: active cells map one to one onto mesh cells in
+/// natural deck order; pressures, well rates (WWPR - WWIR = production), INIT PORV/DEPTH and the
+/// NNC list (no NNC dropped, none added) must all match.
+inline FlowComparison compare_flow(const hm::CaseSpec& cs, const hm::PolyMesh& mesh, const hm::MeshGeometry& geo,
+                                   const hm::EclipseDeckInfo& info, const TpfaSolution& ours,
+                                   const hm::EclipseConnections& conn, const nlohmann::json& res) {
+  FlowComparison c;
+  const hm::EclipseLayout& L = info.layout;
+  // Active cells in natural order -> mesh cells.
+  std::vector<int32_t> active_cell;
+  for (size_t g = 0; g < L.deck_cell.size(); ++g)
+    if (L.deck_cell[g] >= 0) active_cell.push_back(L.deck_cell[g]);
+  if (res.is_discarded() || res.is_null()) {
+    c.problem = "no results";
+    return c;
+  }
+  const auto dims = res["dims"];
+  if (dims[0] != L.deck_nx || dims[1] != L.ny || dims[2] != L.nz) {
+    c.problem = "deck dims differ: " + dims.dump();
+    return c;
+  }
+  if (res["active"].get<size_t>() != active_cell.size()) {
+    c.problem = "flow has " + res["active"].dump() + " active cells, the mesh " + std::to_string(active_cell.size());
+    return c;
+  }
+  const auto& p = res["pressure"];
+  const auto& depth = res["init"]["depth"];
+  const auto& porv = res["init"]["porv"];  // global
+  if (p.size() != active_cell.size() || depth.size() != active_cell.size()) {
+    c.problem = "PRESSURE/DEPTH sizes differ from the active cell count";
+    return c;
+  }
+  for (size_t a = 0; a < active_cell.size(); ++a) {
+    const int32_t cell = active_cell[a];
+    const double po = ours.pressure[cell];
+    c.max_rel_pressure = std::max(c.max_rel_pressure, std::abs(p[a].get<double>() - po) / std::abs(po));
+    c.max_depth_diff = std::max(c.max_depth_diff, std::abs(depth[a].get<double>() - mesh.cell_fv_center[cell].z));
+  }
+  if (porv.size() == L.deck_cell.size()) {
+    for (size_t g = 0; g < L.deck_cell.size(); ++g) {
+      if (L.deck_cell[g] < 0) continue;
+      const int32_t cell = L.deck_cell[g];
+      const double pv = geo.cell_volume[cell] * mesh.cell_porosity[cell];
+      c.max_rel_porv = std::max(c.max_rel_porv, std::abs(porv[g].get<double>() - pv) / pv);
+    }
+  } else {
+    c.problem = "INIT PORV has " + std::to_string(porv.size()) + " values";
+  }
+  for (size_t w = 0; w < cs.wells.size(); ++w) {
+    const auto& wj = res["wells"][cs.wells[w].name];
+    const double q = wj.value("WWPR", 0.0) - wj.value("WWIR", 0.0);
+    c.max_rel_rate = std::max(c.max_rel_rate, std::abs(q - ours.well_rate[w]) / std::abs(ours.well_rate[w]));
+  }
+  // TRANX/Y/Z: flow's (active order) must be ours, including the zeros of the extra columns.
+  const char* tran_keys[3] = {"tranx", "trany", "tranz"};
+  const std::vector<double>* tran_ours[3] = {&conn.tranx, &conn.trany, &conn.tranz};
+  double tmax = 0;
+  for (int d = 0; d < 3; ++d)
+    for (double v : *tran_ours[d]) tmax = std::max(tmax, std::abs(v));
+  for (int d = 0; d < 3; ++d) {
+    const auto& arr = res["init"][tran_keys[d]];
+    if (arr.size() != active_cell.size()) {
+      c.problem = std::string("INIT ") + tran_keys[d] + " has " + std::to_string(arr.size()) + " values";
+      return c;
+    }
+    size_t a = 0;
+    for (size_t g = 0; g < L.deck_cell.size(); ++g) {
+      if (L.deck_cell[g] < 0) continue;
+      const double mine = (*tran_ours[d])[g];
+      const double diff = std::abs(arr[a++].get<double>() - mine);
+      // Relative to the value; a zero of ours must be a zero of flow's (floor: 1e-9 of the largest).
+      c.max_rel_tran = std::max(c.max_rel_tran, diff / std::max(std::abs(mine), 1e-9 * tmax));
+    }
+  }
+  // NNC: flow's list (EGRID NNC1/NNC2, INIT TRANNNC) must be exactly ours.
+  const auto& t = res["init"]["trannnc"];
+  const auto& n1 = res["init"]["nnc1"];
+  const auto& n2 = res["init"]["nnc2"];
+  c.flow_nnc = t.size();
+  if (t.size() != conn.nnc.size() || n1.size() != t.size() || n2.size() != t.size()) {
+    c.problem = "flow kept " + std::to_string(t.size()) + " NNCs (" + std::to_string(n1.size()) + " in EGRID), the deck has " +
+                std::to_string(conn.nnc.size());
+    return c;
+  }
+  std::map<std::pair<int32_t, int32_t>, double> mine;
+  for (const auto& r : conn.nnc) mine[{r.a, r.b}] = r.t;
+  for (size_t k = 0; k < t.size(); ++k) {
+    int32_t a = n1[k].get<int32_t>() - 1, b = n2[k].get<int32_t>() - 1;
+    if (a > b) std::swap(a, b);
+    auto it = mine.find({a, b});
+    if (it == mine.end()) {
+      c.problem = "flow has an NNC " + std::to_string(a) + "-" + std::to_string(b) + " that the deck does not";
+      return c;
+    }
+    c.max_rel_nnc = std::max(c.max_rel_nnc, std::abs(t[k].get<double>() - it->second) / std::abs(it->second));
+  }
+  return c;
+}
+
+}  // namespace hmtest
