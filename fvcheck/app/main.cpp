@@ -84,6 +84,11 @@ int main(int argc, char** argv) {
   if (!in.has_region) report.notes.push_back("no region array: every cell counted as reservoir");
   if (h_ref.empty()) report.notes.push_back("no h_ref array: Q_S uses each cell's mean edge length as h");
   if (report.structure.ok) {
+    if (!in.find("permeability")) {
+      // The signs and magnitudes of the geometric part are still worth checking.
+      for (hm::Vec3& k : in.mesh.cell_perm) k = {1, 1, 1};
+      report.notes.push_back("no permeability array: transmissibilities computed with k = 1 mD (geometric part)");
+    }
     const hm::MeshGeometry geo = hm::compute_geometry(in.mesh);
     const hm::Transmissibilities t = hm::compute_transmissibilities(in.mesh, geo);
     report.transmissibility = hm::summarize_transmissibilities(t.face);

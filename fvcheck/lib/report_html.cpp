@@ -41,7 +41,7 @@ std::string ids_text(const std::vector<int32_t>& ids) {
 // A bar chart of nbins equal bins over [lo, hi].
 std::string svg_histogram(const std::string& title, const std::vector<int64_t>& counts, double lo, double hi,
                           const char* tick_fmt, int tick_every, const char* color) {
-  const int W = 360, H = 210, L = 44, R = 10, T = 26, B = 34;
+  const int W = 360, H = 220, L = 44, R = 10, T = 36, B = 34;
   const int pw = W - L - R, ph = H - T - B;
   const int nb = static_cast<int>(counts.size());
   const int64_t cmax = std::max<int64_t>(1, *std::max_element(counts.begin(), counts.end()));
@@ -55,13 +55,13 @@ std::string svg_histogram(const std::string& title, const std::vector<int64_t>& 
   s << "<text x='" << L - 4 << "' y='" << T + ph << "' class='yl'>0</text>";
   const double bw = static_cast<double>(pw) / nb;
   for (int i = 0; i < nb; ++i) {
-    const double h = ph * static_cast<double>(counts[i]) / static_cast<double>(cmax);
+    // At least one pixel for a non-empty bin, so that a few cells among thousands still show.
+    const double h = counts[i] > 0 ? std::max(1.0, ph * static_cast<double>(counts[i]) / static_cast<double>(cmax)) : 0.0;
     const double x = L + i * bw;
     if (counts[i] > 0) {
       s << "<rect x='" << fmt(x + 1, "%.1f") << "' y='" << fmt(T + ph - h, "%.1f") << "' width='"
         << fmt(std::max(bw - 2, 1.0), "%.1f") << "' height='" << fmt(h, "%.1f") << "' fill='" << color
         << "'><title>" << counts[i] << "</title></rect>";
-      if (nb <= 12)
         s << "<text x='" << fmt(x + bw / 2, "%.1f") << "' y='" << fmt(T + ph - h - 3, "%.1f") << "' class='c'>"
           << counts[i] << "</text>";
     }
@@ -92,7 +92,7 @@ svg .t{font-size:13px;text-anchor:middle;font-weight:bold}
 svg .ax{stroke:#333;stroke-width:1}
 svg .yl{font-size:10px;text-anchor:end}
 svg .xl{font-size:10px;text-anchor:middle}
-svg .c{font-size:9px;text-anchor:middle;fill:#333}
+svg .c{font-size:8px;text-anchor:middle;fill:#333}
 .small{font-size:12px;color:#555}
 )";
 
@@ -206,10 +206,13 @@ std::string report_html(const FvReport& r) {
 
   if (r.transmissibility.present) {
     h << "<h2>Transmissibilities</h2><table><tr><th class='l'>faces with T &ne; 0</th><th>min</th><th>max</th>"
-         "<th>negative</th></tr><tr"
+         "<th>negative faces</th><th>negative halves</th></tr><tr"
       << (r.transmissibility.negative > 0 ? " class='bad'" : "") << "><td class='l'>" << r.transmissibility.count
       << "</td><td>" << fmt(r.transmissibility.min) << "</td><td>" << fmt(r.transmissibility.max) << "</td><td>"
-      << r.transmissibility.negative << "</td></tr></table>\n";
+      << r.transmissibility.negative << "</td><td>" << r.transmissibility.negative_halves << "</td></tr></table>\n";
+    if (!r.transmissibility.negative_faces.empty())
+      h << "<p class='small'>Faces with a negative transmissibility: " << ids_text(r.transmissibility.negative_faces)
+        << "</p>\n";
   }
 
   h << "<h2>Thresholds</h2><p class='small'>relative geometric tolerance " << fmt(r.options.rel_tol)
