@@ -1,0 +1,195 @@
+// Transition meshes around real well blocks, through the whole pipeline (reservoir grid,
+// radial well blocks, cavity extraction, transition, assembly), before optimisation.
+// Issue #3 acceptance criteria on vertical, deviated, horizontal, bent and merged wells.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <map>
+#include <set>
+#include <tuple>
+
+#include "meshgen/case/case.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+
+namespace hm {
+namespace {
+
+std::string case_yaml(const std::string& name, const std::string& wells) {
+  return "name: " + name + R"(
+reservoir:
+  x: [0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100]
+  y: [0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100]
+  z: [0, 6, 10, 13.5, 17, 20.5, 24, 27.5, 31, 34.5, 38, 44, 50]
+wells:
+)" + wells + R"(
+transition: {dilation: 1.5, optimize: false}
+)";
+}
+
+std::string well(const std::string& name, const std::string& trajectory, double drainage = 4.0) {
+  return "  - name: " + name + "\n    trajectory: " + trajectory +
+         "\n    radius: 0.1\n    drainage_radius: " + std::to_string(drainage) +
+         "\n    rings: 4\n    sectors: 12\n    segment_length: 3.0\n    bhp: 150\n";
+}
+
+struct WellMetrics {
+  int cells = 0, faces = 0, vertices = 0;
+  int polygons = 0, polygons_not_once = 0, bad_boundary = 0, negative_volumes = 0;
+  double max_closure = 0, volume_error = 0, max_planarity = 0, max_convexity = 0;
+  double min_site_margin = 1e300, min_orth = 90, mean_orth = 0;
+  int n_orth = 0, sites_outside = 0;
+};
+
+// Transition cells: the same properties as on the synthetic cavities. The cavity volume is
+// the volume enclosed by its constrained polygons (fan triangles around each polygon's
+// node mean, as the geometry pass does), so "transition volume == cavity volume" says the
+// cells fill the cavity exactly.
+WellMetrics measure(const HybridMesh& hm) {
+  WellMetrics mt;
+  const PolyMesh& m = hm.mesh;
+  const MeshGeometry& geo = hm.geometry;
+  std::map<std::tuple<double, double, double>, int32_t> node_at;
+  for (int v = 0; v < m.n_nodes(); ++v) node_at[{m.nodes[v].x, m.nodes[v].y, m.nodes[v].z}] = v;
+  std::map<std::vector<int32_t>, int> face_of;  // sorted nodes -> face
+  for (int f = 0; f < m.n_faces(); ++f) {
+    std::vector<int32_t> key(m.face_begin(f), m.face_end(f));
+    std::sort(key.begin(), key.end());
+    face_of[key] = f;
+  }
+  const ReservoirGrid& g = hm.grid;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    if (m.face_neighbour[f] >= 0) continue;
+    if (is_wellbore_patch(m.face_patch[f])) continue;
+    bool ok = false;
+    if (m.face_patch[f] == kOuterBoundary)
+      for (int axis = 0; axis < 3 && !ok; ++axis) {
+        const std::vector<double>& c = axis == 0 ? g.x : axis == 1 ? g.y : g.z;
+        for (double v : {c.front(), c.back()}) {
+          bool all = true;
+          for (const int32_t* n = m.face_begin(f); n != m.face_end(f); ++n) all = all && m.nodes[*n][axis] == v;
+          ok = ok || all;
+        }
+      }
+    if (!ok) ++mt.bad_boundary;
+  }
+  double cavity_volume = 0;
+  for (const Cavity& cav : hm.cavities.cavities)
+    for (const ConstrainedFace& q : cav.faces) {
+      ++mt.polygons;
+      std::vector<int32_t> key;
+      Vec3 gq;
+      for (int32_t v : q.nodes) {
+        const Vec3 p = hm.cavity_node_coords[v];
+        gq += p / static_cast<double>(q.nodes.size());
+        auto it = node_at.find({p.x, p.y, p.z});
+        key.push_back(it == node_at.end() ? -1 : it->second);
+      }
+      for (size_t i = 0; i < q.nodes.size(); ++i) {  // normal into the cavity: minus sign
+        const Vec3 a = hm.cavity_node_coords[q.nodes[i]], b = hm.cavity_node_coords[q.nodes[(i + 1) % q.nodes.size()]];
+        cavity_volume -= dot(gq, cross(a, b)) / 6.0;
+      }
+      std::sort(key.begin(), key.end());
+      auto it = face_of.find(key);
+      int transition_sides = 0;
+      if (it != face_of.end()) {
+        const int f = it->second;
+        transition_sides += m.cell_region[m.face_owner[f]] == kTransition;
+        transition_sides += m.face_neighbour[f] >= 0 && m.cell_region[m.face_neighbour[f]] == kTransition;
+      }
+      mt.polygons_not_once += transition_sides != 1;
+    }
+  double transition_volume = 0;
+  std::set<int> tfaces, tnodes;
+  double orth_sum = 0;
+  for (int c = 0; c < m.n_cells(); ++c) {
+    double asum = 0;
+    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) asum += norm(geo.face_area[*f]);
+    mt.max_closure = std::max(mt.max_closure, norm(cell_area_sum(m, geo, c)) / asum);
+    if (geo.cell_volume[c] <= 0) ++mt.negative_volumes;
+    if (m.cell_region[c] != kTransition) continue;
+    ++mt.cells;
+    transition_volume += geo.cell_volume[c];
+    const double h = hm.cell_h_ref[c];
+    std::set<int32_t> cell_nodes;
+    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) cell_nodes.insert(m.face_begin(*f), m.face_end(*f));
+    tnodes.insert(cell_nodes.begin(), cell_nodes.end());
+    double margin = 1e300;
+    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+      const int f = *fp;
+      tfaces.insert(f);
+      const Vec3 n = normalized(m.face_sign(f, c) * geo.face_area[f]);
+      const Vec3 x0 = geo.face_centroid[f];
+      for (const int32_t* v = m.face_begin(f); v != m.face_end(f); ++v)
+        mt.max_planarity = std::max(mt.max_planarity, std::abs(dot(m.nodes[*v] - x0, n)) / h);
+      for (int32_t v : cell_nodes) mt.max_convexity = std::max(mt.max_convexity, dot(m.nodes[v] - x0, n) / h);
+      margin = std::min(margin, -dot(m.cell_fv_center[c] - x0, n) / h);
+      const int other = m.face_owner[f] == c ? m.face_neighbour[f] : m.face_owner[f];
+      if (other > c && m.cell_region[other] == kTransition) {
+        const Vec3 d = m.cell_fv_center[other] - m.cell_fv_center[c];
+        const double a = 90.0 - std::atan2(norm(cross(d, n)), std::abs(dot(d, n))) * 180.0 / M_PI;
+        mt.min_orth = std::min(mt.min_orth, a);
+        orth_sum += a;
+        ++mt.n_orth;
+      }
+    }
+    mt.min_site_margin = std::min(mt.min_site_margin, margin);
+    mt.sites_outside += margin <= 0;
+  }
+  mt.mean_orth = mt.n_orth ? orth_sum / mt.n_orth : 90;
+  mt.volume_error = std::abs(transition_volume - cavity_volume) / cavity_volume;
+  mt.faces = static_cast<int>(tfaces.size());
+  mt.vertices = static_cast<int>(tnodes.size());
+  return mt;
+}
+
+void run(const char* name, const std::string& yaml, int expected_cavities) {
+  const CaseSpec cs = parse_case(yaml);
+  PipelineOptions opts;
+  opts.optimize = false;
+  const HybridMesh hm = build_hybrid_mesh(cs, opts);
+  const WellMetrics mt = measure(hm);
+  int corrections = 0, hidden = 0, snapped = 0, ambiguous = 0, splits = 0;
+  for (const TransitionReport& r : hm.transition_reports) {
+    corrections += r.site_corrections, hidden += r.hidden_sites, snapped += r.snapped_vertices;
+    ambiguous += r.ambiguous_vertices, splits += r.split_boxes;
+    EXPECT_EQ(r.unmatched_external_faces, 0);
+    EXPECT_EQ(r.missing_polygons, 0);
+  }
+  std::printf("[%s] cavities %zu polygons %d | cells %d faces %d vertices %d | corrections %d splits %d hidden %d "
+              "snapped %d ambiguous %d | orth min %.4f mean %.4f (n %d) | planarity %.2e convexity %.2e "
+              "site-margin %.2e (outside %d) | closure %.1e volume err %.1e\n",
+              name, hm.cavities.cavities.size(), mt.polygons, mt.cells, mt.faces, mt.vertices, corrections, splits,
+              hidden, snapped, ambiguous, mt.min_orth, mt.mean_orth, mt.n_orth, mt.max_planarity, mt.max_convexity,
+              mt.min_site_margin, mt.sites_outside, mt.max_closure, mt.volume_error);
+  for (const TransitionReport& r : hm.transition_reports)
+    for (const std::string& n : r.notes) std::printf("   note: %s\n", n.c_str());
+  EXPECT_EQ(static_cast<int>(hm.cavities.cavities.size()), expected_cavities);
+  EXPECT_TRUE(hm.build_report.ok);
+  EXPECT_EQ(mt.bad_boundary, 0);
+  EXPECT_EQ(mt.polygons_not_once, 0);
+  EXPECT_EQ(mt.negative_volumes, 0);
+  EXPECT_LT(mt.max_closure, 1e-9);
+  EXPECT_LT(mt.volume_error, 1e-9);
+  EXPECT_GT(mt.cells, 0);
+}
+
+TEST(TransitionWells, Vertical) { run("vertical", case_yaml("vertical", well("V", "[[50, 50, 14], [50, 50, 36]]")), 1); }
+
+TEST(TransitionWells, Deviated45) {
+  run("deviated45", case_yaml("deviated45", well("D", "[[40, 50, 16], [56, 50, 32]]")), 1);
+}
+
+TEST(TransitionWells, Horizontal) {
+  run("horizontal", case_yaml("horizontal", well("H", "[[33, 50, 25], [67, 50, 25]]")), 1);
+}
+
+TEST(TransitionWells, Bent) {
+  run("bent", case_yaml("bent", well("B", "[[48, 50, 16], [48, 50, 26], [58, 50, 34]]")), 1);
+}
+
+TEST(TransitionWells, TwoMergedWells) {
+  run("two merged", case_yaml("merged", well("A", "[[46, 50, 14], [46, 50, 36]]") + well("B", "[[55, 52, 14], [55, 52, 36]]")), 1);
+}
+
+}  // namespace
+}  // namespace hm
