@@ -9,7 +9,6 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <sstream>
 
 #include "meshgen/core/geometry.hpp"
 
@@ -850,14 +849,22 @@ ReadResult read_vtu(const std::string& path) {
     r.error = "cannot open " + path + ": " + std::strerror(errno);
     return r;
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  // One buffer of the file's size (no stream copy: mesh files can be large).
+  std::string bytes;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (size > 0) {
+    bytes.resize(static_cast<size_t>(size));
+    in.read(bytes.data(), size);
+    bytes.resize(static_cast<size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  }
   if (in.bad()) {
     ReadResult r;
     r.error = "cannot read " + path;
     return r;
   }
-  ReadResult r = read_vtu_buffer(ss.str());
+  ReadResult r = read_vtu_buffer(bytes);
   if (!r.ok) r.error = path + ": " + r.error;
   return r;
 }
