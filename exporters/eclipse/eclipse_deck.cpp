@@ -132,7 +132,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   for (int c = 0; c < nc; ++c)
     if (!(geo.cell_volume[c] > 0))
       return fail("cell " + std::to_string(c) + " has a non-positive volume " + std::to_string(geo.cell_volume[c]));
-  if (!(options.tstep_days > 0)) return fail("tstep_days must be > 0");
+  // Flow's calendar ends in 2262 (64-bit nanoseconds); the deck starts in 1900.
+  if (!(options.tstep_days > 0 && options.tstep_days <= 130000)) return fail("tstep_days must be in (0, 130000]");
 
   EclipseLayout L;
   std::string error;
@@ -279,7 +280,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       << "RUNSPEC\n\nTITLE\n" << name << "\n\n"
       << "DIMENS\n" << L.deck_nx << ' ' << L.ny << ' ' << L.nz << " /\n\n"
       << "WATER\n\nMETRIC\n\n"
-      << "START\n1 'JAN' 2000 /\n\n"
+      << "-- 1900: flow keeps dates as 64-bit nanoseconds (years 1678..2262); a long step from 2000 wraps.\n"
+      << "START\n1 'JAN' 1900 /\n\n"
       << "-- max wells, max connections per well, max groups, max wells per group\n"
       << "WELLDIMS\n" << std::max(n_wells, 1) << ' ' << max_connections << " 1 " << std::max(n_wells, 1) << " /\n\n"
       << "UNIFOUT\n\n"

@@ -22,8 +22,9 @@ namespace hm {
 
 struct EclipseDeckOptions {
   /// Length of the single report step (days). Long enough that the compressible accumulation
-  /// left after one backward-Euler step is negligible: the run is a steady-state solve.
-  double tstep_days = 1.0e6;
+  /// left after one backward-Euler step is negligible: the run is a steady-state solve. The run
+  /// starts on 1 Jan 1900 and flow's dates end in 2262: at most ~131,000 days.
+  double tstep_days = 1.0e5;
   /// Thickness (m) of the thin boxes that carry the non-reservoir cells. Their depth (centre)
   /// is exact; the thickness only decides how many fit in one column.
   double thin_cell_thickness = 1.0e-3;

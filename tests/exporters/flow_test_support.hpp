@@ -56,9 +56,10 @@ struct FlowComparison {
   double max_rel_rate = 0;      ///< max |q_flow - q_ours| / |q_ours| over wells
   double max_rel_porv = 0;      ///< INIT PORV vs ours
   double max_depth_diff = 0;    ///< |INIT DEPTH - FV centre z| (m)
-  double max_rel_nnc = 0;       ///< INIT TRANNNC vs our NNC values, matched by cell pair
-  double max_rel_tran = 0;      ///< INIT TRANX/Y/Z vs ours (relative; zeros must stay zeros)
-  size_t flow_nnc = 0;          ///< number of TRANNNC entries flow kept
+  double max_rel_connection = 0;  ///< flow's transmissibility per cell pair (INIT) vs ours
+  size_t our_connections = 0;     ///< cell pairs the deck connects (TRANX/Y/Z + NNC)
+  size_t flow_connections = 0;    ///< cell pairs flow connects (INIT TRANX/Y/Z + TRANNNC)
+  size_t flow_nnc = 0;            ///< TRANNNC entries (NNCs not merged into a face)
   std::string problem;          ///< structural mismatch (counts, missing arrays), empty if none
 };
 
@@ -115,12 +116,13 @@ inline FlowComparison compare_flow(const hm::CaseSpec& cs, const hm::PolyMesh& m
     const double q = wj.value("WWPR", 0.0) - wj.value("WWIR", 0.0);
     c.max_rel_rate = std::max(c.max_rel_rate, std::abs(q - ours.well_rate[w]) / std::abs(ours.well_rate[w]));
   }
-  // TRANX/Y/Z: flow's (active order) must be ours, including the zeros of the extra columns.
-  const char* tran_keys[3] = {"tranx", "trany", "tranz"};
+  // Connections: flow merges an NNC between cells that share a geometric face into that face's
+  // TRANX/Y/Z, so compare per cell pair: flow's TRANX/Y/Z (active order, converted to pairs)
+  // plus its TRANNNC list must be exactly our TRANX/Y/Z plus NNC: none dropped, none added.
+  std::map<std::pair<int32_t, int32_t>, double> mine, theirs;
+  const int32_t step[3] = {1, L.deck_nx, L.deck_nx * L.ny};
   const std::vector<double>* tran_ours[3] = {&conn.tranx, &conn.trany, &conn.tranz};
-  double tmax = 0;
-  for (int d = 0; d < 3; ++d)
-    for (double v : *tran_ours[d]) tmax = std::max(tmax, std::abs(v));
+  const char* tran_keys[3] = {"tranx", "trany", "tranz"};
   for (int d = 0; d < 3; ++d) {
     const auto& arr = res["init"][tran_keys[d]];
     if (arr.size() != active_cell.size()) {
@@ -128,35 +130,42 @@ inline FlowComparison compare_flow(const hm::CaseSpec& cs, const hm::PolyMesh& m
       return c;
     }
     size_t a = 0;
-    for (size_t g = 0; g < L.deck_cell.size(); ++g) {
+    for (int32_t g = 0; g < static_cast<int32_t>(L.deck_cell.size()); ++g) {
+      if ((*tran_ours[d])[g] != 0) mine[{g, g + step[d]}] += (*tran_ours[d])[g];
       if (L.deck_cell[g] < 0) continue;
-      const double mine = (*tran_ours[d])[g];
-      const double diff = std::abs(arr[a++].get<double>() - mine);
-      // Relative to the value; a zero of ours must be a zero of flow's (floor: 1e-9 of the largest).
-      c.max_rel_tran = std::max(c.max_rel_tran, diff / std::max(std::abs(mine), 1e-9 * tmax));
+      const double v = arr[a++].get<double>();
+      if (v != 0) theirs[{g, g + step[d]}] += v;
     }
   }
-  // NNC: flow's list (EGRID NNC1/NNC2, INIT TRANNNC) must be exactly ours.
+  for (const auto& r : conn.nnc) mine[{r.a, r.b}] += r.t;
   const auto& t = res["init"]["trannnc"];
   const auto& n1 = res["init"]["nnc1"];
   const auto& n2 = res["init"]["nnc2"];
   c.flow_nnc = t.size();
-  if (t.size() != conn.nnc.size() || n1.size() != t.size() || n2.size() != t.size()) {
-    c.problem = "flow kept " + std::to_string(t.size()) + " NNCs (" + std::to_string(n1.size()) + " in EGRID), the deck has " +
-                std::to_string(conn.nnc.size());
+  if (n1.size() != t.size() || n2.size() != t.size()) {
+    c.problem = "INIT TRANNNC has " + std::to_string(t.size()) + " values, EGRID NNC1/NNC2 " +
+                std::to_string(n1.size()) + "/" + std::to_string(n2.size());
     return c;
   }
-  std::map<std::pair<int32_t, int32_t>, double> mine;
-  for (const auto& r : conn.nnc) mine[{r.a, r.b}] = r.t;
   for (size_t k = 0; k < t.size(); ++k) {
     int32_t a = n1[k].get<int32_t>() - 1, b = n2[k].get<int32_t>() - 1;
     if (a > b) std::swap(a, b);
-    auto it = mine.find({a, b});
+    theirs[{a, b}] += t[k].get<double>();
+  }
+  c.our_connections = mine.size();
+  c.flow_connections = theirs.size();
+  for (const auto& [pair, v] : theirs) {
+    auto it = mine.find(pair);
     if (it == mine.end()) {
-      c.problem = "flow has an NNC " + std::to_string(a) + "-" + std::to_string(b) + " that the deck does not";
+      c.problem = "flow connects deck cells " + std::to_string(pair.first) + " and " + std::to_string(pair.second) +
+                  " (T = " + std::to_string(v) + "), the deck does not";
       return c;
     }
-    c.max_rel_nnc = std::max(c.max_rel_nnc, std::abs(t[k].get<double>() - it->second) / std::abs(it->second));
+    c.max_rel_connection = std::max(c.max_rel_connection, std::abs(v - it->second) / std::abs(it->second));
+  }
+  if (mine.size() != theirs.size()) {
+    c.problem = "flow kept " + std::to_string(theirs.size()) + " connections, the deck has " + std::to_string(mine.size());
+    return c;
   }
   return c;
 }
