@@ -2,6 +2,7 @@
 // stages are in transition_delaunay.cpp and transition_power.cpp.
 #include "transition.hpp"
 
+#include <chrono>
 #include <sstream>
 #include <stdexcept>
 
@@ -55,7 +56,11 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
                                  const ReservoirGrid& grid, const std::vector<WellBlock>& /*blocks*/,
                                  int32_t base_node_id) {
   TransitionReport report;
+  using Clock = std::chrono::steady_clock;
+  auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  const Clock::time_point t0 = Clock::now();
   const std::vector<PolygonFrame> frames = frames_of(cavity, node_coords, report.notes);
+  const Clock::time_point t1 = Clock::now();
   const std::vector<int> bad = non_admissible(cavity, frames);
   if (!bad.empty()) {
     const PolygonFrame& f = frames[bad.front()];
@@ -70,6 +75,7 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
   int iterations = 0;
   report.site_corrections = correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
   report.correction_iterations = iterations;
+  const Clock::time_point t2 = Clock::now();
 
   TransitionCells out;
   for (int round = 0;; ++round) {
@@ -98,6 +104,9 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
   }
   // Merge the stage reports.
   TransitionReport& r = out.report;
+  r.seconds_delaunay = seconds(t0, t1);
+  r.seconds_sites = seconds(t1, t2);
+  r.seconds_power = seconds(t2, Clock::now());
   r.site_corrections = report.site_corrections;
   r.correction_iterations = report.correction_iterations;
   r.hidden_sites = report.hidden_sites;

@@ -26,6 +26,7 @@ struct TransitionReport {
   int hidden_repairs = 0;       ///< rebuilds after moving hidden internal sites
   int power_vertices = 0;       ///< distinct power vertices used by the cells (after exact merging)
   int merged_cells = 0;         ///< RT cells merged into another's power vertex (co-spherical sites)
+  int exact_power_centers = 0;  ///< power vertices of nearly flat RT cells, computed exactly
   int coincident_vertices = 0;  ///< power vertices merged because they coincide numerically (< 1e-9 x size)
   int identified_vertices = 0;  ///< power vertices identified with a constrained vertex combinatorially
   int ambiguous_vertices = 0;   ///< of those, vertices whose sites shared an edge AB (nearest end taken)
@@ -35,6 +36,7 @@ struct TransitionReport {
   int faces = 0;                ///< distinct faces of the transition cells
   double max_identification_shift = 0;  ///< max distance power vertex -> identified constrained node (m)
   double max_snap_shift = 0;    ///< max distance power vertex -> snapped constrained node (m)
+  double seconds_delaunay = 0, seconds_sites = 0, seconds_power = 0;  ///< wall time of the stages
 };
 
 /// Transition cells of one cavity, ready for the builder.

@@ -35,9 +35,10 @@ using WPoint = K::Weighted_point_3;
 using BPoint = K::Point_3;
 using EK = CGAL::Exact_predicates_exact_constructions_kernel;
 
-// The power vertex of a cell, computed exactly and rounded once: the double formula loses
-// up to 1e-8 relative on the nearly flat cells that co-spherical sites produce, which
-// would tilt the faces (orthogonality is checked to 1e-9 degrees).
+// The power vertex of a cell. Co-spherical sites make many nearly flat cells, on which the
+// double formula loses up to 1e-8 relative; those (|det| of the edge vectors below 1e-4 of
+// the product of their lengths) are computed exactly and rounded once. Well-shaped cells
+// keep the fast double formula (error about cond x 1e-16).
 Vec3 exact_power_center(const Regular::Cell_handle& c) {
   const CGAL::Cartesian_converter<K, EK> to_exact;
   const EK::Point_3 p = EK().construct_weighted_circumcenter_3_object()(
@@ -45,6 +46,21 @@ Vec3 exact_power_center(const Regular::Cell_handle& c) {
       to_exact(c->vertex(3)->point()));
   return Vec3{CGAL::to_double(CGAL::exact(p.x())), CGAL::to_double(CGAL::exact(p.y())),
               CGAL::to_double(CGAL::exact(p.z()))};
+}
+
+Vec3 power_center(const Regular& rt, const Regular::Cell_handle& c, int* exact_count) {
+  auto at = [&](int i) {
+    const auto& p = c->vertex(i)->point().point();
+    return Vec3{p.x(), p.y(), p.z()};
+  };
+  const Vec3 p0 = at(0), r1 = at(1) - p0, r2 = at(2) - p0, r3 = at(3) - p0;
+  const double det = dot(r1, cross(r2, r3));
+  if (std::abs(det) > 1e-4 * norm(r1) * norm(r2) * norm(r3)) {
+    const BPoint p = rt.dual(c);
+    return Vec3{p.x(), p.y(), p.z()};
+  }
+  ++*exact_count;
+  return exact_power_center(c);
 }
 
 struct UnionFind {
@@ -178,6 +194,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     int ambiguous = 0;
   };
   std::vector<ClassInfo> info(nc);
+  int exact_centers = 0;
   std::map<int, std::vector<int>> class_cells;
   for (int a = 0; a < nc; ++a) class_cells[uf.find(a)].push_back(a);
   auto cell_class_info = [&](int cls) -> ClassInfo& {
@@ -204,7 +221,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
         ++ci.ambiguous, candidates.insert(candidates.end(), common.begin(), common.end());
       }
     }
-    ci.point = exact_power_center(cells[rep_cell]);
+    ci.point = power_center(rt, cells[rep_cell], &exact_centers);
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     if (!candidates.empty()) {
@@ -413,6 +430,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
   rep.identified_vertices = identified;
   rep.free_vertices = static_cast<int>(out.new_nodes.size());
   rep.ambiguous_vertices = ambiguous;
+  rep.exact_power_centers = exact_centers;
   auto node_of = [&](Token tk) -> int32_t { return tk >= 0 ? static_cast<int32_t>(tk) : free_id.at(static_cast<int>(-1 - tk)); };
 
   // ---- cells
