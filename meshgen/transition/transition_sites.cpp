@@ -354,6 +354,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
       for (size_t b = a + 1; b < order.size(); ++b) {
         const Site& sj = set.sites[order[b]];
         if (sj.p.x - si.p.x > max_w) break;
+        if (!si.internal() && !sj.internal()) continue;  // only transition cells must be auto-centred
         const double d2 = norm2(sj.p - si.p);
         if (d2 > std::max(si.w2, sj.w2)) continue;
         if (std::abs(si.w2 - sj.w2) <= d2) continue;  // condition (6)
