@@ -143,6 +143,13 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
     well_vertices.assign(verts.begin(), verts.end());
     for (const EdgeKey& e : edges) well_edges.push_back({e.a, e.b});
   }
+  std::vector<std::vector<int32_t>> well_polygons;
+  for (size_t w = 0; w < blocks.size(); ++w)
+    for (const auto& poly : blocks[w].surface_faces) {
+      std::vector<int32_t> g;
+      for (int32_t v : poly) g.push_back(well_node_ids[w][v]);
+      well_polygons.push_back(std::move(g));
+    }
   const int lattice_nx = grid.nx() + 1, lattice_ny = grid.ny() + 1;
   std::vector<int32_t> lattice_of(node_coords.size(), -1);  // builder id -> lattice node
   for (int n = 0; n < grid.n_nodes(); ++n) lattice_of[reservoir_node_ids[n]] = n;
@@ -160,13 +167,17 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
   };
 
   // 2. Gabriel across the two sides (paper 5.1): no reservoir boundary edge's diametral
-  //    sphere holds a well vertex and vice versa. Where it fails the cavity grows locally
-  //    (the paper's local dilation): the active cells at the offending reservoir edge or
-  //    vertex are deactivated, and the test runs again.
+  //    sphere holds a well vertex and vice versa; the same for the diametral spheres of the
+  //    constrained polygons (what the transition's site placement needs: the Voronoi edge
+  //    of each polygon must start on the cavity side). Where it fails the cavity grows
+  //    locally (the paper's local dilation): the active cells at the offending reservoir
+  //    edge, face or vertex are deactivated, and the test runs again.
   int repaired_cells = 0, rounds = 0, remaining = 0;
   for (rounds = 0; rounds < 60; ++rounds) {
     std::set<std::pair<int, int>> res_edge_set;
     std::set<int32_t> res_vertex_set;
+    std::vector<std::vector<int32_t>> res_polygons;
+    std::vector<int> res_polygon_cell;  // the active cell outside each reservoir polygon
     for (int c = 0; c < nc; ++c) {
       if (active[c]) continue;
       for (int side = 0; side < 6; ++side) {
@@ -180,11 +191,15 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
         }
         if (!active[n]) continue;
         const auto fn = grid.cell_face_nodes(c, side);
+        std::vector<int32_t> poly;
         for (int i = 0; i < 4; ++i) {
           const int32_t a = res_node(fn[i]), b = res_node(fn[(i + 1) % 4]);
           res_vertex_set.insert(a);
           res_edge_set.insert({std::min(a, b), std::max(a, b)});
+          poly.push_back(a);
         }
+        res_polygons.push_back(std::move(poly));
+        res_polygon_cell.push_back(n);
       }
     }
     std::vector<std::array<int32_t, 2>> res_edges;
@@ -192,7 +207,9 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
     const std::vector<int32_t> res_vertices(res_vertex_set.begin(), res_vertex_set.end());
     const auto bad_res = gabriel_violations(node_coords, res_edges, well_vertices);
     const auto bad_well = gabriel_violations(node_coords, well_edges, res_vertices);
-    remaining = static_cast<int>(bad_res.size() + bad_well.size());
+    const auto bad_res_faces = face_gabriel_violations(node_coords, res_polygons, well_vertices);
+    const auto bad_well_faces = face_gabriel_violations(node_coords, well_polygons, res_vertices);
+    remaining = static_cast<int>(bad_res.size() + bad_well.size() + bad_res_faces.size() + bad_well_faces.size());
     if (remaining == 0) break;
     std::set<int> grow;
     for (const GabrielViolation& v : bad_res) {
@@ -205,6 +222,8 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
       cells_around(std::min(a, b), lo, hi, grow);
     }
     for (const GabrielViolation& v : bad_well) cells_around(lattice_of[v.p], {-1, -1, -1}, {0, 0, 0}, grow);
+    for (const FaceGabrielViolation& v : bad_res_faces) grow.insert(res_polygon_cell[v.polygon]);
+    for (const FaceGabrielViolation& v : bad_well_faces) cells_around(lattice_of[v.p], {-1, -1, -1}, {0, 0, 0}, grow);
     if (grow.empty()) break;  // violations between two wells: nothing in the reservoir to change
     for (int c : grow) active[c] = 0;
     repaired_cells += static_cast<int>(grow.size());

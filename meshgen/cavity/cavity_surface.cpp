@@ -72,6 +72,8 @@ bool write_cavity_surface(const Cavity& cavity, const std::vector<Vec3>& coords,
   // name keeps the extension, which OpenMesh uses to pick the format.
   const std::string tmp = path + ".tmp.obj";
   OpenMesh::IO::Options opt;
+  omlog().disable();  // OpenMesh's writer chatters on its log streams
+  omout().disable();
   if (!OpenMesh::IO::write_mesh(mesh, tmp, opt, 17)) {
     std::remove(tmp.c_str());
     return false;

@@ -29,4 +29,19 @@ std::vector<GabrielViolation> gabriel_violations(const std::vector<Vec3>& nodes,
 std::vector<GabrielViolation> gabriel_violations(const std::vector<Vec3>& nodes,
                                                  const std::vector<std::vector<int32_t>>& polygons);
 
+/// A point strictly inside the diametral sphere of a polygon's fan triangle.
+struct FaceGabrielViolation {
+  int32_t polygon = -1;  ///< index into the polygons given
+  int32_t p = -1;        ///< the offending point
+};
+
+/// Face version of the Gabriel condition: every (polygon, point) pair with the point
+/// strictly inside the smallest sphere through a fan triangle (v0, v_i, v_{i+1}) of the
+/// polygon (exact predicate), the polygon's own vertices excluded. For a co-circular
+/// polygon all fan triangles share that sphere (the polygon's diametral sphere); a
+/// polygon passes only if each of its triangles does. Sorted by (polygon, p).
+std::vector<FaceGabrielViolation> face_gabriel_violations(const std::vector<Vec3>& nodes,
+                                                          const std::vector<std::vector<int32_t>>& polygons,
+                                                          const std::vector<int32_t>& points);
+
 }  // namespace hm

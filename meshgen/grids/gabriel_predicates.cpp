@@ -13,4 +13,8 @@ bool strictly_inside_diametral_sphere(Vec3 a, Vec3 b, Vec3 p) {
   return CGAL::side_of_bounded_sphere(to_cgal(a), to_cgal(b), to_cgal(p)) == CGAL::ON_BOUNDED_SIDE;
 }
 
+bool strictly_inside_diametral_sphere(Vec3 a, Vec3 b, Vec3 c, Vec3 p) {
+  return CGAL::side_of_bounded_sphere(to_cgal(a), to_cgal(b), to_cgal(c), to_cgal(p)) == CGAL::ON_BOUNDED_SIDE;
+}
+
 }  // namespace hm

@@ -9,4 +9,8 @@ namespace hm {
 /// exact (CGAL::side_of_bounded_sphere with EPICK): a co-spherical p is NOT inside.
 bool strictly_inside_diametral_sphere(Vec3 a, Vec3 b, Vec3 p);
 
+/// True iff p lies strictly inside the smallest sphere through a, b and c (the sphere that
+/// has the triangle's circumcircle as a great circle). Exact sign (EPICK).
+bool strictly_inside_diametral_sphere(Vec3 a, Vec3 b, Vec3 c, Vec3 p);
+
 }  // namespace hm

@@ -321,7 +321,6 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   block.cell_attrs.reserve(static_cast<size_t>(n_segments) * rings * sectors);
   for (int l = 0; l < n_segments; ++l) {
     const Leg& g = legs[segment_leg[l]];
-    const Vec3 axis_mid = 0.5 * (layers[l].p + layers[l + 1].p);
     const double length = norm(layers[l + 1].p - layers[l].p);
     for (int i = 0; i < rings; ++i)
       for (int s = 0; s < sectors; ++s) {
@@ -356,7 +355,17 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
         rad.angle = sector_angle;
         rad.length = length;
         const double phi_mid = (s + 0.5) * sector_angle;
-        at.fv_center = axis_mid + rad.r_center * (std::cos(phi_mid) * g.u + std::sin(phi_mid) * g.v);
+        // On the radial line at the mid angle, halfway between where the line parallel to
+        // the leg at radius r_center meets the two cross-section planes: the axis midpoint
+        // on straight legs (ring and angular faces exactly orthogonal); next to a bend it
+        // follows the mitre, so the centre stays inside the cell on the inner side of the
+        // bend (there the ring faces are only nearly orthogonal). A position shared by all
+        // rings of a sector was tried: it makes the axial faces at the bend almost parallel
+        // to the centre-to-centre segments (Q_O of 2 degrees, negative transmissibilities).
+        const Vec3 e_mid = rad.r_center * (std::cos(phi_mid) * g.u + std::sin(phi_mid) * g.v);
+        const Vec3 x0 = layers[l].p + e_mid + plane_offset(layers[l].m, g.d, e_mid) * g.d;
+        const Vec3 x1 = layers[l + 1].p + e_mid + plane_offset(layers[l + 1].m, g.d, e_mid) * g.d;
+        at.fv_center = 0.5 * (x0 + x1);
         block.cell_faces.push_back(std::move(faces));
         block.cell_attrs.push_back(at);
       }

@@ -59,7 +59,8 @@ Built build(const CaseSpec& cs) {
   return b;
 }
 
-// Gabriel across the two sides of every cavity, recomputed from the extracted faces.
+// Gabriel (edges and polygons) across the two sides of every cavity, recomputed from the
+// extracted faces.
 size_t cross_gabriel_violations(const Built& b) {
   size_t n = 0;
   for (const Cavity& cav : b.set.cavities) {
@@ -73,10 +74,13 @@ size_t cross_gabriel_violations(const Built& b) {
         edges[s].insert({std::min(a, c), std::max(a, c)});
       }
     }
+    std::vector<std::vector<int32_t>> polygons[2];
+    for (const ConstrainedFace& f : cav.faces) polygons[static_cast<int>(f.side)].push_back(f.nodes);
     for (int s = 0; s < 2; ++s) {
       std::vector<std::array<int32_t, 2>> e(edges[s].begin(), edges[s].end());
       std::vector<int32_t> p(verts[1 - s].begin(), verts[1 - s].end());
       n += gabriel_violations(b.coords, e, p).size();
+      n += face_gabriel_violations(b.coords, polygons[s], p).size();
     }
   }
   return n;
