@@ -270,6 +270,37 @@ TEST(Transition, SiteCorrection) {
   EXPECT_EQ(s.t, 0.1);                                   // the smaller did not
 }
 
+// Hidden sites are detected, never dropped silently: a site sitting on another one with a
+// smaller weight has no power cell; build_power_cells names it and emits nothing, and the
+// same set without it gives one cell per internal site.
+TEST(Transition, HiddenSiteIsReported) {
+  using namespace transition_detail;
+  Scene sc;
+  InnerBlock b;
+  b.center = {23, 20, 16};
+  b.half = 2.5;
+  build_scene(sc, kX, kY, kZ, central, {b});
+  std::vector<std::string> notes;
+  std::vector<PolygonFrame> frames;
+  for (const ConstrainedFace& f : sc.cavity.faces) frames.push_back(fit_polygon(f.nodes, sc.coords));
+  attach_voronoi_edges(sc.cavity, sc.coords, frames, notes);
+  SiteSet set = make_sites(sc.cavity, sc.coords, sc.grid, frames, notes);
+  int internal = 0;
+  for (const Site& s : set.sites) internal += s.alive && s.internal();
+  TransitionCells ok;
+  EXPECT_TRUE(build_power_cells(set, sc.cavity, sc.coords, frames, ok).empty());
+  EXPECT_EQ(static_cast<int>(ok.cells.size()), internal);
+  EXPECT_EQ(ok.report.missing_polygons, 0);
+  Site ghost = set.sites[set.internal_of[0]];
+  ghost.w2 *= 0.5;
+  set.sites.push_back(ghost);
+  TransitionCells out;
+  const std::vector<int> hidden = build_power_cells(set, sc.cavity, sc.coords, frames, out);
+  ASSERT_EQ(hidden.size(), 1u);
+  EXPECT_EQ(hidden[0], static_cast<int>(set.sites.size()) - 1);
+  EXPECT_TRUE(out.cells.empty());
+}
+
 // A broken cavity (one reservoir polygon dropped, so the surface is open) is not silently
 // accepted: the power faces that should have been that polygon match no constrained
 // polygon, are reported, and the builder finds the faces left without a partner.
