@@ -429,7 +429,7 @@ TEST(RunFvcheck, CentreOutsideFailsOnlyAutoCentering) {
   EXPECT_NE(report_summary_text(r).find("FAILED"), std::string::npos);
 }
 
-TEST(Transmissibility, SummaryCountsNegativeAndNonFinite) {
+TEST(TransmissibilitySummary, CountsNegativeAndNonFinite) {
   const TransmissibilitySummary s = summarize_transmissibilities({0.0, 2.0, -1.0, 5.0, NAN});
   EXPECT_TRUE(s.present);
   EXPECT_EQ(s.count, 3);
