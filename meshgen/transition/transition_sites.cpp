@@ -17,6 +17,11 @@ namespace {
 // the rounding of vertices that are co-spherical by construction (lattice nodes).
 constexpr double kEmptySlack = 1e-10;
 constexpr double kShrink = 0.7;  // alpha of 5.5.3 (paper: 0.7 <= alpha < 1)
+// A polygon site never comes closer to its polygon than this fraction of the circumradius:
+// at t = 0 it would coincide with its reflection (same weighted point, one of them hidden).
+constexpr double kMinT = 1e-3;
+
+double shrunk(double t, double alpha, double radius) { return std::max(alpha * t, std::min(t, kMinT * radius)); }
 
 struct Box {
   Vec3 center;
@@ -298,12 +303,13 @@ void shrink_or_split(SiteSet& set, int s, double alpha, const Cavity& cavity, co
   if (!site.alive) return;
   switch (site.kind) {
     case SiteKind::InternalPolygon:
-      place_polygon_site(set, s, alpha * site.t, cavity, coords, frames);
+      place_polygon_site(set, s, shrunk(site.t, alpha, frames[site.polygon].radius), cavity, coords, frames);
       break;
     case SiteKind::ExternalMirror: {
       const int in = set.internal_of[site.polygon];
       if (set.sites[in].kind == SiteKind::InternalPolygon)
-        place_polygon_site(set, in, alpha * set.sites[in].t, cavity, coords, frames);
+        place_polygon_site(set, in, shrunk(set.sites[in].t, alpha, frames[site.polygon].radius), cavity, coords,
+                           frames);
       else
         split_box(set, in, cavity, coords, frames);
       break;
