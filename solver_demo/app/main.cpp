@@ -1,0 +1,200 @@
+// solver_demo CASE.yaml -o OUTDIR
+//   Builds the hybrid mesh, solves the steady single-phase problem the exported deck poses (wells
+//   at their BHP, no-flow outer boundary, gravity) and writes solution.json and pressure.vtu.
+// solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N]
+//   The near-well accuracy study (docs/accuracy.md): accuracy.json and accuracy.svg.
+// Exit codes: 0 success, 1 failure (meshing, solver), 2 bad input or arguments.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "exporters/vtu/vtu_writer.hpp"
+#include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "solver_demo/lib/accuracy.hpp"
+#include "solver_demo/lib/tpfa.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: solver_demo CASE.yaml -o OUTDIR\n"
+    "       solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N] [--source-to-tips]\n"
+    "         (N refinement levels, default 3; --source-to-tips: the line source runs to the well's end\n"
+    "          points, singular on the end caps, instead of stopping r_w short of them)\n";
+
+int usage(const std::string& why) {
+  std::cerr << "solver_demo: " << why << "\n" << kUsage;
+  return 2;
+}
+
+bool write_text(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    if (!f) return false;
+    f << text;
+    if (!f.good()) return false;
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  return !ec;
+}
+
+int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
+  hm::HybridMesh mesh;
+  hm::FlowSolution sol;
+  try {
+    mesh = hm::build_hybrid_mesh(cs);
+    hm::FlowProblem pb;
+    pb.mesh = &mesh.mesh;
+    pb.geo = &mesh.geometry;
+    pb.viscosity_cp = cs.fluid.viscosity;
+    pb.density = cs.fluid.density;
+    pb.gravity = true;
+    for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w)
+      pb.wells.push_back({w, cs.wells[w].bhp, cs.wells[w].trajectory.front().z});
+    sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry));
+  } catch (const hm::InputError& e) {
+    std::cerr << "solver_demo: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "solver_demo: " << e.what() << "\n";
+    return 1;
+  }
+
+  nlohmann::json j;
+  j["case"] = cs.name;
+  j["wells"] = nlohmann::json::array();
+  for (size_t w = 0; w < cs.wells.size(); ++w)
+    j["wells"].push_back({{"name", cs.wells[w].name},
+                          {"rate_m3_per_day", w < sol.well_rate_m3_per_day.size() ? sol.well_rate_m3_per_day[w] : 0.0},
+                          {"bhp", cs.wells[w].bhp}});
+  double pmin = 0, pmax = 0, vol = 0, pv = 0;
+  if (!sol.pressure.empty()) {
+    pmin = *std::min_element(sol.pressure.begin(), sol.pressure.end());
+    pmax = *std::max_element(sol.pressure.begin(), sol.pressure.end());
+  }
+  for (int c = 0; c < mesh.mesh.n_cells(); ++c) {
+    vol += mesh.geometry.cell_volume[c];
+    pv += mesh.geometry.cell_volume[c] * sol.pressure[c];
+  }
+  j["pressure"] = {{"min", pmin}, {"max", pmax}, {"mean", vol > 0 ? pv / vol : 0.0}};
+  j["cells"] = mesh.mesh.n_cells();
+  j["solver"] = {{"name", sol.solver}, {"iterations", sol.iterations}, {"relative_residual", sol.relative_residual}};
+  if (!write_text(out / "solution.json", j.dump(2) + "\n")) {
+    std::cerr << "solver_demo: cannot write '" << (out / "solution.json").string() << "'\n";
+    return 2;
+  }
+  const hm::WriteStatus st = hm::write_vtu((out / "pressure.vtu").string(), mesh.mesh,
+                                           {hm::VtuCellArray::real("pressure", 1, sol.pressure)});
+  if (!st.ok) {
+    std::cerr << "solver_demo: " << st.message << "\n";
+    return 2;
+  }
+  std::cout << "solver_demo: " << cs.name << ": " << mesh.mesh.n_cells() << " cells, " << sol.solver << ", "
+            << sol.iterations << " iterations, relative residual " << sol.relative_residual << "\n";
+  for (size_t w = 0; w < cs.wells.size(); ++w)
+    std::cout << "  " << cs.wells[w].name << ": bhp " << cs.wells[w].bhp << " bar, rate "
+              << sol.well_rate_m3_per_day[w] << " rm3/day\n";
+  std::cout << "  wrote " << (out / "solution.json").string() << "\n  wrote " << (out / "pressure.vtu").string()
+            << "\n";
+  return 0;
+}
+
+std::string percent(double v) {
+  std::ostringstream os;
+  os << std::setprecision(3) << v * 100 << " %";
+  return os.str();
+}
+
+int run_accuracy(const hm::CaseSpec& cs, const fs::path& out, int levels, const hm::AccuracyOptions& opt) {
+  hm::AccuracyStudy st;
+  try {
+    st = hm::run_accuracy_study(cs, levels, opt);
+  } catch (const hm::InputError& e) {
+    std::cerr << "solver_demo: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "solver_demo: " << e.what() << "\n";
+    return 1;
+  }
+  for (const auto& [name, status] :
+       {std::pair{std::string("accuracy.json"), hm::write_accuracy_json((out / "accuracy.json").string(), st)},
+        std::pair{std::string("accuracy.svg"), hm::write_accuracy_svg((out / "accuracy.svg").string(), st)}})
+    if (!status.ok) {
+      std::cerr << "solver_demo: " << status.message << "\n";
+      return 2;
+    }
+  std::cout << "solver_demo: accuracy of " << cs.name << " (errors relative to the exact rate / the drawdown)\n";
+  for (const hm::RefinementLevel& lv : st.refinement)
+    std::cout << "  x" << lv.factor << ": hybrid (" << lv.hybrid_cells << " cells) rate " << percent(lv.hybrid.rate_rel_error)
+              << ", near-well " << percent(lv.hybrid.near_well_pressure_rel_error) << "; Cartesian + Peaceman ("
+              << lv.cartesian_cells << " cells) rate " << percent(lv.peaceman.rate_rel_error) << ", near-well "
+              << percent(lv.peaceman.near_well_pressure_rel_error) << "\n";
+  std::cout << "  wrote " << (out / "accuracy.json").string() << "\n  wrote " << (out / "accuracy.svg").string() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string case_path, out_dir;
+  bool accuracy = false;
+  int levels = 3;
+  hm::AccuracyOptions acc_opt;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-o" || a == "--output") {
+      if (++i >= argc) return usage("-o needs a directory");
+      out_dir = argv[i];
+    } else if (a == "--accuracy") {
+      accuracy = true;
+    } else if (a == "--source-to-tips") {
+      acc_opt.source_to_tips = true;
+    } else if (a == "--levels") {
+      if (++i >= argc) return usage("--levels needs a number");
+      try {
+        size_t used = 0;
+        levels = std::stoi(argv[i], &used);
+        if (used != std::string(argv[i]).size()) throw std::invalid_argument("trailing characters");
+      } catch (const std::exception&) {
+        return usage(std::string("--levels: not an integer: '") + argv[i] + "'");
+      }
+      if (levels < 1 || levels > 4) return usage("--levels: must be in [1, 4]");
+    } else if (a == "-h" || a == "--help") {
+      std::cout << kUsage;
+      return 0;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage("unknown option '" + a + "'");
+    } else if (case_path.empty()) {
+      case_path = a;
+    } else {
+      return usage("more than one case file given");
+    }
+  }
+  if (case_path.empty()) return usage("no case file given");
+  if (out_dir.empty()) return usage("no output directory given (-o OUTDIR)");
+
+  hm::CaseSpec cs;
+  try {
+    cs = hm::load_case(case_path);
+  } catch (const hm::InputError& e) {
+    std::cerr << "solver_demo: " << e.what() << "\n";
+    return 2;
+  }
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec || !fs::is_directory(out_dir)) {
+    std::cerr << "solver_demo: -o: cannot create directory '" << out_dir << "'" << (ec ? ": " + ec.message() : "")
+              << "\n";
+    return 2;
+  }
+  return accuracy ? run_accuracy(cs, out_dir, levels, acc_opt) : run_flow(cs, out_dir);
+}

@@ -1,0 +1,157 @@
+#include "accuracy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "peaceman.hpp"
+
+namespace hm {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}
+
+AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& opt) {
+  if (cs.wells.size() != 1)
+    throw InputError("wells: the accuracy study needs exactly one well (got " + std::to_string(cs.wells.size()) + ")");
+  const Vec3 k = cs.reservoir.permeability;
+  if (!(k.x == k.y && k.y == k.z))
+    throw InputError("reservoir.permeability: the accuracy study needs isotropic permeability (kx = ky = kz)");
+  const WellSpec& ws = cs.wells[0];
+  if (ws.bhp == cs.reservoir.initial_pressure)
+    throw InputError("wells[0].bhp: must differ from reservoir.initial_pressure (the study's drawdown)");
+  AccuracySetup s;
+  s.near_radius = 3 * ws.drainage_radius;
+  s.viscosity = cs.fluid.viscosity;
+  s.permeability = k.x;
+  s.p_w = ws.bhp;
+  s.drawdown = std::fabs(cs.reservoir.initial_pressure - ws.bhp);
+  s.source_inset = opt.source_to_tips ? 0.0 : ws.radius;
+  s.field = make_line_source_field(ws.trajectory, ws.radius, ws.bhp, cs.reservoir.initial_pressure, s.near_radius,
+                                   s.source_inset);
+  s.reference = field_reference(ws.trajectory);
+  const double q_per_length = 4 * kPi * kDarcyMetric * s.permeability * s.field.coefficient / s.viscosity;
+  s.exact_rate = q_per_length * s.field.source_length();
+  const double leg = norm(ws.trajectory[s.reference.leg + 1] - ws.trajectory[s.reference.leg]);
+  s.slab_half_width = std::max(0.1 * leg, ws.segment_length);
+  return s;
+}
+
+AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
+                                const std::vector<WellConnection>& connections, const AccuracySetup& setup,
+                                std::vector<double>* pressure_out, std::vector<PressureSample>* samples) {
+  const LineSourceField& field = setup.field;
+  FlowProblem pb;
+  pb.mesh = &mesh;
+  pb.geo = &geo;
+  pb.viscosity_cp = setup.viscosity;
+  pb.gravity = false;  // the manufactured solution has no gravity term
+  pb.connections = connections;
+  pb.outer_dirichlet = [&](Vec3 x) { return field.pressure(x); };
+  pb.wellbore_pressure = [&](Vec3 x) { return field.wellbore_pressure(x); };
+  const Transmissibilities tr = compute_transmissibilities(mesh, geo);
+  const FlowSolution sol = solve_tpfa(pb, tr);
+
+  AccuracyErrors e;
+  e.cells = mesh.n_cells();
+  e.iterations = sol.iterations;
+  e.relative_residual = sol.relative_residual;
+  e.exact_rate = setup.exact_rate;
+  e.rate = sol.well_rate_m3_per_day.empty() ? 0.0 : sol.well_rate_m3_per_day[0];
+  e.rate_rel_error = (e.rate - e.exact_rate) / e.exact_rate;
+
+  std::set<int32_t> connected;
+  for (const WellConnection& wc : connections) connected.insert(wc.cell);
+  const std::vector<Vec3>& traj = field.polyline;
+  const int ref_leg = setup.reference.leg;
+  const double ref_len = norm(traj[ref_leg + 1] - traj[ref_leg]);
+  double sum_v = 0, sum_ve2 = 0;
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    if (connected.count(c)) continue;
+    const Vec3 x = mesh.cell_fv_center[c];
+    const PolylinePoint cp = closest_on_polyline(x, traj);
+    if (cp.distance > setup.near_radius) continue;
+    const double exact = field.pressure(x);
+    const double err = std::fabs(sol.pressure[c] - exact) / setup.drawdown;
+    ++e.near_well_cells;
+    const bool beyond_end = (cp.leg == 0 && cp.t == 0.0) || (cp.leg == static_cast<int>(traj.size()) - 2 && cp.t == 1.0);
+    double& side = beyond_end ? e.near_well_max_beyond_ends : e.near_well_max_lateral;
+    side = std::max(side, err);
+    const int region = mesh.cell_region[c];
+    if (region >= 0 && region < 3) e.near_well_max_by_region[region] = std::max(e.near_well_max_by_region[region], err);
+    if (err > e.near_well_pressure_rel_error) {
+      e.near_well_pressure_rel_error = err;
+      e.worst_cell = c;
+      e.worst_region = mesh.cell_region[c];
+      e.worst_point = x;
+      e.worst_distance = cp.distance;
+    }
+    const double v = std::fabs(geo.cell_volume[c]);
+    sum_v += v;
+    sum_ve2 += v * err * err;
+    if (samples) {
+      PressureSample s;
+      s.distance = cp.distance;
+      s.pressure = sol.pressure[c];
+      s.exact = exact;
+      s.region = mesh.cell_region[c];
+      s.in_slab = cp.leg == ref_leg && std::fabs(cp.t - 0.5) * ref_len <= setup.slab_half_width;
+      samples->push_back(s);
+    }
+  }
+  e.l2_pressure_rel_error = sum_v > 0 ? std::sqrt(sum_ve2 / sum_v) : 0.0;
+  if (pressure_out) *pressure_out = sol.pressure;
+  return e;
+}
+
+CaseSpec refine_case(const CaseSpec& cs, int factor) {
+  CaseSpec out = cs;
+  if (factor <= 1) return out;
+  auto split = [factor](const std::vector<double>& v) {
+    std::vector<double> r;
+    for (size_t i = 0; i + 1 < v.size(); ++i)
+      for (int j = 0; j < factor; ++j) r.push_back(v[i] + (v[i + 1] - v[i]) * j / factor);
+    r.push_back(v.back());
+    return r;
+  };
+  out.reservoir.x = split(cs.reservoir.x);
+  out.reservoir.y = split(cs.reservoir.y);
+  out.reservoir.z = split(cs.reservoir.z);
+  for (WellSpec& w : out.wells) {
+    w.rings *= factor;
+    w.sectors *= factor;
+    w.segment_length /= factor;
+  }
+  return out;
+}
+
+AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyOptions& opt) {
+  AccuracyStudy st;
+  st.case_name = cs.name;
+  st.setup = make_accuracy_setup(cs, opt);
+  for (int f = 1; f <= std::max(1, levels); ++f) {
+    const CaseSpec level_case = refine_case(cs, f);
+    RefinementLevel lv;
+    lv.factor = f;
+    {
+      const HybridMesh hm = build_hybrid_mesh(level_case);
+      if (f == 1) st.notes = hm.notes;
+      lv.hybrid_cells = hm.mesh.n_cells();
+      lv.hybrid = measure_accuracy(hm.mesh, hm.geometry, {}, st.setup, nullptr, f == 1 ? &st.hybrid_samples : nullptr);
+    }
+    {
+      const CartesianMesh cm = make_cartesian_mesh(level_case.reservoir);
+      lv.cartesian_cells = cm.mesh.n_cells();
+      lv.peaceman = measure_accuracy(cm.mesh, cm.geo, peaceman_connections(cm, level_case.wells[0], 0), st.setup,
+                                     nullptr, f == 1 ? &st.peaceman_samples : nullptr);
+    }
+    if (f == 1) st.hybrid = lv.hybrid, st.peaceman = lv.peaceman;
+    st.refinement.push_back(lv);
+  }
+  return st;
+}
+
+}  // namespace hm

@@ -1,0 +1,105 @@
+// The near-well accuracy study (issue #7, docs/accuracy.md): a manufactured exact solution (the
+// potential of a uniform line source on the well trajectory) is imposed on the outer boundary
+// and on the wellbore; the TPFA solution on (a) the hybrid mesh and (b) the same reservoir grid
+// with a Peaceman well is compared with it.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "exporters/vtu/vtu_writer.hpp"
+#include "line_source.hpp"
+#include "meshgen/case/case.hpp"
+#include "meshgen/core/geometry.hpp"
+#include "tpfa.hpp"
+
+namespace hm {
+
+struct AccuracyOptions {
+  /// false (default): the source is the trajectory shortened by r_w at both ends, strictly inside
+  /// the wellbore, so the exact p is smooth on the whole flow domain. true: the source runs to the
+  /// trajectory's end points, which lie on the end caps: p is singular (log) at the cap centres.
+  bool source_to_tips = false;
+};
+
+/// Everything the error measures need, derived from a one-well case with isotropic k.
+struct AccuracySetup {
+  LineSourceField field;
+  FieldReference reference;   ///< longest leg's midpoint and perpendicular (where p_w and the drawdown are taken)
+  double p_w = 0;             ///< exact p on the wellbore circle at the reference point (= case bhp)
+  double drawdown = 0;        ///< |p_exact(reference point at near_radius) - p_w| (= |initial_pressure - bhp|)
+  double near_radius = 0;     ///< 3 x drainage radius: the near-well region
+  double viscosity = 1;       ///< cP
+  double permeability = 0;    ///< mD (isotropic)
+  double exact_rate = 0;      ///< rm3/day, q' x trajectory length (> 0 produced)
+  double slab_half_width = 0; ///< plot: cells projecting within this of the reference midpoint
+  double source_inset = 0;    ///< m removed from each end of the trajectory to get the source
+};
+
+/// Throws InputError when the study does not apply: not exactly one well, anisotropic k.
+AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& options = {});
+
+struct AccuracyErrors {
+  double rate_rel_error = 0;                ///< (q - q_exact) / q_exact, signed
+  double near_well_pressure_rel_error = 0;  ///< max |p - p_exact| over near-well cells / drawdown
+  double l2_pressure_rel_error = 0;         ///< volume-weighted RMS of p - p_exact over near-well cells / drawdown
+  double rate = 0, exact_rate = 0;          ///< rm3/day
+  int cells = 0, near_well_cells = 0;
+  // Diagnostics (the same maximum split by where the cell is; they do not replace the measure):
+  double near_well_max_by_region[3] = {0, 0, 0};  ///< over reservoir, transition, well cells
+  double near_well_max_lateral = 0;     ///< cells whose closest trajectory point is not an end point
+  double near_well_max_beyond_ends = 0; ///< cells whose closest trajectory point is an end point
+  int worst_cell = -1;                      ///< where the near-well maximum is reached
+  int worst_region = -1;                    ///< its region code
+  Vec3 worst_point;                         ///< its FV centre
+  double worst_distance = 0;                ///< its distance to the trajectory
+  int iterations = 0;
+  double relative_residual = 0;
+};
+
+/// One cell's pressure against the exact one (plots).
+struct PressureSample {
+  double distance = 0;  ///< FV centre to the trajectory (m)
+  double pressure = 0, exact = 0;
+  int region = 0;
+  bool in_slab = false;  ///< projects onto the reference leg within slab_half_width of its midpoint
+};
+
+/// Solves the exact-solution problem on a mesh (Dirichlet outer faces, exact p on wellbore faces
+/// and on `connections`) and measures the errors. Cells holding a connection are excluded from
+/// the pressure errors (Peaceman's cell pressure is not a point value of p). `pressure` (optional)
+/// receives the solution, `samples` (optional) one entry per near-well cell.
+AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
+                                const std::vector<WellConnection>& connections, const AccuracySetup& setup,
+                                std::vector<double>* pressure = nullptr,
+                                std::vector<PressureSample>* samples = nullptr);
+
+/// The case refined by an integer factor: every reservoir interval split into `factor` equal
+/// parts, rings and sectors multiplied by it, segment_length divided by it.
+CaseSpec refine_case(const CaseSpec& cs, int factor);
+
+struct RefinementLevel {
+  int factor = 1;
+  int hybrid_cells = 0, cartesian_cells = 0;
+  AccuracyErrors hybrid, peaceman;
+};
+
+struct AccuracyStudy {
+  std::string case_name;
+  AccuracySetup setup;
+  AccuracyErrors hybrid, peaceman;
+  std::vector<PressureSample> hybrid_samples, peaceman_samples;
+  std::vector<RefinementLevel> refinement;  ///< factors 1..levels (factor 1 = the case itself)
+  std::vector<std::string> notes;           ///< the mesher's automatic changes
+};
+
+/// Builds the hybrid mesh of the case (and of its refinements) and the Cartesian + Peaceman
+/// model, solves both, measures. levels >= 1. Throws InputError / std::runtime_error.
+AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyOptions& options = {});
+
+/// accuracy.json (docs/accuracy.md has the schema).
+WriteStatus write_accuracy_json(const std::string& path, const AccuracyStudy& study);
+/// The plot: pressure vs distance (exact curve, hybrid and Peaceman points in the reference
+/// slab) and the error / drawdown of every near-well cell vs distance.
+WriteStatus write_accuracy_svg(const std::string& path, const AccuracyStudy& study);
+
+}  // namespace hm
