@@ -187,6 +187,23 @@ PolyMesh from_editable(const EditableMesh& m, const PolyMesh& src) {
   return out;
 }
 
+// Solves A x = rhs for a symmetric positive definite 3x3 A (Cramer's rule); false if singular.
+bool solve3(const double A[3][3], const double rhs[3], Vec3* x) {
+  auto det3 = [](const double M[3][3]) {
+    return M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+           M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
+  };
+  const double D = det3(A);
+  if (!(std::abs(D) > 0)) return false;
+  for (int k = 0; k < 3; ++k) {
+    double M[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) M[i][j] = j == k ? rhs[i] : A[i][j];
+    (*x)[k] = det3(M) / D;
+  }
+  return true;
+}
+
 class Optimizer {
  public:
   Optimizer(const PolyMesh& src, const std::vector<double>& h_ref, const OptimizeParams& p)
@@ -206,7 +223,11 @@ class Optimizer {
     }
   }
 
-  // Phase: 0 = remove without control, 1 = remove under control, 2 = expand under control.
+  // Phase: 0 = remove edges < G1 h, 1 = remove edges < G2 h, 2 = expand edges < G3 h.
+  // Every phase applies the FV controls. The paper removes the G1 edges without control
+  // because its power vertices carry round-off duplicates; ours are identified
+  // combinatorially, and on examples/paper_single_well.yaml uncontrolled removal pushed 81
+  // of 578 cells above omega_p and one face to Q_O = 43 degrees (docs/optimization.md).
   int run_phase(int phase, double gamma, OptimizeReport* rep) {
     int total = 0;
     for (int pass = 0; pass < p_.max_passes; ++pass) {
@@ -215,9 +236,8 @@ class Optimizer {
       for (const auto& cand : short_edges(gamma)) {
         const int32_t a = cand.second.first, b = cand.second.second;
         if (!edge_exists(a, b) || norm(m_.nodes[a] - m_.nodes[b]) >= gamma * edge_h(a, b)) continue;
-        const bool ok = phase == 2 ? try_expand(a, b) : try_collapse(a, b, phase == 1);
-        if (ok) ++changed;
-        else ++rep->rejected;
+        report_ = rep;
+        if (phase == 2 ? try_expand(a, b) : try_collapse(a, b)) ++changed;
       }
       total += changed;
       if (changed == 0) break;
@@ -294,26 +314,36 @@ class Optimizer {
     return cells;
   }
 
+  bool reject(int OptimizeReport::*reason) {
+    ++(report_->*reason);
+    ++report_->rejected;
+    return false;
+  }
+
   void restore(const Saved& s) {
     for (const auto& [f, cyc] : s.faces) m_.faces[f] = cyc;
     for (const auto& [f, al] : s.alive) m_.alive[f] = al;
     for (const auto& [v, p] : s.nodes) m_.nodes[v] = p;
   }
 
-  // Validity always; with `control`, the FV controls of paper 6.2 (orthogonality and
-  // planarity thresholds per cell, auto-centering) on every touched cell.
-  bool accept(const std::set<int32_t>& cells, bool control, const std::set<int32_t>* must_improve_qs,
-              double qs_before) {
+  // Validity (closed, non-degenerate, positive volume, still convex if it was) and the FV
+  // controls of paper 6.2 (per-cell orthogonality and planarity thresholds,
+  // auto-centering) on every touched cell; for an expansion also a better mean Q_S.
+  bool accept(const std::set<int32_t>& cells, const std::set<int32_t>* must_improve_qs, double qs_before) {
     std::vector<std::pair<int32_t, CellMeasures>> measured;
     double qs_sum = 0;
     for (int32_t c : cells) {
       const CellMeasures cm = measure_cell(m_, src_, h_ref_, c);
-      if (!cm.valid || (convex0_[c] && !cm.convex)) return false;
-      if (control && (cm.q_o < thr_o_[c] || cm.q_p > thr_p_[c] || (centred0_[c] && !cm.centred))) return false;
+      if (!cm.valid) return reject(&OptimizeReport::rejected_invalid);
+      if (convex0_[c] && !cm.convex) return reject(&OptimizeReport::rejected_convexity);
+      if (cm.q_o < thr_o_[c]) return reject(&OptimizeReport::rejected_orthogonality);
+      if (cm.q_p > thr_p_[c]) return reject(&OptimizeReport::rejected_planarity);
+      if (centred0_[c] && !cm.centred) return reject(&OptimizeReport::rejected_centering);
       qs_sum += cm.q_s;
       measured.push_back({c, cm});
     }
-    if (must_improve_qs && qs_sum / std::max<size_t>(1, cells.size()) <= qs_before) return false;
+    if (must_improve_qs && qs_sum / std::max<size_t>(1, cells.size()) <= qs_before)
+      return reject(&OptimizeReport::rejected_shape);
     // A cell's thresholds follow its improvements (paper 6.2).
     for (const auto& [c, cm] : measured) {
       thr_o_[c] = std::max(thr_o_[c], std::min(p_.omega_o, cm.q_o));
@@ -322,10 +352,52 @@ class Optimizer {
     return true;
   }
 
-  bool try_collapse(int32_t a, int32_t b, bool control) {
+  // Where two free vertices merge. The paper takes the midpoint; moving a vertex off the
+  // planes of its faces tilts them, which costs orthogonality and planarity. Each face
+  // between two transition cells should lie in a plane normal to the segment between the
+  // two sites (that is what makes the power diagram orthogonal), so the merged vertex is
+  // the least-squares point of those planes (each through its face's current centroid),
+  // regularised toward the midpoint; it falls back to the midpoint if that point strays
+  // farther than the edge's length.
+  Vec3 merge_position(int32_t a, int32_t b) const {
+    const Vec3 mid = 0.5 * (m_.nodes[a] + m_.nodes[b]);
+    const double l = norm(m_.nodes[a] - m_.nodes[b]);
+    double A[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, rhs[3] = {0, 0, 0};
+    std::set<int32_t> faces;
+    for (int32_t v : {a, b})
+      for (int32_t f : m_.node_faces[v])
+        if (m_.alive[f] && transition_face(f)) faces.insert(f);
+    int n_planes = 0;
+    for (int32_t f : faces) {
+      const Vec3 d = src_.cell_fv_center[m_.neighbour[f]] - src_.cell_fv_center[m_.owner[f]];
+      const double dn = norm(d);
+      if (dn == 0) continue;
+      const Vec3 n = d / dn;
+      Vec3 g;
+      for (int32_t v : m_.faces[f]) g += m_.nodes[v];
+      g = g / static_cast<double>(m_.faces[f].size());
+      const double off = dot(n, g);
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) A[i][j] += n[i] * n[j];
+        rhs[i] += n[i] * off;
+      }
+      ++n_planes;
+    }
+    if (n_planes == 0) return mid;
+    const double lambda = 1e-3 * n_planes;  // pulls the free directions to the midpoint
+    for (int i = 0; i < 3; ++i) {
+      A[i][i] += lambda;
+      rhs[i] += lambda * mid[i];
+    }
+    Vec3 p;
+    if (!solve3(A, rhs, &p)) return mid;
+    return norm(p - mid) <= l ? p : mid;
+  }
+
+  bool try_collapse(int32_t a, int32_t b) {
     if (m_.fixed[b] && !m_.fixed[a]) std::swap(a, b);  // keep the constrained vertex in place
     if (m_.fixed[a] && m_.fixed[b]) return false;
-    const Vec3 target = m_.fixed[a] ? m_.nodes[a] : 0.5 * (m_.nodes[a] + m_.nodes[b]);
+    const Vec3 target = m_.fixed[a] ? m_.nodes[a] : merge_position(a, b);
     // Touched: faces that lose b, and faces of a when a moves (case 1); their cells are
     // the ones to check (B_b, or B_a u B_b).
     std::set<int32_t> cells = ball(b);
@@ -355,15 +427,19 @@ class Optimizer {
       m_.faces[f] = cyc;
       if (cyc.size() < 3) m_.alive[f] = 0;
     }
-    if (!accept(cells, control, nullptr, 0)) {
-      restore(s);
-      return false;
-    }
-    for (int32_t f : m_.node_faces[b])
+    // Incidence of the merged vertex (restored below if the collapse is refused).
+    const std::set<int32_t> faces_a = m_.node_faces[a], faces_b = m_.node_faces[b];
+    for (int32_t f : faces_b)
       if (m_.alive[f]) m_.node_faces[a].insert(f);
     m_.node_faces[b].clear();
     for (auto it = m_.node_faces[a].begin(); it != m_.node_faces[a].end();)
       it = m_.alive[*it] ? std::next(it) : m_.node_faces[a].erase(it);
+    if (!accept(cells, nullptr, 0)) {
+      restore(s);
+      m_.node_faces[a] = faces_a;
+      m_.node_faces[b] = faces_b;
+      return false;
+    }
     ++collapsed_;
     return true;
   }
@@ -383,7 +459,7 @@ class Optimizer {
     saved.nodes = {{a, m_.nodes[a]}, {b, m_.nodes[b]}};
     if (!m_.fixed[a]) m_.nodes[a] = m_.nodes[a] - s * ab;
     m_.nodes[b] = m_.nodes[b] + s * ab;
-    if (!accept(cells, true, &cells, qs_before)) {
+    if (!accept(cells, &cells, qs_before)) {
       restore(saved);
       return false;
     }
@@ -397,6 +473,8 @@ class Optimizer {
   std::vector<double> thr_o_, thr_p_;
   std::vector<char> convex0_, centred0_;  // initial state: a control never makes a cell worse
   int collapsed_ = 0;
+  OptimizeReport* report_ = nullptr;
+
 };
 
 }  // namespace
@@ -405,8 +483,8 @@ PolyMesh optimize_transition(const PolyMesh& mesh, const std::vector<double>& h_
                              OptimizeReport* report) {
   OptimizeReport rep;
   Optimizer opt(mesh, h_ref, params);
-  rep.removed_uncontrolled = opt.run_phase(0, params.gamma[0], &rep);
-  rep.removed_controlled = opt.run_phase(1, params.gamma[1], &rep);
+  rep.removed_below_g1 = opt.run_phase(0, params.gamma[0], &rep);
+  rep.removed_below_g2 = opt.run_phase(1, params.gamma[1], &rep);
   rep.expanded = opt.run_phase(2, params.gamma[2], &rep);
   if (report) *report = rep;
   return opt.result();

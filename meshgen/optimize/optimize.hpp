@@ -1,5 +1,5 @@
 // Optimisation of the transition mesh (paper 6.2): small edges are removed, then
-// expanded, under finite-volume controls. Constrained vertices (those of the reservoir
+// expanded, under finite-volume controls (in all three phases: see optimize.cpp). Constrained vertices (those of the reservoir
 // and well grids) never move, so conformity with the structured grids and the total
 // volume are preserved; every accepted change keeps the touched cells closed, convex
 // (if they were) and with positive volume.
@@ -21,10 +21,16 @@ struct OptimizeParams {
 };
 
 struct OptimizeReport {
-  int removed_uncontrolled = 0;  ///< phase 1: edges < G1 h
-  int removed_controlled = 0;    ///< phase 2: edges < G2 h, under FV controls
+  int removed_below_g1 = 0;      ///< phase 1: edges < G1 h removed
+  int removed_below_g2 = 0;      ///< phase 2: edges < G2 h removed
   int expanded = 0;              ///< phase 3: edges < G3 h, expanded
-  int rejected = 0;              ///< candidate operations refused by a control
+  int rejected = 0;              ///< candidate operations refused (the sum of the reasons below)
+  int rejected_invalid = 0;      ///< would open, flatten or invert a cell
+  int rejected_convexity = 0;    ///< would make a convex cell non-convex
+  int rejected_orthogonality = 0;  ///< Q_O(V) below the cell's threshold
+  int rejected_planarity = 0;    ///< Q_P(V) above the cell's threshold
+  int rejected_centering = 0;    ///< a site would leave its cell
+  int rejected_shape = 0;        ///< expansion without mean Q_S improvement
   int passes = 0;
 };
 

@@ -52,10 +52,17 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
     t["before"] = to_json(h.transition_before);
     if (h.optimized) {
       t["after"] = to_json(h.transition_after);
-      t["optimization"] = {{"removed_uncontrolled", h.optimize_report.removed_uncontrolled},
-                           {"removed_controlled", h.optimize_report.removed_controlled},
+      t["optimization"] = {{"removed_below_g1", h.optimize_report.removed_below_g1},
+                           {"removed_below_g2", h.optimize_report.removed_below_g2},
                            {"expanded", h.optimize_report.expanded},
                            {"rejected", h.optimize_report.rejected},
+                           {"rejected_by",
+                            {{"invalid", h.optimize_report.rejected_invalid},
+                             {"convexity", h.optimize_report.rejected_convexity},
+                             {"orthogonality", h.optimize_report.rejected_orthogonality},
+                             {"planarity", h.optimize_report.rejected_planarity},
+                             {"centering", h.optimize_report.rejected_centering},
+                             {"shape", h.optimize_report.rejected_shape}}},
                            {"passes", h.optimize_report.passes}};
     }
     int corrections = 0, hidden = 0, snapped = 0, removed = 0, internal = 0, external = 0;
