@@ -71,21 +71,28 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
   for (int32_t f : m.cell_faces[c])
     if (m.alive[f]) cycles.push_back(outward_cycle(m, f, c));
   if (cycles.size() < 4) return r;
-  // Combinatorial closure: each directed edge once, and its reverse once.
-  std::map<std::pair<int32_t, int32_t>, int> directed;
-  std::set<int32_t> cell_nodes;
+  // Combinatorial closure: each directed edge once, and its reverse once (sorted vectors:
+  // this runs for every cell of every candidate operation).
+  std::vector<std::pair<int32_t, int32_t>> directed;
+  std::vector<int32_t> cell_nodes;
   for (const auto& cyc : cycles) {
-    std::set<int32_t> distinct(cyc.begin(), cyc.end());
-    if (distinct.size() != cyc.size() || cyc.size() < 3) return r;
+    if (cyc.size() < 3) return r;
+    std::vector<int32_t> distinct(cyc);
+    std::sort(distinct.begin(), distinct.end());
+    if (std::adjacent_find(distinct.begin(), distinct.end()) != distinct.end()) return r;
     for (size_t i = 0; i < cyc.size(); ++i) {
-      if (++directed[{cyc[i], cyc[(i + 1) % cyc.size()]}] > 1) return r;
-      cell_nodes.insert(cyc[i]);
+      directed.push_back({cyc[i], cyc[(i + 1) % cyc.size()]});
+      cell_nodes.push_back(cyc[i]);
     }
   }
-  for (const auto& [e, n] : directed)
-    if (!directed.count({e.second, e.first})) return r;
+  std::sort(directed.begin(), directed.end());
+  if (std::adjacent_find(directed.begin(), directed.end()) != directed.end()) return r;
+  for (const auto& e : directed)
+    if (!std::binary_search(directed.begin(), directed.end(), std::make_pair(e.second, e.first))) return r;
+  std::sort(cell_nodes.begin(), cell_nodes.end());
+  cell_nodes.erase(std::unique(cell_nodes.begin(), cell_nodes.end()), cell_nodes.end());
 
-  Vec3 lo = m.nodes[*cell_nodes.begin()], hi = lo;
+  Vec3 lo = m.nodes[cell_nodes.front()], hi = lo;
   for (int32_t v : cell_nodes)
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], m.nodes[v][a]);
@@ -111,7 +118,7 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
     for (size_t i = 0; i < cyc.size(); ++i)
       vol += dot(g - site, cross(m.nodes[cyc[i]] - site, m.nodes[cyc[(i + 1) % cyc.size()]] - site)) / 6.0;
     for (int32_t v : cell_nodes)
-      if (std::find(cyc.begin(), cyc.end(), v) == cyc.end() && dot(n, m.nodes[v] - g) > tol) r.convex = false;
+      if (r.convex && dot(n, m.nodes[v] - g) > tol && std::find(cyc.begin(), cyc.end(), v) == cyc.end()) r.convex = false;
     if (dot(n, site - g) >= -tol) r.centred = false;
     // Q_O (eq. 8): the segment to the other cell's FV centre (or the face centroid on the boundary).
     const int32_t other = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
@@ -124,7 +131,7 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
   // Q_S (eq. 7) over the distinct edges.
   const double h = h_ref.size() > static_cast<size_t>(c) && h_ref[c] > 0 ? h_ref[c] : L;
   r.q_s = 1;
-  for (const auto& [e, n] : directed) {
+  for (const auto& e : directed) {
     if (e.first > e.second) continue;
     const double l = norm(m.nodes[e.first] - m.nodes[e.second]);
     r.q_s = std::min(r.q_s, l > 0 ? std::min(l / h, h / l) : 0.0);
@@ -213,6 +220,7 @@ class Optimizer {
     thr_p_.assign(nc, p.omega_p);
     convex0_.assign(nc, 0);
     centred0_.assign(nc, 0);
+    cell_stamp_.assign(nc, 0);
     for (int c = 0; c < nc; ++c) {
       if (src.cell_region[c] != kTransition) continue;
       const CellMeasures cm = measure_cell(m_, src_, h_ref_, c);
@@ -237,7 +245,16 @@ class Optimizer {
         const int32_t a = cand.second.first, b = cand.second.second;
         if (!edge_exists(a, b) || norm(m_.nodes[a] - m_.nodes[b]) >= gamma * edge_h(a, b)) continue;
         report_ = rep;
-        if (phase == 2 ? try_expand(a, b) : try_collapse(a, b)) ++changed;
+        // A refused operation is retried only once a cell around it has changed.
+        const auto key = std::make_pair(a, b);
+        const auto old = refused_.find(key);
+        if (old != refused_.end() && old->second.first == phase && latest_change(a, b) <= old->second.second) continue;
+        if (phase == 2 ? try_expand(a, b) : try_collapse(a, b)) {
+          ++changed;
+          refused_.erase(key);
+        } else {
+          refused_[key] = {phase, op_count_};
+        }
       }
       total += changed;
       if (changed == 0) break;
@@ -246,6 +263,17 @@ class Optimizer {
   }
 
   PolyMesh result() const { return from_editable(m_, src_); }
+
+  // The last accepted operation that changed a cell around a or b.
+  long latest_change(int32_t a, int32_t b) const {
+    long t = 0;
+    for (int32_t v : {a, b})
+      for (int32_t f : m_.node_faces[v])
+        if (m_.alive[f])
+          for (int32_t c : {m_.owner[f], m_.neighbour[f]})
+            if (c >= 0) t = std::max(t, cell_stamp_[c]);
+    return t;
+  }
 
  private:
   struct Saved {
@@ -345,7 +373,9 @@ class Optimizer {
     if (must_improve_qs && qs_sum / std::max<size_t>(1, cells.size()) <= qs_before)
       return reject(&OptimizeReport::rejected_shape);
     // A cell's thresholds follow its improvements (paper 6.2).
+    ++op_count_;
     for (const auto& [c, cm] : measured) {
+      cell_stamp_[c] = op_count_;
       thr_o_[c] = std::max(thr_o_[c], std::min(p_.omega_o, cm.q_o));
       thr_p_[c] = std::min(thr_p_[c], std::max(p_.omega_p, cm.q_p));
     }
@@ -473,6 +503,9 @@ class Optimizer {
   std::vector<double> thr_o_, thr_p_;
   std::vector<char> convex0_, centred0_;  // initial state: a control never makes a cell worse
   int collapsed_ = 0;
+  long op_count_ = 0;                 // accepted operations so far
+  std::vector<long> cell_stamp_;      // per cell: the accepted operation that last changed it
+  std::map<std::pair<int32_t, int32_t>, std::pair<int, long>> refused_;  // edge -> (phase, op_count_)
   OptimizeReport* report_ = nullptr;
 
 };
