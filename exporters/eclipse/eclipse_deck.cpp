@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include "meshgen/core/mesh_builder.hpp"
 #include "staged_files.hpp"
@@ -99,10 +100,7 @@ std::string eclipse_deck_name(const CaseSpec& cs) { return upper(cs.name); }
 
 std::vector<std::string> flow_steady_state_options() {
   return {"--enable-adaptive-time-stepping=false", "--time-step-control=newtoniterationcount",
-          "--max-residual-allowed=1e30",           "--tolerance-mb=1e-12",
-          "--tolerance-cnv=1e-9",                  "--tolerance-wells=1e-12",
-          "--linear-solver-reduction=1e-12",       "--linear-solver-max-iter=2000",
-          "--newton-min-iterations=2",             "--newton-max-iterations=30"};
+          "--max-residual-allowed=1e30", "--linear-solver-reduction=1e-6", "--tolerance-mb=1e-9"};
 }
 
 WriteStatus write_reservoir_grdecl(const std::string& path, const ReservoirSpec& reservoir, const PolyMesh& mesh) {
@@ -149,6 +147,13 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   if (conn.negative_faces > 0)
     warnings.push_back(std::to_string(conn.negative_faces) +
                        " interior faces have a negative or non-finite transmissibility (written as computed)");
+  if (conn.below_flow_threshold > 0) {
+    std::ostringstream w;
+    w << conn.below_flow_threshold << " NNC records have T < " << kFlowNncThreshold
+      << " cP.rm3/day/bar, which OPM Flow ignores (sum " << conn.below_flow_threshold_sum << " of a total "
+      << conn.total << ")";
+    warnings.push_back(w.str());
+  }
   if (conn.zero_faces > 0)
     warnings.push_back(std::to_string(conn.zero_faces) + " interior faces have a zero transmissibility (no connection)");
 
@@ -164,7 +169,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     o << "-- Deck grid: reservoir columns 1.." << L.nx;
     if (L.extra_columns > 0)
       o << ", separator column " << L.nx + 1 << " (inactive), well/transition cells in columns " << L.nx + 2 << ".."
-        << L.deck_nx << " (thin boxes at their FV-centre depth)";
+        << L.deck_nx << " (thin boxes at their FV-centre depth, on every other I and J)";
     o << ".\n\n";
     write_coord(o, L.pillar_x, L.pillar_y, L.pillar_top, L.pillar_bottom);
     write_zcorn(o, L.deck_nx, L.ny, L.nz, L.top, L.bottom);

@@ -3,7 +3,8 @@
 // Deck layout ("layout 2" of shared/reference/opm-flow-deck.md): the structured reservoir keeps
 // its (i,j,k) in columns 1..NX of a corner-point grid; reservoir cells replaced by the cavity are
 // inactive; column NX+1 is an inactive separator; every other cell (well and transition cells)
-// is a thin box at its true FV-centre depth in the extra columns NX+2..NX+1+MX. Flow then uses
+// is a thin box at its true FV-centre depth in the extra columns NX+2..NX+1+MX (every other I and
+// every other J, so that boxes of different columns never touch). Flow then uses
 // OUR numbers: TRANX/Y/Z (EDIT) for logical reservoir neighbours, NNC for every other connection,
 // PORV (EDIT) = volume * porosity, COMPDAT CF = wellbore connection factors, depths = FV centres.
 #pragma once
@@ -35,7 +36,7 @@ struct EclipseDeckOptions {
 /// Where every mesh cell sits in the deck's corner-point grid.
 struct EclipseLayout {
   int nx = 0, ny = 0, nz = 0;   ///< the reservoir lattice of the case
-  int extra_columns = 0;        ///< MX: extra i-columns for the non-reservoir cells (0: none)
+  int extra_columns = 0;        ///< MX: i-columns after the separator (0: none); boxes on every other i and j
   int deck_nx = 0;              ///< NX of DIMENS: nx, or nx + 1 + extra_columns
   /// n_cells: 0-based natural deck index I + deck_nx (J + ny K) of each mesh cell.
   std::vector<int32_t> cell_deck_index;
@@ -58,6 +59,11 @@ struct EclipseLayout {
 bool make_eclipse_layout(const ReservoirSpec& reservoir, const PolyMesh& mesh, const EclipseDeckOptions& options,
                          EclipseLayout* layout, std::string* error);
 
+/// OPM Flow sets every connection between cells that are not logical (I,J,K) neighbours to zero
+/// when its transmissibility is below this value in the deck's units (cP.rm3/day/bar in METRIC);
+/// its INIT file then lists the NNC with a negative TRANNNC.
+constexpr double kFlowNncThreshold = 1e-6;
+
 /// The transmissibilities as the deck carries them (METRIC, cP.rm3/day/bar).
 struct EclipseConnections {
   /// deck cells: transmissibility to the +I / +J / +K neighbour, for logical neighbours that are
@@ -70,6 +76,8 @@ struct EclipseConnections {
   std::vector<Nnc> nnc;      ///< every other connection, sorted by (a, b), t != 0
   int zero_faces = 0;        ///< interior faces with T == 0 (nothing to write)
   int negative_faces = 0;    ///< interior faces with T < 0 or not finite (written as computed)
+  int below_flow_threshold = 0;        ///< NNC records flow ignores: |t| < kFlowNncThreshold, not logical neighbours
+  double below_flow_threshold_sum = 0; ///< their summed |t|
   double total = 0;          ///< sum of all interior face transmissibilities (for checks)
 };
 

@@ -106,9 +106,13 @@ bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const E
     columns[col].bottom = z + 0.5 * h;
     if (static_cast<int>(columns[col].cells.size()) < L.nz) open.push({columns[col].bottom, col});
   }
-  L.extra_columns = columns.empty() ? 0 : static_cast<int>((columns.size() + L.ny - 1) / L.ny);
+  // Extra columns sit on every other i and every other j: two thin boxes of neighbouring columns
+  // that overlap in depth would get a geometric (fault-like) connection from flow that no EDIT
+  // keyword removes; columns with an inactive column between them never touch.
+  const int rows = (L.ny + 1) / 2;
+  const int slabs = columns.empty() ? 0 : static_cast<int>((columns.size() + rows - 1) / rows);
+  L.extra_columns = slabs == 0 ? 0 : 2 * slabs - 1;
   L.deck_nx = L.extra_columns == 0 ? L.nx : L.nx + 1 + L.extra_columns;
-
   const size_t nd = static_cast<size_t>(L.deck_nx) * L.ny * L.nz;
   L.deck_cell.assign(nd, -1);
   L.top.assign(nd, 0.0);
@@ -129,28 +133,29 @@ bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const E
           if (c >= 0) L.cell_deck_index[c] = static_cast<int32_t>(g);
         }
       }
-  // Extra columns: column m is (i, j) = (nx + 1 + m / ny, m % ny), its cells in k order; unused
-  // slots are zero-thickness boxes at the last bottom (or at the reservoir top).
-  const int n_extra_slots = L.extra_columns * L.ny;
-  for (int m = 0; m < n_extra_slots; ++m) {
-    const int i = L.nx + 1 + m / L.ny, j = m % L.ny;
-    double last = res.z.front();
-    for (int k = 0; k < L.nz; ++k) {
-      const size_t g = deck_index(i, j, k);
-      if (m < static_cast<int>(columns.size()) && k < static_cast<int>(columns[m].cells.size())) {
-        const int32_t c = columns[m].cells[k];
-        const double z = mesh.cell_fv_center[c].z;
-        L.top[g] = z - 0.5 * h;
-        L.bottom[g] = z + 0.5 * h;
-        last = L.bottom[g];
-        L.deck_cell[g] = c;
-        L.cell_deck_index[c] = static_cast<int32_t>(g);
-      } else {
-        L.top[g] = last;
-        L.bottom[g] = last;
+  // Extra columns: column m is (i, j) = (nx + 1 + 2 (m / rows), 2 (m % rows)), its cells in k order;
+  // unused slots (and the inactive columns in between) are zero-thickness boxes at the last bottom
+  // (or at the reservoir top).
+  for (int i = L.nx + 1; i < L.deck_nx; ++i)
+    for (int j = 0; j < L.ny; ++j) {
+      const int m = (i - L.nx - 1) % 2 == 0 && j % 2 == 0 ? (i - L.nx - 1) / 2 * rows + j / 2 : -1;
+      double last = res.z.front();
+      for (int k = 0; k < L.nz; ++k) {
+        const size_t g = deck_index(i, j, k);
+        if (m >= 0 && m < static_cast<int>(columns.size()) && k < static_cast<int>(columns[m].cells.size())) {
+          const int32_t c = columns[m].cells[k];
+          const double z = mesh.cell_fv_center[c].z;
+          L.top[g] = z - 0.5 * h;
+          L.bottom[g] = z + 0.5 * h;
+          last = L.bottom[g];
+          L.deck_cell[g] = c;
+          L.cell_deck_index[c] = static_cast<int32_t>(g);
+        } else {
+          L.top[g] = last;
+          L.bottom[g] = last;
+        }
       }
     }
-  }
 
   L.pillar_x.assign(res.x.begin(), res.x.end());
   if (L.extra_columns > 0)
@@ -205,6 +210,13 @@ EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseL
     else
       out.nnc.push_back(r);
   }
+  // Flow's test: index difference not 1, NX or NX*NY (it keeps small logical-neighbour connections).
+  const int32_t nxd = L.deck_nx, nxy = L.deck_nx * L.ny;
+  for (const auto& r : out.nnc)
+    if (std::abs(r.t) < kFlowNncThreshold && r.b - r.a != 1 && r.b - r.a != nxd && r.b - r.a != nxy) {
+      ++out.below_flow_threshold;
+      out.below_flow_threshold_sum += std::abs(r.t);
+    }
   return out;
 }
 

@@ -133,6 +133,21 @@ TEST(EclipseLayout, ReservoirCellsKeepIjkOthersAreThinBoxesInExtraColumns) {
         last_bottom = L.bottom[g];
       }
     }
+  // No box of an extra column has an active lateral neighbour (it would touch it geometrically).
+  for (int g = 0; g < L.n_deck_cells(); ++g) {
+    const auto ijk = L.deck_ijk(g);
+    if (L.deck_cell[g] < 0 || ijk[0] <= L.nx) continue;
+    EXPECT_EQ(L.deck_cell[g - 1], -1);
+    if (ijk[0] + 1 < L.deck_nx) {
+      EXPECT_EQ(L.deck_cell[g + 1], -1);
+    }
+    if (ijk[1] + 1 < L.ny) {
+      EXPECT_EQ(L.deck_cell[g + L.deck_nx], -1);
+    }
+    if (ijk[1] > 0) {
+      EXPECT_EQ(L.deck_cell[g - L.deck_nx], -1);
+    }
+  }
   // 8 well cells per layer share one depth: at least 8 columns.
   int columns_used = 0;
   for (int j = 0; j < L.ny; ++j)
@@ -150,9 +165,11 @@ TEST(EclipseLayout, FewLayersForceMoreColumns) {
   hm::EclipseLayout L;
   std::string error;
   ASSERT_TRUE(hm::make_eclipse_layout(cs.reservoir, mesh, {}, &L, &error)) << error;
-  EXPECT_EQ(L.extra_columns, 1);  // 4 well cells in 5 rows of the first extra column
+  // 4 well cells, one per column, columns on rows j = 0, 2, 4: two slabs (I = nx+2 and nx+4).
+  EXPECT_EQ(L.extra_columns, 3);
   int placed = 0;
-  for (int j = 0; j < L.ny; ++j) placed += L.deck_cell[(L.nx + 1) + L.deck_nx * j] >= 0;
+  for (int j = 0; j < L.ny; ++j)
+    for (int i = L.nx + 1; i < L.deck_nx; ++i) placed += L.deck_cell[i + L.deck_nx * j] >= 0;
   EXPECT_EQ(placed, 4);
 }
 

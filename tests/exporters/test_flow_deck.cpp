@@ -61,6 +61,7 @@ TEST(FlowDeck, BoxWithTwoVerticalWellsAndGravityMatchesOurSolve) {
   EXPECT_LT(c.max_depth_diff, 1e-3);
   EXPECT_LT(c.max_rel_connection, 1e-6);
   EXPECT_EQ(c.flow_connections, c.our_connections);
+  EXPECT_EQ(c.dropped_by_flow, c.expected_dropped);
 }
 
 // The fail half of the pair: the same comparison flags a deck whose transmissibilities are not
@@ -141,6 +142,7 @@ TEST(FlowDeck, LargerBoxWithFourWellsMatchesOurSolve) {
   EXPECT_LT(c.max_rel_porv, 1e-6);
   EXPECT_LT(c.max_rel_connection, 1e-6);
   EXPECT_EQ(c.flow_connections, c.our_connections);
+  EXPECT_EQ(c.dropped_by_flow, c.expected_dropped);
 }
 
 }  // namespace
