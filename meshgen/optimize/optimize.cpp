@@ -240,7 +240,9 @@ class Optimizer {
     int total = 0;
     for (int pass = 0; pass < p_.max_passes; ++pass) {
       ++rep->passes;
-      int changed = 0;
+      report_ = rep;
+      int changed = phase == 2 ? 0 : collapse_small_faces(gamma);
+      rep->collapsed_faces += changed;
       for (const auto& cand : short_edges(gamma)) {
         const int32_t a = cand.second.first, b = cand.second.second;
         if (!edge_exists(a, b) || norm(m_.nodes[a] - m_.nodes[b]) >= gamma * edge_h(a, b)) continue;
@@ -389,12 +391,16 @@ class Optimizer {
   // the least-squares point of those planes (each through its face's current centroid),
   // regularised toward the midpoint; it falls back to the midpoint if that point strays
   // farther than the edge's length.
-  Vec3 merge_position(int32_t a, int32_t b) const {
-    const Vec3 mid = 0.5 * (m_.nodes[a] + m_.nodes[b]);
-    const double l = norm(m_.nodes[a] - m_.nodes[b]);
+  Vec3 merge_position(const std::vector<int32_t>& verts) const {
+    Vec3 mid;
+    for (int32_t v : verts) mid += m_.nodes[v];
+    mid = mid / static_cast<double>(verts.size());
+    double l = 0;  // the farthest the merged vertex may go: the set's diameter
+    for (int32_t v : verts)
+      for (int32_t w : verts) l = std::max(l, norm(m_.nodes[v] - m_.nodes[w]));
     double A[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, rhs[3] = {0, 0, 0};
     std::set<int32_t> faces;
-    for (int32_t v : {a, b})
+    for (int32_t v : verts)
       for (int32_t f : m_.node_faces[v])
         if (m_.alive[f] && transition_face(f)) faces.insert(f);
     int n_planes = 0;
@@ -424,54 +430,100 @@ class Optimizer {
     return norm(p - mid) <= l ? p : mid;
   }
 
-  bool try_collapse(int32_t a, int32_t b) {
-    if (m_.fixed[b] && !m_.fixed[a]) std::swap(a, b);  // keep the constrained vertex in place
-    if (m_.fixed[a] && m_.fixed[b]) return false;
-    const Vec3 target = m_.fixed[a] ? m_.nodes[a] : merge_position(a, b);
-    // Touched: faces that lose b, and faces of a when a moves (case 1); their cells are
-    // the ones to check (B_b, or B_a u B_b).
-    std::set<int32_t> cells = ball(b);
-    if (!m_.fixed[a])
-      for (int32_t c : ball(a)) cells.insert(c);
-    Saved s;
-    s.nodes = {{a, m_.nodes[a]}, {b, m_.nodes[b]}};
-    std::set<int32_t> touched;
-    for (int32_t f : m_.node_faces[b])
-      if (m_.alive[f]) touched.insert(f);
-    if (!m_.fixed[a])
-      for (int32_t f : m_.node_faces[a])
+  // Merges a set of vertices (an edge, or all the vertices of a small face) into one:
+  // the constrained vertex if the set has one (it stays in place), else a new position
+  // (merge_position). Faces that fall below 3 vertices disappear. Accepted only if every
+  // touched cell stays valid and passes the controls; otherwise everything is restored.
+  bool try_merge(std::vector<int32_t> verts, int target_choice = 0) {
+    std::sort(verts.begin(), verts.end());
+    int32_t keep = verts.front();
+    int n_fixed = 0;
+    for (int32_t v : verts)
+      if (m_.fixed[v]) {
+        keep = v;
+        ++n_fixed;
+      }
+    if (n_fixed > 1) return false;
+    const bool keep_moves = n_fixed == 0;
+    // target_choice 0: the plane-fitting position; k > 0: where verts[k - 1] is.
+    const Vec3 target = !keep_moves ? m_.nodes[keep]
+                        : target_choice == 0 ? merge_position(verts)
+                                             : m_.nodes[verts[target_choice - 1]];
+    // Touched: faces of the vertices that disappear, and faces of the keeper if it moves.
+    std::set<int32_t> touched, cells;
+    for (int32_t v : verts) {
+      if (v == keep && !keep_moves) continue;
+      for (int32_t f : m_.node_faces[v])
         if (m_.alive[f]) touched.insert(f);
+      for (int32_t c : ball(v)) cells.insert(c);
+    }
+    Saved s;
+    for (int32_t v : verts) s.nodes.push_back({v, m_.nodes[v]});
     for (int32_t f : touched) {
       if (!transition_face(f)) return false;  // never rewrite a reservoir or well face
       s.faces.push_back({f, m_.faces[f]});
       s.alive.push_back({f, m_.alive[f]});
     }
-    m_.nodes[a] = target;
+    auto merged = [&](int32_t v) { return std::binary_search(verts.begin(), verts.end(), v) ? keep : v; };
+    m_.nodes[keep] = target;
     for (int32_t f : touched) {
       std::vector<int32_t> cyc;
       for (int32_t v : m_.faces[f]) {
-        const int32_t w = v == b ? a : v;
+        const int32_t w = merged(v);
         if (cyc.empty() || cyc.back() != w) cyc.push_back(w);
       }
       while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
       m_.faces[f] = cyc;
       if (cyc.size() < 3) m_.alive[f] = 0;
     }
-    // Incidence of the merged vertex (restored below if the collapse is refused).
-    const std::set<int32_t> faces_a = m_.node_faces[a], faces_b = m_.node_faces[b];
-    for (int32_t f : faces_b)
-      if (m_.alive[f]) m_.node_faces[a].insert(f);
-    m_.node_faces[b].clear();
-    for (auto it = m_.node_faces[a].begin(); it != m_.node_faces[a].end();)
-      it = m_.alive[*it] ? std::next(it) : m_.node_faces[a].erase(it);
     if (!accept(cells, nullptr, 0)) {
       restore(s);
-      m_.node_faces[a] = faces_a;
-      m_.node_faces[b] = faces_b;
       return false;
     }
-    ++collapsed_;
+    for (int32_t v : verts) {
+      if (v == keep) continue;
+      for (int32_t f : m_.node_faces[v])
+        if (m_.alive[f]) m_.node_faces[keep].insert(f);
+      m_.node_faces[v].clear();
+    }
+    for (auto it = m_.node_faces[keep].begin(); it != m_.node_faces[keep].end();)
+      it = m_.alive[*it] ? std::next(it) : m_.node_faces[keep].erase(it);
     return true;
+  }
+
+  // An edge of two free vertices merges at the plane-fitting position, or failing that at
+  // either end (which leaves that end's faces untouched); a constrained end stays put.
+  bool try_collapse(int32_t a, int32_t b) {
+    if (try_merge({a, b})) return true;
+    if (m_.fixed[a] || m_.fixed[b]) return false;
+    return try_merge({a, b}, 1) || try_merge({a, b}, 2);
+  }
+
+  // Small faces (paper 6.2: "small faces are then removed in an implicit way"): a face
+  // whose edges are all shorter than gamma h collapses to a point in one operation.
+  // Collapsing its edges one at a time would first turn it into a tilted sliver that the
+  // orthogonality control refuses.
+  int collapse_small_faces(double gamma) {
+    std::vector<std::pair<double, int32_t>> small;
+    for (size_t f = 0; f < m_.faces.size(); ++f) {
+      if (!m_.alive[f] || !transition_face(static_cast<int32_t>(f))) continue;
+      const auto& cyc = m_.faces[f];
+      double longest = 0, h = 1e300;
+      for (size_t i = 0; i < cyc.size(); ++i) {
+        const int32_t a = cyc[i], b = cyc[(i + 1) % cyc.size()];
+        longest = std::max(longest, norm(m_.nodes[a] - m_.nodes[b]));
+        h = std::min(h, edge_h(a, b));
+      }
+      if (h > 0 && longest < gamma * h) small.push_back({longest / h, static_cast<int32_t>(f)});
+    }
+    std::sort(small.begin(), small.end());
+    int merged = 0;
+    for (const auto& [ratio, f] : small) {
+      (void)ratio;
+      if (!m_.alive[f]) continue;
+      if (try_merge(m_.faces[f])) ++merged;
+    }
+    return merged;
   }
 
   bool try_expand(int32_t a, int32_t b) {

@@ -24,6 +24,7 @@ struct OptimizeReport {
   int removed_below_g1 = 0;      ///< phase 1: edges < G1 h removed
   int removed_below_g2 = 0;      ///< phase 2: edges < G2 h removed
   int expanded = 0;              ///< phase 3: edges < G3 h, expanded
+  int collapsed_faces = 0;       ///< of the removals: small faces collapsed to a point at once
   int rejected = 0;              ///< candidate operations refused (the sum of the reasons below)
   int rejected_invalid = 0;      ///< would open, flatten or invert a cell
   int rejected_convexity = 0;    ///< would make a convex cell non-convex

@@ -55,6 +55,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
       t["optimization"] = {{"removed_below_g1", h.optimize_report.removed_below_g1},
                            {"removed_below_g2", h.optimize_report.removed_below_g2},
                            {"expanded", h.optimize_report.expanded},
+                           {"collapsed_faces", h.optimize_report.collapsed_faces},
                            {"rejected", h.optimize_report.rejected},
                            {"rejected_by",
                             {{"invalid", h.optimize_report.rejected_invalid},
