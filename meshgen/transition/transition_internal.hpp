@@ -52,6 +52,7 @@ struct Site {
   Vec3 p;
   double w2 = 0;          ///< squared weight (CGAL's weight)
   bool alive = true;      ///< false once replaced (a split box)
+  bool unchecked = true;  ///< sphere not yet checked empty since its last move
   int reservoir_cell = -1;  ///< boxes: reservoir linear cell index
   int polygon = -1;       ///< InternalPolygon / ExternalMirror: its polygon
   double t = 0;           ///< InternalPolygon: parameter on the dual line

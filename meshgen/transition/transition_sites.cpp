@@ -60,6 +60,7 @@ void update_mirror(SiteSet& set, int q, const std::vector<PolygonFrame>& frames)
   const Site& in = set.sites[set.internal_of[q]];
   set.sites[e].p = 2.0 * frames[q].center - in.p;
   set.sites[e].w2 = in.w2;
+  set.sites[e].unchecked = true;
 }
 
 // Places the internal polygon site s at O + t n with the weight of its constrained vertices.
@@ -68,6 +69,7 @@ void place_polygon_site(SiteSet& set, int s, double t, const Cavity& cavity, con
   Site& site = set.sites[s];
   const int q = site.polygon;
   site.t = t;
+  site.unchecked = true;
   site.p = frames[q].center + t * frames[q].normal;
   site.w2 = mean_w2(site.p, cavity.faces[q].nodes, coords);
   update_mirror(set, q, frames);
@@ -133,22 +135,25 @@ void split_box(SiteSet& set, int s, const Cavity& cavity, const std::vector<Vec3
   }
 }
 
-// Sites whose sphere strictly holds a cavity vertex that is not theirs.
-std::vector<int> non_empty_sites(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords) {
+// Sites whose sphere strictly holds a cavity vertex that is not theirs. Only sites moved or
+// created since their last check are examined (the vertices do not move).
+std::vector<int> non_empty_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords) {
   std::vector<std::pair<double, int32_t>> by_x;
   by_x.reserve(cavity.vertices.size());
   for (int32_t v : cavity.vertices) by_x.push_back({coords[v].x, v});
   std::sort(by_x.begin(), by_x.end());
   std::vector<int> bad;
   for (size_t s = 0; s < set.sites.size(); ++s) {
-    const Site& site = set.sites[s];
-    if (!site.alive || site.kind == SiteKind::Guard) continue;
+    Site& site = set.sites[s];
+    if (!site.alive || site.kind == SiteKind::Guard || !site.unchecked) continue;
+    site.unchecked = false;
     const double r = std::sqrt(site.w2);
     auto it = std::lower_bound(by_x.begin(), by_x.end(), std::make_pair(site.p.x - r, INT32_MIN));
     for (; it != by_x.end() && it->first <= site.p.x + r; ++it) {
       if (std::binary_search(site.vertices.begin(), site.vertices.end(), it->second)) continue;
       if (norm2(coords[it->second] - site.p) - site.w2 < -kEmptySlack * site.w2) {
         bad.push_back(static_cast<int>(s));
+        site.unchecked = true;
         break;
       }
     }
@@ -342,30 +347,35 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
   int left = 0;
   for (int it = 1; it <= max_iterations; ++it) {
     *iterations = it;
-    // Sweep over sites sorted by x; a pair is examined when |Pi Pj|^2 <= max(wi^2, wj^2).
+    // A pair is examined when |Pi Pj|^2 <= max(wi^2, wj^2): each site looks for the others
+    // within its own radius (x-sorted window), and a pair seen from both sides is counted
+    // once, from its smaller index.
     std::vector<int> order;
-    double max_w = 0;
     for (size_t s = 0; s < set.sites.size(); ++s)
-      if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard) {
-        order.push_back(static_cast<int>(s));
-        max_w = std::max(max_w, std::sqrt(set.sites[s].w2));
-      }
+      if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard) order.push_back(static_cast<int>(s));
     std::sort(order.begin(), order.end(), [&](int a, int b) {
       return set.sites[a].p.x < set.sites[b].p.x || (set.sites[a].p.x == set.sites[b].p.x && a < b);
     });
+    std::vector<double> xs(order.size());
+    for (size_t k = 0; k < order.size(); ++k) xs[k] = set.sites[order[k]].p.x;
     std::vector<char> fix(set.sites.size(), 0);
     int n = 0;
     for (size_t a = 0; a < order.size(); ++a) {
-      const Site& si = set.sites[order[a]];
-      for (size_t b = a + 1; b < order.size(); ++b) {
-        const Site& sj = set.sites[order[b]];
-        if (sj.p.x - si.p.x > max_w) break;
+      const int i = order[a];
+      const Site& si = set.sites[i];
+      const double r = std::sqrt(si.w2);
+      const size_t lo = static_cast<size_t>(std::lower_bound(xs.begin(), xs.end(), si.p.x - r) - xs.begin());
+      for (size_t b = lo; b < order.size() && xs[b] <= si.p.x + r; ++b) {
+        const int j = order[b];
+        if (j == i) continue;
+        const Site& sj = set.sites[j];
         if (!si.internal() && !sj.internal()) continue;  // only transition cells must be auto-centred
         const double d2 = norm2(sj.p - si.p);
-        if (d2 > std::max(si.w2, sj.w2)) continue;
+        if (d2 > si.w2) continue;
+        if (d2 <= sj.w2 && j < i) continue;  // found from j's side too
         if (std::abs(si.w2 - sj.w2) <= d2) continue;  // condition (6)
         ++n;
-        fix[si.w2 > sj.w2 ? order[a] : order[b]] = 1;  // the larger weight moves (5.5.2)
+        fix[si.w2 > sj.w2 ? i : j] = 1;  // the larger weight moves (5.5.2)
       }
     }
     corrections += n;
