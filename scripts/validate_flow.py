@@ -10,7 +10,7 @@ python3-opm-common (hence /usr/bin/python3). Prints one JSON object:
   report_steps    restart report steps found
   pressure        PRESSURE (bar) of the last report step, active-cell order
   wells           {NAME: {"WBHP", "WWPR", "WWIR"}} at the last summary time (sm3/day, bar)
-  init            {"porv": global PORV (rm3), "depth", "tranx", "trany", "tranz": active order,
+  init            {"porv": global PORV (rm3), "poro", "depth", "tranx", "trany", "tranz": active order,
                    "trannnc": TRANNNC values, "nnc1", "nnc2": 1-based global indices (EGRID)}
 Exit code 1 with a message on stderr when a file is missing or unreadable.
 """
@@ -72,8 +72,8 @@ def main(argv):
         init = EclFile(base + ".INIT")
         init_names = [a[0] for a in init.arrays]
         res_init = {}
-        for key, out_key in (("PORV", "porv"), ("DEPTH", "depth"), ("TRANX", "tranx"), ("TRANY", "trany"),
-                             ("TRANZ", "tranz"), ("TRANNNC", "trannnc")):
+        for key, out_key in (("PORV", "porv"), ("PORO", "poro"), ("DEPTH", "depth"), ("TRANX", "tranx"),
+                             ("TRANY", "trany"), ("TRANZ", "tranz"), ("TRANNNC", "trannnc")):
             res_init[out_key] = floats(init[key]) if key in init_names else []
         res_init["nnc1"] = nnc1
         res_init["nnc2"] = nnc2

@@ -1,0 +1,148 @@
+// End-to-end: `meshgen --export eclipse` writes a deck, OPM Flow runs it, and its steady well
+// rates and pressures equal those of `solver_demo` (our TPFA solve of the same case).
+// Cell-by-cell comparisons against the library solve live in tests/exporters/test_flow_*.cpp.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "run_command.hpp"
+
+namespace fs = std::filesystem;
+using hm_test::fresh_dir;
+using hm_test::run_command;
+using hm_test::slurp;
+
+namespace {
+
+const std::string kMeshgen = std::string(HM_BIN_DIR) + "/meshgen";
+const std::string kSolver = std::string(HM_BIN_DIR) + "/solver_demo";
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+// Removes a test's directory at scope exit (flow and checkMesh outputs are large), unless
+// HM_KEEP_TEST_OUTPUT is set.
+struct RemoveAtExit {
+  fs::path dir;
+  ~RemoveAtExit() {
+    std::error_code ec;
+    if (std::getenv("HM_KEEP_TEST_OUTPUT") == nullptr) fs::remove_all(dir, ec);
+  }
+};
+
+bool have(const std::string& exe) { return run_command("sh -c 'command -v " + exe + "'", 10).exit_code == 0; }
+
+// The example with its fluid made nearly incompressible (1e-8 /bar): the steady TPFA model has a
+// constant density, flow uses rho_s (1 + Cw dp) in gravity terms (docs/export-eclipse.md).
+fs::path incompressible_copy(const std::string& example, const fs::path& dir) {
+  std::string text = slurp(std::string(HM_SOURCE_DIR) + "/examples/" + example + ".yaml");
+  text = std::regex_replace(text, std::regex(R"(compressibility:\s*[0-9.eE+-]+)"), "compressibility: 1.0e-8");
+  const fs::path p = dir / (example + ".yaml");
+  std::ofstream(p) << text;
+  return p;
+}
+
+void run_example(const std::string& example) {
+  if (!have("flow") || !fs::exists("/usr/bin/python3"))
+    GTEST_SKIP() << "OPM Flow (Debian packages libopm-simulators-bin, python3-opm-common) is not installed; "
+                    "scripts/install-deps.sh --validators installs it";
+  const fs::path d = fresh_dir("flow_" + example);
+  const RemoveAtExit cleanup{d};
+  const fs::path yaml = incompressible_copy(example, d);
+  const auto mg = run_command(kMeshgen + " " + q(yaml) + " -o " + q(d / "mesh") + " --export eclipse", 900);
+  if (mg.exit_code == 2 && mg.err.find("--export") != std::string::npos)
+    GTEST_SKIP() << "meshgen does not accept --export eclipse yet: " << mg.err;
+  ASSERT_EQ(mg.exit_code, 0) << mg.out << mg.err;
+  std::string name = example;
+  for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const fs::path deck_dir = d / "mesh" / "eclipse";
+  ASSERT_TRUE(fs::exists(deck_dir / (name + ".DATA"))) << mg.out;
+
+  // flow, with the options written in the deck's header comment ("-- Run: flow ...").
+  const std::string data = slurp(deck_dir / (name + ".DATA"));
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(data, m, std::regex("-- Run: flow ([^\\n]*) " + name + "\\.DATA"))) << data.substr(0, 400);
+  const auto fl = run_command("sh -c 'cd " + q(deck_dir) + " && flow " + m[1].str() + " --output-dir=out " + name +
+                                  ".DATA'",
+                              900);
+  ASSERT_EQ(fl.exit_code, 0) << fl.out.substr(fl.out.size() > 4000 ? fl.out.size() - 4000 : 0) << fl.err;
+  const auto rd = run_command("/usr/bin/python3 " + q(std::string(HM_SOURCE_DIR) + "/scripts/validate_flow.py") + " " +
+                                  q(deck_dir / "out") + " " + name,
+                              300);
+  ASSERT_EQ(rd.exit_code, 0) << rd.err;
+  const nlohmann::json res = nlohmann::json::parse(rd.out);
+
+  // Our solve of the same case.
+  const auto sd = run_command(kSolver + " " + q(yaml) + " -o " + q(d / "solve"), 900);
+  ASSERT_EQ(sd.exit_code, 0) << sd.out << sd.err;
+  const nlohmann::json ours = nlohmann::json::parse(slurp(d / "solve" / "solution.json"));
+
+  // Every mesh cell is an active deck cell.
+  ASSERT_EQ(res["active"].get<long>(), ours["cells"].get<long>());
+  // Pressures: minimum, maximum and volume-weighted mean (volume = PORV / PORO per active cell).
+  const auto& p = res["pressure"];
+  const auto& porv = res["init"]["porv"];
+  const auto& poro = res["init"]["poro"];
+  ASSERT_EQ(poro.size(), p.size());
+  std::vector<double> porv_active;
+  for (const auto& v : porv)
+    if (v.get<double>() > 0) porv_active.push_back(v.get<double>());
+  ASSERT_EQ(porv_active.size(), p.size());
+  double pmin = 1e300, pmax = -1e300, pv = 0, vol = 0;
+  for (size_t a = 0; a < p.size(); ++a) {
+    const double pa = p[a].get<double>(), va = porv_active[a] / poro[a].get<double>();
+    pmin = std::min(pmin, pa);
+    pmax = std::max(pmax, pa);
+    pv += pa * va;
+    vol += va;
+  }
+  const auto& op = ours["pressure"];
+  EXPECT_NEAR(pmin, op["min"].get<double>(), 1e-5 * op["min"].get<double>());
+  EXPECT_NEAR(pmax, op["max"].get<double>(), 1e-5 * op["max"].get<double>());
+  EXPECT_NEAR(pv / vol, op["mean"].get<double>(), 1e-5 * op["mean"].get<double>());
+  // Well rates: 1e-5 relative, or 0.01 m3/day absolute for a well at rest (1e-5 of 1000 m3/day; a
+  // lone producer in a closed reservoir ends hydrostatic at its BHP, with a rate of ~0).
+  double max_rel = 0;
+  for (const auto& w : ours["wells"]) {
+    const std::string wn = w["name"];
+    ASSERT_TRUE(res["wells"].contains(wn)) << res["wells"].dump();
+    const double qf = res["wells"][wn].value("WWPR", 0.0) - res["wells"][wn].value("WWIR", 0.0);
+    const double qo = w["rate_m3_per_day"].get<double>();
+    const double rel = std::abs(qf - qo) / std::max(std::abs(qo), 1000.0);
+    max_rel = std::max(max_rel, rel);
+    EXPECT_LT(rel, 1e-5) << wn << ": flow " << qf << ", solver_demo " << qo;
+  }
+  std::printf("[ figures  ] %s: flow vs solver_demo: pressure min %.3g, max %.3g, mean %.3g (relative); rates %.3g\n",
+              example.c_str(), std::abs(pmin - op["min"].get<double>()) / op["min"].get<double>(),
+              std::abs(pmax - op["max"].get<double>()) / op["max"].get<double>(),
+              std::abs(pv / vol - op["mean"].get<double>()) / op["mean"].get<double>(), max_rel);
+}
+
+TEST(FlowMeshgen, PaperSingleWellDeckMatchesSolverDemo) { run_example("paper_single_well"); }
+TEST(FlowMeshgen, ThreeWellsDeckMatchesSolverDemo) { run_example("three_wells"); }
+
+TEST(FlowMeshgen, UnwritableExportDirectoryExitsTwoAndLeavesNoDeck) {
+  const fs::path d = fresh_dir("flow_unwritable");
+  const RemoveAtExit cleanup{d};
+  const auto probe = run_command(kMeshgen + " --help", 30);
+  if (probe.err.find("--export") == std::string::npos && probe.out.find("--export") == std::string::npos)
+    GTEST_SKIP() << "meshgen has no --export option yet";
+  // OUT/eclipse cannot be created: OUT/eclipse is a regular file.
+  fs::create_directories(d / "mesh");
+  std::ofstream(d / "mesh" / "eclipse") << "not a directory";
+  const auto mg = run_command(kMeshgen + " " + q(std::string(HM_SOURCE_DIR) + "/examples/paper_single_well.yaml") +
+                                  " -o " + q(d / "mesh") + " --export eclipse",
+                              900);
+  if (mg.exit_code == 2 && mg.err.find("unknown option") != std::string::npos)
+    GTEST_SKIP() << "meshgen does not accept --export eclipse yet: " << mg.err;
+  EXPECT_EQ(mg.exit_code, 2) << mg.out << mg.err;
+  EXPECT_NE(mg.err.find("cannot create directory"), std::string::npos) << mg.err;
+  EXPECT_EQ(slurp(d / "mesh" / "eclipse"), "not a directory");
+  for (const auto& e : fs::recursive_directory_iterator(d))
+    EXPECT_EQ(e.path().extension().string() == ".DATA" || e.path().extension().string() == ".INC", false)
+        << e.path();
+}
+
+}  // namespace
