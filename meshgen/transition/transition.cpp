@@ -68,7 +68,9 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     os << "transition: " << bad.size() << " constrained polygons are not Delaunay admissible (first: polygon "
        << bad.front() << ", t_in = " << f.t_in << ", t_out = " << f.t_out << ", radius " << f.radius
        << "): a cavity vertex lies in its diametral sphere; the cavity must be enlarged";
-    throw std::runtime_error(os.str());
+    std::vector<int32_t> polygons(bad.begin(), bad.end());
+    std::vector<int32_t> cells = cells_behind(cavity, node_coords, frames, polygons);
+    throw TransitionError(os.str(), std::move(polygons), std::move(cells));
   }
   SiteSet set = make_sites(cavity, node_coords, grid, frames, report.notes);
   enforce_empty_spheres(set, cavity, node_coords, grid, frames);

@@ -3,6 +3,7 @@
 // the .cpp files of this folder only.
 #pragma once
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -55,9 +56,24 @@ struct TransitionCells {
   TransitionReport report;
 };
 
+/// Thrown by build_transition when the cavity cannot carry a valid transition mesh: some
+/// constrained polygon is not Delaunay admissible, or the site correction (5.5.3) does not
+/// converge (typically a large reservoir face close to a well). `cells_to_deactivate` are
+/// the active reservoir cells behind the polygons involved: deactivating them moves that
+/// part of the cavity boundary away, after which the caller may retry.
+class TransitionError : public std::runtime_error {
+ public:
+  TransitionError(const std::string& what, std::vector<int32_t> polygons_involved,
+                  std::vector<int32_t> cells)
+      : std::runtime_error(what), polygons(std::move(polygons_involved)), cells_to_deactivate(std::move(cells)) {}
+  std::vector<int32_t> polygons;             ///< cavity face indices involved (sorted)
+  std::vector<int32_t> cells_to_deactivate;  ///< reservoir linear cell indices (sorted, unique)
+};
+
 /// Builds the transition mesh of one cavity. `node_coords` holds the coordinates of all
-/// global node ids (at least every cavity vertex). Throws std::runtime_error with a clear
-/// message if the site correction does not converge.
+/// global node ids (at least every cavity vertex). Throws TransitionError (a
+/// std::runtime_error) with a clear message if the cavity is not admissible or the site
+/// correction does not converge, std::runtime_error if the cavity leaks (not closed).
 TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
                                  const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                                  int32_t base_node_id);

@@ -79,10 +79,16 @@ int enforce_empty_spheres(SiteSet& set, const Cavity& cavity, const std::vector<
                           const ReservoirGrid& grid, const std::vector<PolygonFrame>& frames);
 
 /// Stage 5.5.3: auto-centering correction. Returns the number of corrected pairs over all
-/// iterations, sets *iterations; throws std::runtime_error when it does not converge.
+/// iterations, sets *iterations; throws TransitionError when it does not converge.
 int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                   const ReservoirGrid& grid, const std::vector<PolygonFrame>& frames, int max_iterations,
                   int* iterations);
+
+/// Active reservoir cells behind the given polygons (reservoir side: the outside cell; well
+/// side: the outside cells of the reservoir polygons that share a vertex lying in the
+/// polygon's diametral sphere on the cavity side), sorted and unique.
+std::vector<int32_t> cells_behind(const Cavity& cavity, const std::vector<Vec3>& coords,
+                                  const std::vector<PolygonFrame>& frames, const std::vector<int32_t>& polygons);
 
 /// Moves a movable site toward its polygon (alpha in (0,1)) or splits a fixed box site;
 /// used by the correction and by the hidden-site repair.

@@ -113,6 +113,28 @@ int add_mirror_site(SiteSet& set, int q, const Cavity& cavity, const std::vector
   return id;
 }
 
+// Largest t of polygon q's internal site that keeps its sphere (and its reflection's) clearly
+// empty.
+double max_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames) {
+  return 0.95 * 2.0 * initial_t(set, q, frames);
+}
+
+// Whether shrink_or_split can still change site s: boxes can be split, polygon sites (or
+// the partner of a reflection) can move while above their minimal distance.
+bool can_shrink(const SiteSet& set, int s, const std::vector<PolygonFrame>& frames) {
+  const Site& site = set.sites[s];
+  int in = s;
+  if (site.kind == SiteKind::ExternalMirror) in = set.internal_of[site.polygon];
+  const Site& p = set.sites[in];
+  if (p.kind != SiteKind::InternalPolygon) return true;
+  return p.t > 1.0001 * kMinT * frames[p.polygon].radius;
+}
+
+bool can_grow(const SiteSet& set, int s, const std::vector<PolygonFrame>& frames) {
+  const Site& site = set.sites[s];
+  return site.kind == SiteKind::InternalPolygon && site.t < 0.9999 * max_t(set, site.polygon, frames);
+}
+
 // Replaces a fixed box site by per-polygon sites (internal) or mirrors (external).
 void split_box(SiteSet& set, int s, const Cavity& cavity, const std::vector<Vec3>& coords,
                const std::vector<PolygonFrame>& frames) {
@@ -345,6 +367,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
                   const std::vector<PolygonFrame>& frames, int max_iterations, int* iterations) {
   int corrections = 0;
   int left = 0;
+  std::vector<char> stuck;
   for (int it = 1; it <= max_iterations; ++it) {
     *iterations = it;
     // A pair is examined when |Pi Pj|^2 <= max(wi^2, wj^2): each site looks for the others
@@ -358,7 +381,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
     });
     std::vector<double> xs(order.size());
     for (size_t k = 0; k < order.size(); ++k) xs[k] = set.sites[order[k]].p.x;
-    std::vector<char> fix(set.sites.size(), 0);
+    std::vector<char> fix(set.sites.size(), 0), grow(set.sites.size(), 0), involved(set.sites.size(), 0);
     int n = 0;
     for (size_t a = 0; a < order.size(); ++a) {
       const int i = order[a];
@@ -369,27 +392,84 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
         const int j = order[b];
         if (j == i) continue;
         const Site& sj = set.sites[j];
-        if (!si.internal() && !sj.internal()) continue;  // only transition cells must be auto-centred
         const double d2 = norm2(sj.p - si.p);
         if (d2 > si.w2) continue;
         if (d2 <= sj.w2 && j < i) continue;  // found from j's side too
         if (std::abs(si.w2 - sj.w2) <= d2) continue;  // condition (6)
+        // (6) fails: the radical plane passes beyond the smaller-weight site, which is thus
+        // outside its own cell. Only transition cells must be auto-centred.
+        const int large = si.w2 > sj.w2 ? i : j, small = si.w2 > sj.w2 ? j : i;
+        if (!set.sites[small].internal()) continue;
         ++n;
-        fix[si.w2 > sj.w2 ? i : j] = 1;  // the larger weight moves (5.5.2)
+        involved[large] = involved[small] = 1;
+        // The larger weight moves toward its polygon (5.5.2); once it cannot (a polygon site
+        // at its minimal distance), the smaller one moves away from its polygon instead,
+        // which raises its weight, within its empty-sphere range.
+        if (can_shrink(set, large, frames)) fix[large] = 1;
+        else if (can_grow(set, small, frames)) grow[small] = 1;
+        else fix[large] = 1;
       }
     }
     corrections += n;
     left = n;
     if (n == 0) return corrections;
-    if (it == max_iterations) break;
+    if (it == max_iterations) {
+      stuck.assign(fix.size(), 0);
+      for (size_t s = 0; s < fix.size(); ++s) stuck[s] = fix[s] || grow[s] || involved[s];
+      break;
+    }
     for (size_t s = 0; s < fix.size(); ++s)
       if (fix[s]) shrink_or_split(set, static_cast<int>(s), kShrink, cavity, coords, grid, frames);
+    for (size_t s = 0; s < grow.size(); ++s)
+      if (grow[s] && !fix[s] && set.sites[s].alive && set.sites[s].kind == SiteKind::InternalPolygon) {
+        const Site& site = set.sites[s];
+        place_polygon_site(set, static_cast<int>(s), std::min(site.t / kShrink, max_t(set, site.polygon, frames)),
+                           cavity, coords, frames);
+      }
     enforce_empty_spheres(set, cavity, coords, grid, frames);
   }
   std::ostringstream os;
   os << "transition: site correction did not converge after " << max_iterations << " iterations (" << left
      << " pairs left)";
-  throw std::runtime_error(os.str());
+  std::vector<int32_t> polygons;
+  for (size_t s = 0; s < stuck.size(); ++s)
+    if (stuck[s]) polygons.insert(polygons.end(), set.sites[s].polygons.begin(), set.sites[s].polygons.end());
+  std::sort(polygons.begin(), polygons.end());
+  polygons.erase(std::unique(polygons.begin(), polygons.end()), polygons.end());
+  std::vector<int32_t> cells = cells_behind(cavity, coords, frames, polygons);
+  throw TransitionError(os.str(), std::move(polygons), std::move(cells));
+}
+
+std::vector<int32_t> cells_behind(const Cavity& cavity, const std::vector<Vec3>& coords,
+                                  const std::vector<PolygonFrame>& frames, const std::vector<int32_t>& polygons) {
+  std::vector<int32_t> cells;
+  std::vector<int32_t> near_vertices;
+  for (int32_t q : polygons) {
+    const ConstrainedFace& f = cavity.faces[q];
+    if (f.side == FaceSide::Reservoir) {
+      if (f.outside_cell >= 0) cells.push_back(f.outside_cell);
+      continue;
+    }
+    // A well polygon: the cavity vertices inside its diametral sphere, or nearest to it.
+    const PolygonFrame& fr = frames[q];
+    for (int32_t v : cavity.vertices) {
+      const Vec3 x = coords[v] - fr.center;
+      const double h = dot(x, fr.normal);
+      if (h > 0 && norm2(x) < 4.0 * fr.radius * fr.radius) near_vertices.push_back(v);
+    }
+  }
+  std::sort(near_vertices.begin(), near_vertices.end());
+  for (const ConstrainedFace& f : cavity.faces) {
+    if (f.side != FaceSide::Reservoir || f.outside_cell < 0) continue;
+    for (int32_t v : f.nodes)
+      if (std::binary_search(near_vertices.begin(), near_vertices.end(), v)) {
+        cells.push_back(f.outside_cell);
+        break;
+      }
+  }
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  return cells;
 }
 
 }  // namespace hm::transition_detail

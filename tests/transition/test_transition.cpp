@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <set>
 
 #include "meshgen/transition/transition_internal.hpp"
 #include "synthetic_cavity.hpp"
@@ -191,22 +192,44 @@ TEST(Transition, Deterministic) {
 
 // Pass/fail pair for admissibility: the L-shaped cavity with a block too close to a
 // reservoir face (a block vertex inside the face's diametral sphere) is refused with a
-// clear message; the admissible one (test LShapedCavity) is built.
-TEST(Transition, NonAdmissibleCavityIsRefused) {
-  Scene sc;
+// clear message and the reservoir cells to deactivate; once they are deactivated the
+// enlarged cavity is built and valid.
+TEST(Transition, NonAdmissibleCavityIsRefusedThenEnlarged) {
   InnerBlock b;
   b.center = {18.5, 15.5, 16};
   b.half = 2;
-  try {
-    build_scene(sc, kX, kY, kZ, [](int i, int j, int k) { return central(i, j, k) && !(i >= 4 && j >= 4); }, {b});
-    FAIL() << "expected a refusal";
-  } catch (const std::runtime_error& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("transition: ", 0), 0u) << msg;
-    EXPECT_NE(msg.find("constrained polygons are not Delaunay admissible"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("the cavity must be enlarged"), std::string::npos) << msg;
+  std::set<int> extra;
+  auto inactive = [&](int i, int j, int k) {
+    const int c = i + 8 * (j + 8 * k);
+    return (central(i, j, k) && !(i >= 4 && j >= 4)) || extra.count(c) > 0;
+  };
+  int refusals = 0;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    Scene sc;
+    try {
+      build_scene(sc, kX, kY, kZ, inactive, {b});
+    } catch (const TransitionError& e) {
+      ++refusals;
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind("transition: ", 0), 0u) << msg;
+      EXPECT_NE(msg.find("constrained polygons are not Delaunay admissible"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("the cavity must be enlarged"), std::string::npos) << msg;
+      EXPECT_FALSE(non_admissible_polygons(sc.cavity, sc.coords).empty());
+      ASSERT_FALSE(e.polygons.empty());
+      ASSERT_FALSE(e.cells_to_deactivate.empty());
+      for (int32_t c : e.cells_to_deactivate) {
+        EXPECT_TRUE(sc.active[c]) << c;
+        EXPECT_TRUE(extra.insert(c).second) << c;
+      }
+      continue;
+    }
+    const Metrics mt = measure(sc);
+    print("L-shape enlarged", sc, mt);
+    expect_valid(sc, mt, 1e-9);
+    break;
   }
-  EXPECT_FALSE(non_admissible_polygons(sc.cavity, sc.coords).empty());
+  EXPECT_GE(refusals, 1);
+  EXPECT_LE(refusals, 2);
 }
 
 // Pass/fail pair for the site correction (5.5.3): a large site whose radical plane with a
@@ -257,8 +280,10 @@ TEST(Transition, SiteCorrection) {
   try {
     correct_sites(bad, cav, coords, grid, frames, 1, &iterations);
     FAIL() << "expected no convergence in one iteration";
-  } catch (const std::runtime_error& e) {
+  } catch (const TransitionError& e) {
     EXPECT_STREQ(e.what(), "transition: site correction did not converge after 1 iterations (1 pairs left)");
+    EXPECT_EQ(e.polygons, (std::vector<int32_t>{0, 1}));  // both sites of the pair
+    EXPECT_TRUE(e.cells_to_deactivate.empty());           // well polygons, no reservoir behind
   }
   SiteSet good = make();
   const int corrections = correct_sites(good, cav, coords, grid, frames, 100, &iterations);
