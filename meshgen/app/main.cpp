@@ -6,8 +6,11 @@
 #include <iostream>
 #include <string>
 
+#include "exporters/eclipse/eclipse_deck.hpp"
+#include "exporters/openfoam/openfoam_case.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/quality.hpp"
+#include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/summary.hpp"
 
@@ -17,7 +20,9 @@ namespace {
 
 int usage(const std::string& why) {
   std::cerr << "meshgen: " << why << "\n"
-            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [--export vtu,eclipse,openfoam]\n";
+            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [--export vtu,eclipse,openfoam]\n"
+            << "  mesh.vtu, summary.json and cavity_K.obj are always written; --export adds\n"
+            << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n";
   return 2;
 }
 
@@ -41,6 +46,7 @@ bool write_text(const fs::path& path, const std::string& text) {
 int main(int argc, char** argv) {
   std::string case_path, out_dir;
   hm::PipelineOptions opts;
+  bool export_eclipse = false, export_openfoam = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-o" || a == "--output") {
@@ -50,6 +56,18 @@ int main(int argc, char** argv) {
       opts.optimize = false;
     } else if (a == "--no-transition") {
       opts.build_transition = false;
+    } else if (a == "--export") {
+      if (++i >= argc) return usage("--export needs a list, e.g. vtu,eclipse,openfoam");
+      std::string list = argv[i];
+      size_t start = 0;
+      while (start <= list.size()) {
+        const size_t comma = std::min(list.find(',', start), list.size());
+        const std::string item = list.substr(start, comma - start);
+        if (item == "eclipse") export_eclipse = true;
+        else if (item == "openfoam") export_openfoam = true;
+        else if (item != "vtu") return usage("--export: unknown format '" + item + "' (expected vtu, eclipse or openfoam)");
+        start = comma + 1;
+      }
     } else if (a == "-h" || a == "--help") {
       usage("help");
       return 0;
@@ -113,6 +131,30 @@ int main(int argc, char** argv) {
       return 2;
     }
     written.push_back(p.string());
+  }
+  if (export_eclipse) {
+    const hm::Transmissibilities trans = hm::compute_transmissibilities(result.mesh, result.geometry);
+    hm::EclipseDeckInfo info;
+    const hm::WriteStatus st =
+        hm::write_eclipse_deck((out / "eclipse").string(), cs, result.mesh, result.geometry, trans, {}, &info);
+    if (!st.ok) {
+      std::cerr << "meshgen: " << st.message << "\n";
+      return 2;
+    }
+    for (const std::string& w : info.warnings) std::cout << "  eclipse: " << w << "\n";
+    written.push_back(info.data_file);
+  }
+  if (export_openfoam) {
+    hm::OpenFoamOptions of;
+    for (const hm::WellSpec& w : cs.wells) of.well_names.push_back(w.name);
+    of.n_wells = static_cast<int>(cs.wells.size());
+    of.binary = result.mesh.n_cells() > 200000;  // ASCII is easier to read; binary pays off on big meshes
+    const hm::WriteStatus st = hm::write_openfoam_case((out / "openfoam").string(), result.mesh, of);
+    if (!st.ok) {
+      std::cerr << "meshgen: " << st.message << "\n";
+      return 2;
+    }
+    written.push_back((out / "openfoam").string() + "/");
   }
   const nlohmann::json summary = hm::make_summary(cs, result);
   if (!write_text(out / "summary.json", summary.dump(2) + "\n")) {
