@@ -101,7 +101,8 @@ struct EdgeKey {
 CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                          const std::vector<int32_t>& reservoir_node_ids,
                          const std::vector<std::vector<int32_t>>& well_node_ids,
-                         const std::vector<Vec3>& node_coords) {
+                         const std::vector<Vec3>& node_coords,
+                         const std::vector<int32_t>& extra_deactivated) {
   CavitySet out;
   const int nc = grid.n_cells();
   out.reservoir_active.assign(nc, 1);
@@ -124,6 +125,8 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
       if (!far && box_polyline_dist(clo, chi, ws.trajectory) <= reach) active[c] = 0;
     }
   }
+  for (int32_t c : extra_deactivated)
+    if (c >= 0 && c < nc) active[c] = 0;
   int regularized = regularize(grid, active);
 
   // The well side of the Gabriel test: outer-surface edges and vertices of every block.
@@ -165,6 +168,31 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
           if (active[c]) into.insert(c);
         }
   };
+
+  // Two well blocks close enough that one's surface holds the other's vertices in its
+  // diametral spheres cannot be separated by changing the reservoir: refuse the input.
+  for (size_t w1 = 0; w1 < blocks.size(); ++w1)
+    for (size_t w2 = 0; w2 < blocks.size(); ++w2) {
+      if (w1 == w2) continue;
+      std::vector<std::vector<int32_t>> polys;
+      std::vector<std::array<int32_t, 2>> edges;
+      for (const auto& poly : blocks[w1].surface_faces) {
+        std::vector<int32_t> g;
+        for (size_t i = 0; i < poly.size(); ++i) {
+          g.push_back(well_node_ids[w1][poly[i]]);
+          const int32_t a = well_node_ids[w1][poly[i]], b = well_node_ids[w1][poly[(i + 1) % poly.size()]];
+          edges.push_back({std::min(a, b), std::max(a, b)});
+        }
+        polys.push_back(std::move(g));
+      }
+      std::vector<int32_t> other(well_node_ids[w2].begin(), well_node_ids[w2].end());
+      if (!face_gabriel_violations(node_coords, polys, other).empty() ||
+          !gabriel_violations(node_coords, edges, other).empty())
+        throw InputError("wells[" + std::to_string(blocks[w2].well) + "].trajectory: too close to wells[" +
+                         std::to_string(blocks[w1].well) +
+                         "]: their radial blocks are not Gabriel with respect to each other (paper 5.1); move the "
+                         "wells apart or reduce their drainage_radius");
+    }
 
   // 2. Gabriel across the two sides (paper 5.1): no reservoir boundary edge's diametral
   //    sphere holds a well vertex and vice versa; the same for the diametral spheres of the

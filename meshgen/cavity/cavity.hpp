@@ -49,11 +49,15 @@ struct CavitySet {
 /// cavity Gabriel across its reservoir and well sides), groups them into cavities with
 /// Boost.Graph connected components, and extracts each boundary. `reservoir_node_ids`
 /// and `well_node_ids[w]` map lattice/local node indices to builder ids.
-/// Throws InputError when a well block does not fit (e.g. pokes out of the reservoir).
+/// `extra_deactivated` (reservoir linear indices) are deactivated too: the cells a
+/// transition mesh asked to move out of its way (TransitionError::cells_to_deactivate).
+/// Throws InputError when a well block does not fit (e.g. pokes out of the reservoir) or
+/// when two well blocks are too close for a Gabriel cavity.
 CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                          const std::vector<int32_t>& reservoir_node_ids,
                          const std::vector<std::vector<int32_t>>& well_node_ids,
-                         const std::vector<Vec3>& node_coords);
+                         const std::vector<Vec3>& node_coords,
+                         const std::vector<int32_t>& extra_deactivated = {});
 
 /// Closed 2-manifold check of a cavity boundary (OpenMesh): every edge in exactly two
 /// faces with opposite directions, every vertex's fan a single disk. Returns problems.

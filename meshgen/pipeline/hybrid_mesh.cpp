@@ -1,5 +1,6 @@
 #include "hybrid_mesh.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <set>
@@ -67,32 +68,58 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
   std::vector<Vec3> coords(builder.n_nodes());
   for (int32_t i = 0; i < builder.n_nodes(); ++i) coords[i] = builder.node(i);
 
-  out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords);
-  for (const std::string& n : out.cavities.notes) out.notes.push_back(n);
-  for (size_t k = 0; k < out.cavities.cavities.size(); ++k) {
-    const auto problems = check_cavity_manifold(out.cavities.cavities[k], coords);
-    if (!problems.empty())
-      throw std::runtime_error("cavity " + std::to_string(k) + ": boundary is not a closed 2-manifold: " + problems[0]);
+  // Cavities, then their transition meshes. A transition may refuse a cavity part (a
+  // polygon that is not Delaunay admissible, or sites whose correction does not converge:
+  // typically a large reservoir face close to a well) and name the reservoir cells whose
+  // deactivation moves that part away; the cavities are then rebuilt with those cells
+  // deactivated (a local dilation), a bounded number of times.
+  std::vector<int32_t> extra_deactivated;
+  std::vector<TransitionCells> transitions;
+  const int32_t base = builder.n_nodes();
+  constexpr int kMaxRetries = 5;
+  for (int attempt = 0;; ++attempt) {
+    out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, extra_deactivated);
+    for (size_t k = 0; k < out.cavities.cavities.size(); ++k) {
+      const auto problems = check_cavity_manifold(out.cavities.cavities[k], coords);
+      if (!problems.empty())
+        throw std::runtime_error("cavity " + std::to_string(k) + ": boundary is not a closed 2-manifold: " + problems[0]);
+    }
+    if (!opts.build_transition) break;
+    // Cavities are independent, so they are built concurrently; results are used in
+    // cavity order, so the output does not depend on scheduling.
+    std::vector<std::future<TransitionCells>> jobs;
+    for (const Cavity& cav : out.cavities.cavities)
+      jobs.push_back(std::async(std::launch::async, [&, cavp = &cav] {
+        return build_transition(*cavp, coords, out.grid, out.blocks, base);
+      }));
+    transitions.clear();
+    std::vector<int32_t> more;
+    std::string first_error;
+    for (auto& j : jobs) {
+      try {
+        transitions.push_back(j.get());
+      } catch (const TransitionError& e) {
+        if (first_error.empty()) first_error = e.what();
+        more.insert(more.end(), e.cells_to_deactivate.begin(), e.cells_to_deactivate.end());
+      }
+    }
+    if (first_error.empty()) break;
+    if (more.empty() || attempt == kMaxRetries)
+      throw std::runtime_error(first_error + (attempt > 0 ? " (after " + std::to_string(attempt) +
+                                                                " cavity enlargements)"
+                                                          : std::string()));
+    extra_deactivated.insert(extra_deactivated.end(), more.begin(), more.end());
+    std::sort(extra_deactivated.begin(), extra_deactivated.end());
+    extra_deactivated.erase(std::unique(extra_deactivated.begin(), extra_deactivated.end()), extra_deactivated.end());
+    out.notes.push_back("cavity: " + std::to_string(more.size()) +
+                        " reservoir cells deactivated so that the transition mesh can be built (" + first_error + ")");
   }
+  for (const std::string& n : out.cavities.notes) out.notes.push_back(n);
   out.cavity_node_coords = coords;
-  timer.mark("cavities");
+  timer.mark(opts.build_transition ? "cavities_and_transition" : "cavities");
 
   add_reservoir_cells(out.grid, cs.reservoir, res_nodes, out.cavities.reservoir_active, builder);
   timer.mark("reservoir_cells");
-
-  // Transition meshes: cavities are independent, so they are built concurrently; the
-  // result is assembled in cavity order, so the output does not depend on scheduling.
-  std::vector<TransitionCells> transitions;
-  if (opts.build_transition) {
-    const int32_t base = builder.n_nodes();
-    std::vector<std::future<TransitionCells>> jobs;
-    for (const Cavity& cav : out.cavities.cavities)
-      jobs.push_back(std::async(std::launch::async, [&, base, cavp = &cav] {
-        return build_transition(*cavp, coords, out.grid, out.blocks, base);
-      }));
-    for (auto& j : jobs) transitions.push_back(j.get());
-    timer.mark("transition");
-  }
 
   // Assemble the transition cells; free nodes are renumbered cavity by cavity.
   std::vector<int32_t> cell_cavity_list;
