@@ -6,6 +6,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "fvcheck/lib/checks.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 
 namespace hm {
@@ -119,6 +120,8 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
       vol += dot(g - site, cross(m.nodes[cyc[i]] - site, m.nodes[cyc[(i + 1) % cyc.size()]] - site)) / 6.0;
     for (int32_t v : cell_nodes)
       if (r.convex && dot(n, m.nodes[v] - g) > tol && std::find(cyc.begin(), cyc.end(), v) == cyc.end()) r.convex = false;
+    // Convex also means every face polygon is simple with no reflex vertex (as fvcheck).
+    if (r.convex && face_polygon_defect(m.nodes, cyc.data(), cyc.data() + cyc.size(), 1e-9) != 0) r.convex = false;
     if (dot(n, site - g) >= -tol) r.centred = false;
     // Q_O (eq. 8): the segment to the other cell's FV centre (or the face centroid on the boundary).
     const int32_t other = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
