@@ -235,14 +235,16 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   std::string sched_text;
   {
     TextOut o;
-    o << "WELSPECS\n";
+    if (n_wells == 0) o << "-- The case has no wells.\n";
+    if (n_wells > 0) o << "WELSPECS\n";
     for (int w = 0; w < n_wells; ++w) {
       const auto head = L.deck_ijk(L.cell_deck_index[wells[w][0].first]);
       // Item 5: BHP reference depth = first trajectory point (the wellhead end of the well).
       o << quoted(cs.wells[w].name) << " 'G1' " << head[0] + 1 << ' ' << head[1] + 1 << ' '
         << cs.wells[w].trajectory.front().z << " 'WATER' /\n";
     }
-    o << "/\n\nCOMPDAT\n-- WELL I J K1 K2 STATUS SATNUM CF: CF = HybridMesh's wellbore connection factor.\n";
+    if (n_wells > 0)
+      o << "/\n\nCOMPDAT\n-- WELL I J K1 K2 STATUS SATNUM CF: CF = HybridMesh's wellbore connection factor.\n";
     for (int w = 0; w < n_wells; ++w) {
       max_connections = std::max(max_connections, static_cast<int>(wells[w].size()));
       for (const auto& [cell, cf] : wells[w]) {
@@ -251,7 +253,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
           << ijk[2] + 1 << " 'OPEN' 1* " << cf << " /\n";
       }
     }
-    o << "/\n\n";
+    if (n_wells > 0) o << "/\n\n";
     bool any_prod = false, any_inj = false;
     for (const WellSpec& w : cs.wells) (w.type == WellType::Producer ? any_prod : any_inj) = true;
     if (any_prod) {

@@ -318,6 +318,32 @@ TEST(EclipseDeck, WritesOurNumbersBitForBit) {
   EXPECT_EQ(eclipse_array(grid, "COORD").size(), 6u * (L.deck_nx + 1) * (L.ny + 1));
 }
 
+TEST(EclipseDeck, BoxWithoutWellsIsThePlainLattice) {
+  hm::CaseSpec cs = box_case({0, 10, 25, 45, 60}, {0, 12, 30, 50}, {1000, 1004, 1010, 1018});
+  hm::BuildReport rep;
+  const hm::PolyMesh mesh = build_box_mesh(cs, &rep);
+  const hm::MeshGeometry geo = hm::compute_geometry(mesh);
+  const hm::Transmissibilities trans = hm::compute_transmissibilities(mesh, geo);
+  TempDir tmp("deck_box");
+  hm::EclipseDeckInfo info;
+  const hm::WriteStatus st = hm::write_eclipse_deck(tmp.str(), cs, mesh, geo, trans, {}, &info);
+  ASSERT_TRUE(st.ok) << st.message;
+  EXPECT_EQ(info.layout.extra_columns, 0);
+  EXPECT_EQ(info.nnc, 0);
+  EXPECT_EQ(info.tran_connections, 3 * 3 * 3 + 4 * 2 * 3 + 4 * 3 * 2);  // the lattice's interior faces
+  const std::string data = read_text(tmp.path / "BOX.DATA");
+  EXPECT_NE(data.find("DIMENS\n4 3 3 /"), std::string::npos);
+  EXPECT_EQ(read_text(tmp.path / "BOX_NNC.INC").find("NNC\n"), std::string::npos);
+  const std::string sched = read_text(tmp.path / "BOX_SCHEDULE.INC");
+  EXPECT_EQ(sched.find("WELSPECS"), std::string::npos);
+  EXPECT_EQ(sched.find("COMPDAT"), std::string::npos);
+  // Logical neighbours carry the generic TPFA value of the lattice: A / (dx1/(2 k1) + dx2/(2 k2)).
+  const std::vector<double> tranx = eclipse_array(read_text(tmp.path / "BOX_EDIT.INC"), "TRANX");
+  ASSERT_EQ(tranx.size(), 36u);
+  EXPECT_NEAR(tranx[0], hm::kDarcyMetric * 12 * 4 / (10 / (2 * 120.0) + 15 / (2 * 120.0)), 1e-12);
+  EXPECT_EQ(tranx[3], 0.0);  // i = 4 has no +I neighbour
+}
+
 TEST(EclipseDeck, GrdeclIsTheStructuredReservoirAlone) {
   Fixture fx;
   TempDir tmp("grdecl");
