@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "checks.hpp"
+#include "meshgen/core/text_file.hpp"
 #include "quality.hpp"
 
 namespace hm {
@@ -53,8 +54,5 @@ std::string report_summary_text(const FvReport& r);
 /// Self-contained HTML page (inline CSS and SVG).
 std::string report_html(const FvReport& r);
 
-/// Writes text to path through path + ".tmp" and a rename. Returns false and sets *error
-/// on failure.
-bool write_text_file(const std::string& path, const std::string& text, std::string* error);
 
 }  // namespace hm

@@ -2,7 +2,6 @@
 // Exit codes: 0 success, 1 meshing failure, 2 bad input or arguments.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <string>
 
@@ -11,6 +10,7 @@
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/quality.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/text_file.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/summary.hpp"
 
@@ -24,21 +24,6 @@ int usage(const std::string& why) {
             << "  mesh.vtu, summary.json and cavity_K.obj are always written; --export adds\n"
             << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n";
   return 2;
-}
-
-// Writes text atomically (temp file + rename) so that a failure never leaves a
-// complete-looking file behind.
-bool write_text(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) return false;
-    f << text;
-    if (!f.good()) return false;
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  return !ec;
 }
 
 }  // namespace
@@ -157,8 +142,9 @@ int main(int argc, char** argv) {
     written.push_back((out / "openfoam").string() + "/");
   }
   const nlohmann::json summary = hm::make_summary(cs, result);
-  if (!write_text(out / "summary.json", summary.dump(2) + "\n")) {
-    std::cerr << "meshgen: cannot write '" << (out / "summary.json").string() << "'\n";
+  std::string error;
+  if (!hm::write_text_file((out / "summary.json").string(), summary.dump(2) + "\n", &error)) {
+    std::cerr << "meshgen: " << error << "\n";
     return 2;
   }
   written.push_back((out / "summary.json").string());
