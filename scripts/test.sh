@@ -20,5 +20,5 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
   bash scripts/build.sh "$root/build-asan" -DHM_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1"
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  (cd build-asan && ctest --output-on-failure -j"$jobs" -E '^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|VtkValidation)')
+  (cd build-asan && ctest --output-on-failure -j"$jobs" -E '^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation)')
 fi
