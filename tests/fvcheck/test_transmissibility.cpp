@@ -474,7 +474,8 @@ TEST(Transmissibility, RingZeroConnectionFactorIsTheLogForm) {
     for (int f = 0; f < m.n_faces(); ++f) {
       if (!is_wellbore_patch(m.face_patch[f])) continue;
       ++wellbore_faces;
-      EXPECT_NEAR(t.face[f], cf, 1e-13 * cf);
+      // The face's axial length comes from its area (rounding of the fan: ~1e-12 relative).
+      EXPECT_NEAR(t.face[f], cf, 1e-11 * cf);
       EXPECT_EQ(t.face[f], t.half_owner[f]);
     }
     EXPECT_EQ(wellbore_faces, s.sectors * s.segments);
