@@ -17,7 +17,8 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
   # -O1 -g1: quick to compile, line numbers in reports. The runs of third-party validators
   # (OPM Flow, OpenFOAM checkMesh, VTK) already ran in the Release pass; here our own code
   # is what the sanitizers watch, so those tests are left out.
-  bash scripts/build.sh "$root/build-asan" -DHM_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1"
+  bash scripts/build.sh "$root/build-asan" -DHM_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
+    -DCGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE=TRUE
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   (cd build-asan && ctest --output-on-failure -j"$jobs" -E '^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation)')
