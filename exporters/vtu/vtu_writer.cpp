@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "meshgen/core/mesh_builder.hpp"
+#include "meshgen/core/text_file.hpp"
 
 namespace hm {
 
@@ -19,21 +20,6 @@ bool host_is_little_endian() {
   unsigned char b;
   std::memcpy(&b, &one, 1);
   return b == 1;
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char ch : s) {
-    switch (ch) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      case '\'': o += "&apos;"; break;
-      default: o += ch;
-    }
-  }
-  return o;
 }
 
 // One appended block: the DataArray header line and the raw bytes (without the UInt64 count).

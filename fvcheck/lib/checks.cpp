@@ -42,6 +42,15 @@ std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_w
   return worst_ids_of(v, higher_is_worse, [](size_t) { return true; });
 }
 
+// Sets r.worst (the largest value, or the smallest when lower is worse; `empty` when there
+// are none) and the ids of the worst values.
+void rank_worst(CheckResult& r, bool higher_is_worse, double empty = 0.0) {
+  if (r.values.empty()) r.worst = empty;
+  else r.worst = higher_is_worse ? *std::max_element(r.values.begin(), r.values.end())
+                                 : *std::min_element(r.values.begin(), r.values.end());
+  r.worst_ids = worst_ids_of(r.values, higher_is_worse);
+}
+
 void push_example(std::vector<int32_t>& ids, int32_t id) {
   if (ids.size() < kWorstIds && std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
 }
@@ -278,8 +287,7 @@ CheckResult check_convexity(const PolyMesh& m, const MeshGeometry& geo, const Ch
     if (outside) ++outside_cells, push_example(ex_outside, c);
     if (outside || bad_face) ++r.violations;
   }
-  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
-  r.worst_ids = worst_ids_of(r.values, true);
+  rank_worst(r, true);
   r.counts = {{"cells_with_node_outside_face_plane", outside_cells},
               {"faces_with_reflex_vertex", reflex},
               {"self_intersecting_faces", non_simple},
@@ -444,8 +452,7 @@ CheckResult check_closure(const PolyMesh& m, const MeshGeometry& geo, const Chec
     r.values[c] = std::isnan(ratio) ? 1.0 : ratio;
     if (!(r.values[c] <= opt.closure_tol)) ++r.violations;
   }
-  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
-  r.worst_ids = worst_ids_of(r.values, true);
+  rank_worst(r, true);
   r.measures = {{"tolerance", opt.closure_tol}};
   return r;
 }
@@ -464,8 +471,7 @@ CheckResult check_volume(const PolyMesh& m, const MeshGeometry& geo, const Check
     min_vol = std::min(min_vol, v);
     total += v;
   }
-  r.worst = r.values.empty() ? 0.0 : *std::min_element(r.values.begin(), r.values.end());
-  r.worst_ids = worst_ids_of(r.values, false);
+  rank_worst(r, false);
   r.measures = {{"min_volume", std::isfinite(min_vol) ? min_vol : 0.0},
                 {"total_volume", total},
                 {"rel_tol", opt.volume_rel_tol}};
@@ -485,8 +491,7 @@ CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, cons
       cell_bad[m.face_owner[f]] = 1;
       if (m.face_neighbour[f] >= 0) cell_bad[m.face_neighbour[f]] = 1;
     }
-  r.worst = r.values.empty() ? 90.0 : *std::min_element(r.values.begin(), r.values.end());
-  r.worst_ids = worst_ids_of(r.values, false);
+  rank_worst(r, false, 90.0);
   r.counts = {{"cells_with_violations", std::count(cell_bad.begin(), cell_bad.end(), 1)}};
   r.measures = {{"min_deg", r.worst}, {"threshold_deg", opt.min_orthogonality_deg}};
   return r;
@@ -512,8 +517,7 @@ CheckResult check_auto_centering(const PolyMesh& m, const MeshGeometry& geo, con
     r.values[c] = value;
     if (!(worst < -sc.tol[c]) || !std::isfinite(worst)) ++r.violations;
   }
-  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
-  r.worst_ids = worst_ids_of(r.values, true);
+  rank_worst(r, true);
   r.measures = {{"rel_tol", opt.rel_tol}};
   return r;
 }
@@ -530,8 +534,7 @@ CheckResult check_planarity(const PolyMesh& m, const MeshGeometry& geo, const Ch
       cell_bad[m.face_owner[f]] = 1;
       if (m.face_neighbour[f] >= 0) cell_bad[m.face_neighbour[f]] = 1;
     }
-  r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
-  r.worst_ids = worst_ids_of(r.values, true);
+  rank_worst(r, true);
   r.counts = {{"cells_with_violations", std::count(cell_bad.begin(), cell_bad.end(), 1)}};
   r.measures = {{"max_deg", r.worst}, {"threshold_deg", opt.max_planarity_deg}};
   return r;

@@ -10,20 +10,6 @@ namespace hm {
 
 namespace {
 
-std::string esc(const std::string& s) {
-  std::string o;
-  for (char ch : s) {
-    switch (ch) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += ch;
-    }
-  }
-  return o;
-}
-
 std::string fmt(double x, const char* f = "%.4g") {
   if (std::isnan(x)) return "NaN";
   if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
@@ -48,7 +34,7 @@ std::string svg_histogram(const std::string& title, const std::vector<int64_t>& 
   std::ostringstream s;
   s << "<svg xmlns='http://www.w3.org/2000/svg' width='" << W << "' height='" << H << "' viewBox='0 0 " << W << ' '
     << H << "' role='img'>";
-  s << "<text x='" << W / 2 << "' y='16' class='t'>" << esc(title) << "</text>";
+  s << "<text x='" << W / 2 << "' y='16' class='t'>" << xml_escape(title) << "</text>";
   s << "<line x1='" << L << "' y1='" << T + ph << "' x2='" << L + pw << "' y2='" << T + ph << "' class='ax'/>";
   s << "<line x1='" << L << "' y1='" << T << "' x2='" << L << "' y2='" << T + ph << "' class='ax'/>";
   s << "<text x='" << L - 4 << "' y='" << T + 4 << "' class='yl'>" << cmax << "</text>";
@@ -100,9 +86,9 @@ svg .c{font-size:8px;text-anchor:middle;fill:#333}
 
 std::string report_html(const FvReport& r) {
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>fvcheck: " << esc(r.source)
+  h << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>fvcheck: " << xml_escape(r.source)
     << "</title><style>" << kCss << "</style></head><body>\n";
-  h << "<h1>fvcheck report &mdash; " << esc(r.source) << "</h1>\n";
+  h << "<h1>fvcheck report &mdash; " << xml_escape(r.source) << "</h1>\n";
   h << "<p><span class='badge " << (r.ok() ? "ok'>ALL CHECKS HOLD" : "fail'>CHECKS FAILED") << "</span></p>\n";
 
   // Counts.
@@ -112,15 +98,15 @@ std::string report_html(const FvReport& r) {
   h << "<tr><td class='l'>boundary faces</td><td>" << r.boundary_faces << "</td></tr>";
   h << "<tr><td class='l'>nodes</td><td>" << r.nodes << "</td></tr>";
   for (const RegionQuality& rq : r.by_region)
-    h << "<tr><td class='l'>" << esc(rq.name) << " cells</td><td>" << rq.cells << "</td></tr>";
+    h << "<tr><td class='l'>" << xml_escape(rq.name) << " cells</td><td>" << rq.cells << "</td></tr>";
   h << "</table>\n";
-  for (const std::string& n : r.notes) h << "<p class='small'>Note: " << esc(n) << "</p>\n";
+  for (const std::string& n : r.notes) h << "<p class='small'>Note: " << xml_escape(n) << "</p>\n";
 
   // Checks.
   h << "<h2>Finite-volume checks</h2>";
   if (!r.structure.ok) {
     h << "<p><b>The mesh structure is invalid; the checks were skipped.</b></p><ul>";
-    for (const std::string& p : r.structure.problems) h << "<li>" << esc(p) << "</li>";
+    for (const std::string& p : r.structure.problems) h << "<li>" << xml_escape(p) << "</li>";
     h << "</ul>";
   }
   h << "<table><tr><th class='l'>check</th><th class='l'>status</th><th>violations</th><th>worst</th>"
@@ -129,9 +115,9 @@ std::string report_html(const FvReport& r) {
     std::string limit;
     for (const auto& [name, x] : c.measures)
       if (name == "threshold_deg" || name == "tolerance" || name == "rel_tol") limit = name + " " + fmt(x);
-    h << "<tr" << (c.ok() ? "" : " class='bad'") << "><td class='l'>" << esc(c.name) << "</td><td class='l'>"
+    h << "<tr" << (c.ok() ? "" : " class='bad'") << "><td class='l'>" << xml_escape(c.name) << "</td><td class='l'>"
       << (c.skipped ? "skipped" : (c.ok() ? "ok" : "FAILED")) << "</td><td>" << c.violations << "</td><td>"
-      << (c.skipped ? "&ndash;" : fmt(c.worst)) << "</td><td class='l'>" << esc(limit) << "</td><td class='l'>"
+      << (c.skipped ? "&ndash;" : fmt(c.worst)) << "</td><td class='l'>" << xml_escape(limit) << "</td><td class='l'>"
       << (c.id_kind == IdKind::Face ? "faces " : "cells ") << ids_text(c.worst_ids) << "</td></tr>";
   }
   h << "</table>\n";
@@ -144,14 +130,14 @@ std::string report_html(const FvReport& r) {
     h << "<h2>Failed checks</h2><ul>";
     for (const CheckResult& c : r.checks) {
       if (c.ok() || c.skipped) continue;
-      h << "<li><b>" << esc(c.name) << "</b>: " << c.violations << " violation(s), worst " << fmt(c.worst)
+      h << "<li><b>" << xml_escape(c.name) << "</b>: " << c.violations << " violation(s), worst " << fmt(c.worst)
         << "; worst " << (c.id_kind == IdKind::Face ? "faces" : "cells") << ": " << ids_text(c.worst_ids);
       std::string sub;
       for (const auto& [name, n] : c.counts)
-        if (n > 0) sub += (sub.empty() ? "" : "; ") + esc(name) + " " + std::to_string(n);
+        if (n > 0) sub += (sub.empty() ? "" : "; ") + xml_escape(name) + " " + std::to_string(n);
       if (!sub.empty()) h << "<br><span class='small'>" << sub << "</span>";
       for (const auto& [name, ids] : c.id_lists)
-        if (!ids.empty()) h << "<br><span class='small'>" << esc(name) << ": " << ids_text(ids) << "</span>";
+        if (!ids.empty()) h << "<br><span class='small'>" << xml_escape(name) << ": " << ids_text(ids) << "</span>";
       h << "</li>";
     }
     h << "</ul>\n";
@@ -161,7 +147,7 @@ std::string report_html(const FvReport& r) {
     // Quality table in the layout of the paper's Table 2, one column per region.
     h << "<h2>Quality (paper section 6.1)</h2><table><tr><th class='l'>criterion</th><th class='l'></th>"
          "<th>all cells</th>";
-    for (const RegionQuality& rq : r.by_region) h << "<th>" << esc(rq.name) << "</th>";
+    for (const RegionQuality& rq : r.by_region) h << "<th>" << xml_escape(rq.name) << "</th>";
     h << "</tr>";
     struct Row {
       const char* name;
@@ -196,7 +182,7 @@ std::string report_html(const FvReport& r) {
       }
       std::vector<bool> mask(r.cell_region.size());
       for (size_t c = 0; c < mask.size(); ++c) mask[c] = r.cell_region[c] == rq.region;
-      h << "<h3>" << esc(rq.name) << " (" << rq.cells << " cells)</h3><div class='grid'>";
+      h << "<h3>" << xml_escape(rq.name) << " (" << rq.cells << " cells)</h3><div class='grid'>";
       h << svg_histogram("Q_S (bins of 0.1)", histogram(r.q_s, mask, 0.0, 1.0, 10), 0.0, 1.0, "%.1f", 1, "#1565c0");
       h << svg_histogram("Q_O (deg, bins of 5)", histogram(r.q_o_cell, mask, 0.0, 90.0, 18), 0.0, 90.0, "%.0f", 3, "#2e7d32");
       h << svg_histogram("Q_P (deg, bins of 5)", histogram(r.q_p_cell, mask, 0.0, 90.0, 18), 0.0, 90.0, "%.0f", 3, "#ef6c00");

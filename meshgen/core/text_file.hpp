@@ -8,4 +8,7 @@ namespace hm {
 /// on failure.
 bool write_text_file(const std::string& path, const std::string& text, std::string* error);
 
+/// `s` with & < > " ' replaced by XML entities (VTU attributes, HTML reports).
+std::string xml_escape(const std::string& s);
+
 }  // namespace hm
