@@ -14,6 +14,7 @@ namespace hm {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr double kSkewnessLimit = kOpenFoamSkewnessLimit;
 
 // A mutable copy of the mesh: faces as node cycles (owner orientation) that edge
 // operations rewrite in place, with enough incidence to find the ball of a node.
@@ -64,6 +65,77 @@ double face_planarity_deg(const EditableMesh& m, const std::vector<int32_t>& cyc
     worst = std::max(worst, std::acos(std::min(1.0, std::abs(dot(n, t / tn)))) * kRadToDeg);
   }
   return worst;
+}
+
+// OpenFOAM's face centre and area vector (primitiveMesh face centres): a triangle
+// directly; otherwise a fan around the point average whose triangle centroids are weighted
+// by their area projected on the face's normal. The area points as the cycle turns.
+void foam_face(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* e, Vec3* centre, Vec3* area) {
+  const size_t n = static_cast<size_t>(e - b);
+  if (n == 3) {
+    *centre = (nodes[b[0]] + nodes[b[1]] + nodes[b[2]]) / 3.0;
+    *area = 0.5 * cross(nodes[b[1]] - nodes[b[0]], nodes[b[2]] - nodes[b[0]]);
+    return;
+  }
+  Vec3 mean;
+  for (const int32_t* v = b; v != e; ++v) mean += nodes[*v];
+  mean = mean / static_cast<double>(n);
+  Vec3 sum_n;
+  for (size_t i = 0; i < n; ++i) sum_n += cross(nodes[b[(i + 1) % n]] - nodes[b[i]], mean - nodes[b[i]]);
+  Vec3 sum_c;
+  double sum_a = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = nodes[b[i]], q = nodes[b[(i + 1) % n]];
+    const double a = dot(cross(q - p, mean - p), sum_n);
+    sum_a += a;
+    sum_c += a * (p + q + mean);
+  }
+  *centre = sum_a > 1e-300 ? sum_c / (3.0 * sum_a) : mean;
+  *area = 0.5 * sum_n;
+}
+
+// OpenFOAM's cell centre (primitiveMesh cell centres): the volume-weighted centroid of the
+// pyramids from the average of the face centres. Faces are given as outward cycles.
+Vec3 foam_cell_centre(const std::vector<Vec3>& nodes, const std::vector<std::vector<int32_t>>& outward) {
+  std::vector<Vec3> fc(outward.size()), fa(outward.size());
+  Vec3 est;
+  for (size_t i = 0; i < outward.size(); ++i) {
+    foam_face(nodes, outward[i].data(), outward[i].data() + outward[i].size(), &fc[i], &fa[i]);
+    est += fc[i];
+  }
+  if (outward.empty()) return est;
+  est = est / static_cast<double>(outward.size());
+  Vec3 sum;
+  double vol = 0;
+  for (size_t i = 0; i < outward.size(); ++i) {
+    const double pv = std::max(dot(fa[i], fc[i] - est), 1e-300);
+    sum += pv * (0.75 * fc[i] + 0.25 * est);
+    vol += pv;
+  }
+  return vol > 0 ? sum / vol : est;
+}
+
+// OpenFOAM's face skewness (primitiveMeshTools::faceSkewness / boundaryFaceSkewness): the
+// distance from the face centre to where the line between the cell centres crosses the face
+// plane, over the face's extent in that direction (at least 0.2 |d|; 0.4 |d| on the boundary).
+double foam_skewness(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* e, Vec3 fc, Vec3 fa, Vec3 own_cc,
+                     const Vec3* nei_cc) {
+  const Vec3 cpf = fc - own_cc;
+  Vec3 d;
+  double fd;
+  if (nei_cc) {
+    d = *nei_cc - own_cc;
+    fd = 0.2 * norm(d);
+  } else {
+    const Vec3 nrm = fa / (norm(fa) + 1e-300);
+    d = dot(nrm, cpf) * nrm;
+    fd = 0.4 * norm(d);
+  }
+  const Vec3 sv = cpf - (dot(fa, cpf) / (dot(fa, d) + 1e-300)) * d;
+  const Vec3 sv_hat = sv / (norm(sv) + 1e-300);
+  fd += 1e-300;
+  for (const int32_t* v = b; v != e; ++v) fd = std::max(fd, std::abs(dot(sv_hat, nodes[*v] - fc)));
+  return norm(sv) / fd;
 }
 
 CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std::vector<double>& h_ref, int32_t c) {
@@ -232,6 +304,11 @@ class Optimizer {
       convex0_[c] = cm.valid && cm.convex;
       centred0_[c] = cm.valid && cm.centred;
     }
+    centre_.resize(nc);
+    for (int c = 0; c < nc; ++c) centre_[c] = cell_centre(c);
+    skew_ok_.resize(m_.faces.size());
+    for (size_t f = 0; f < m_.faces.size(); ++f)
+      skew_ok_[f] = face_skewness(static_cast<int32_t>(f), {}) <= kSkewnessLimit;
   }
 
   // Phase: 0 = remove edges < G1 h, 1 = remove edges < G2 h, 2 = expand edges < G3 h.
@@ -269,6 +346,47 @@ class Optimizer {
 
   PolyMesh result() const { return from_editable(m_, src_); }
 
+  // Skewness phase: faces of transition cells whose OpenFOAM skewness exceeds the limit
+  // (typically a sliver at the far tip of a needle cell, whose centre is far from the
+  // face) are collapsed to a point, or lose their edges one at a time, under every control;
+  // an operation counts only if the face disappears or becomes less skewed.
+  int run_skewness_phase(OptimizeReport* rep) {
+    report_ = rep;
+    int total = 0;
+    for (int pass = 0; pass < p_.max_passes; ++pass) {
+      ++rep->passes;
+      std::vector<std::pair<double, int32_t>> skewed;
+      for (size_t f = 0; f < m_.faces.size(); ++f) {
+        if (!m_.alive[f] || !transition_face(static_cast<int32_t>(f))) continue;
+        const double sk = face_skewness(static_cast<int32_t>(f), {});
+        if (sk > kSkewnessLimit) skewed.push_back({-sk, static_cast<int32_t>(f)});
+      }
+      std::sort(skewed.begin(), skewed.end());  // most skewed first; ties by face id
+      int changed = 0;
+      for (const auto& [neg_sk, f] : skewed) {
+        (void)neg_sk;
+        if (m_.alive[f] && reduce_skewness(f)) ++changed;
+      }
+      total += changed;
+      if (changed == 0) break;
+    }
+    return total;
+  }
+
+  int skewed_faces(double* worst) const {
+    int n = 0;
+    *worst = 0;
+    for (size_t f = 0; f < m_.faces.size(); ++f) {
+      if (!m_.alive[f]) continue;
+      const int32_t o = m_.owner[f], nb = m_.neighbour[f];
+      if (src_.cell_region[o] != kTransition && (nb < 0 || src_.cell_region[nb] != kTransition)) continue;
+      const double sk = face_skewness(static_cast<int32_t>(f), {});
+      *worst = std::max(*worst, sk);
+      if (sk > kSkewnessLimit) ++n;
+    }
+    return n;
+  }
+
   // The last accepted operation that changed a cell around a or b.
   long latest_change(int32_t a, int32_t b) const {
     long t = 0;
@@ -286,6 +404,30 @@ class Optimizer {
     std::vector<std::pair<int32_t, char>> alive;
     std::vector<std::pair<int32_t, Vec3>> nodes;
   };
+
+  // OpenFOAM centre of cell c as the mesh is now.
+  Vec3 cell_centre(int32_t c) const {
+    std::vector<std::vector<int32_t>> cycles;
+    for (int32_t f : m_.cell_faces[c])
+      if (m_.alive[f]) cycles.push_back(outward_cycle(m_, f, c));
+    return foam_cell_centre(m_.nodes, cycles);
+  }
+
+  // OpenFOAM skewness of face f, with the centres in `moved` overriding the cached ones.
+  double face_skewness(int32_t f, const std::vector<std::pair<int32_t, Vec3>>& moved) const {
+    auto centre = [&](int32_t c) {
+      for (const auto& [mc, p] : moved)
+        if (mc == c) return p;
+      return centre_[c];
+    };
+    const auto& cyc = m_.faces[f];
+    Vec3 fc, fa;
+    foam_face(m_.nodes, cyc.data(), cyc.data() + cyc.size(), &fc, &fa);
+    const Vec3 own = centre(m_.owner[f]);
+    if (m_.neighbour[f] < 0) return foam_skewness(m_.nodes, cyc.data(), cyc.data() + cyc.size(), fc, fa, own, nullptr);
+    const Vec3 nei = centre(m_.neighbour[f]);
+    return foam_skewness(m_.nodes, cyc.data(), cyc.data() + cyc.size(), fc, fa, own, &nei);
+  }
 
   bool transition_face(int32_t f) const {
     return src_.cell_region[m_.owner[f]] == kTransition && m_.neighbour[f] >= 0 &&
@@ -362,7 +504,8 @@ class Optimizer {
   // Validity (closed, non-degenerate, positive volume, still convex if it was) and the FV
   // controls of paper 6.2 (per-cell orthogonality and planarity thresholds,
   // auto-centering) on every touched cell; for an expansion also a better mean Q_S.
-  bool accept(const std::set<int32_t>& cells, const std::set<int32_t>* must_improve_qs, double qs_before) {
+  bool accept(const std::set<int32_t>& cells, const std::set<int32_t>* must_improve_qs, double qs_before,
+              int32_t target_face = -1, double target_skew = 0) {
     std::vector<std::pair<int32_t, CellMeasures>> measured;
     double qs_sum = 0;
     for (int32_t c : cells) {
@@ -377,8 +520,30 @@ class Optimizer {
     }
     if (must_improve_qs && qs_sum / std::max<size_t>(1, cells.size()) <= qs_before)
       return reject(&OptimizeReport::rejected_shape);
+    // OpenFOAM skewness of every face of the touched cells (their centres moved): a face
+    // within the limit stays within it. (A cap at each skewed face's own level refused
+    // operations that removed skewed faces elsewhere: three_wells kept 138 instead of 106.)
+    std::vector<std::pair<int32_t, Vec3>> moved;
+    for (int32_t c : cells) moved.push_back({c, cell_centre(c)});
+    std::vector<std::pair<int32_t, double>> skews;
+    std::set<int32_t> seen;
+    for (int32_t c : cells)
+      for (int32_t f : m_.cell_faces[c]) {
+        if (!m_.alive[f] || !seen.insert(f).second) continue;
+        const double sk = face_skewness(f, moved);
+        if (skew_ok_[f] && sk > kSkewnessLimit) return reject(&OptimizeReport::rejected_skewness);
+        skews.push_back({f, sk});
+      }
+    if (target_face >= 0 && m_.alive[target_face]) {
+      const auto it = std::find_if(skews.begin(), skews.end(), [&](const auto& e) { return e.first == target_face; });
+      const double now = it != skews.end() ? it->second : face_skewness(target_face, moved);
+      if (now >= target_skew) return reject(&OptimizeReport::rejected_skewness);
+    }
     // A cell's thresholds follow its improvements (paper 6.2).
     ++op_count_;
+    for (const auto& [c, cc] : moved) centre_[c] = cc;
+    for (const auto& [f, sk] : skews)
+      if (sk <= kSkewnessLimit) skew_ok_[f] = 1;
     for (const auto& [c, cm] : measured) {
       cell_stamp_[c] = op_count_;
       thr_o_[c] = std::max(thr_o_[c], std::min(p_.omega_o, cm.q_o));
@@ -437,7 +602,7 @@ class Optimizer {
   // the constrained vertex if the set has one (it stays in place), else a new position
   // (merge_position). Faces that fall below 3 vertices disappear. Accepted only if every
   // touched cell stays valid and passes the controls; otherwise everything is restored.
-  bool try_merge(std::vector<int32_t> verts, int target_choice = 0) {
+  bool try_merge(std::vector<int32_t> verts, int target_choice = 0, int32_t skew_face = -1, double skew_before = 0) {
     std::sort(verts.begin(), verts.end());
     int32_t keep = verts.front();
     int n_fixed = 0;
@@ -448,9 +613,13 @@ class Optimizer {
       }
     if (n_fixed > 1) return false;
     const bool keep_moves = n_fixed == 0;
-    // target_choice 0: the plane-fitting position; k > 0: where verts[k - 1] is.
+    // target_choice 0: the plane-fitting position; -1: the midpoint; k > 0: where verts[k - 1] is.
+    Vec3 mid;
+    for (int32_t v : verts) mid += m_.nodes[v];
+    mid = mid / static_cast<double>(verts.size());
     const Vec3 target = !keep_moves ? m_.nodes[keep]
                         : target_choice == 0 ? merge_position(verts)
+                        : target_choice < 0  ? mid
                                              : m_.nodes[verts[target_choice - 1]];
     // Touched: faces of the vertices that disappear, and faces of the keeper if it moves.
     std::set<int32_t> touched, cells;
@@ -479,7 +648,7 @@ class Optimizer {
       m_.faces[f] = cyc;
       if (cyc.size() < 3) m_.alive[f] = 0;
     }
-    if (!accept(cells, nullptr, 0)) {
+    if (!accept(cells, nullptr, 0, skew_face, skew_before)) {
       restore(s);
       return false;
     }
@@ -496,10 +665,31 @@ class Optimizer {
 
   // An edge of two free vertices merges at the plane-fitting position, or failing that at
   // either end (which leaves that end's faces untouched); a constrained end stays put.
-  bool try_collapse(int32_t a, int32_t b) {
-    if (try_merge({a, b})) return true;
+  bool try_collapse(int32_t a, int32_t b, int32_t skew_face = -1, double skew_before = 0) {
+    if (try_merge({a, b}, 0, skew_face, skew_before)) return true;
     if (m_.fixed[a] || m_.fixed[b]) return false;
-    return try_merge({a, b}, 1) || try_merge({a, b}, 2);
+    if (try_merge({a, b}, -1, skew_face, skew_before)) return true;
+    return try_merge({a, b}, 1, skew_face, skew_before) || try_merge({a, b}, 2, skew_face, skew_before);
+  }
+
+  // One operation that removes face f or makes it less skewed: the whole face to a point
+  // (where its planes meet, or at one of its vertices), else one of its edges collapsed,
+  // shortest first.
+  bool reduce_skewness(int32_t f) {
+    const double before = face_skewness(f, {});
+    const std::vector<int32_t> cyc = m_.faces[f];
+    for (size_t k = 0; k <= cyc.size(); ++k)
+      if (try_merge(cyc, static_cast<int>(k), f, before)) return true;
+    std::vector<std::pair<double, std::pair<int32_t, int32_t>>> edges;
+    for (size_t i = 0; i < cyc.size(); ++i) {
+      int32_t a = cyc[i], b = cyc[(i + 1) % cyc.size()];
+      if (a > b) std::swap(a, b);
+      if (!(m_.fixed[a] && m_.fixed[b])) edges.push_back({norm(m_.nodes[a] - m_.nodes[b]), {a, b}});
+    }
+    std::sort(edges.begin(), edges.end());
+    for (const auto& e : edges)
+      if (try_collapse(e.second.first, e.second.second, f, before)) return true;
+    return false;
   }
 
   // Small faces (paper 6.2: "small faces are then removed in an implicit way"): a face
@@ -556,6 +746,8 @@ class Optimizer {
   OptimizeParams p_;
   EditableMesh m_;
   std::vector<double> thr_o_, thr_p_;
+  std::vector<Vec3> centre_;        // OpenFOAM cell centres (geometric centroids), kept current
+  std::vector<char> skew_ok_;       // per face: its skewness is within kSkewnessLimit, and must stay so
   std::vector<char> convex0_, centred0_;  // initial state: a control never makes a cell worse
   int collapsed_ = 0;
   long op_count_ = 0;                 // accepted operations so far
@@ -567,6 +759,27 @@ class Optimizer {
 
 }  // namespace
 
+std::vector<double> openfoam_face_skewness(const PolyMesh& mesh) {
+  std::vector<Vec3> centre(mesh.n_cells());
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    std::vector<std::vector<int32_t>> outward;
+    for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f) {
+      outward.emplace_back(mesh.face_begin(*f), mesh.face_end(*f));
+      if (mesh.face_owner[*f] != c) std::reverse(outward.back().begin(), outward.back().end());
+    }
+    centre[c] = foam_cell_centre(mesh.nodes, outward);
+  }
+  std::vector<double> skew(mesh.n_faces());
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    Vec3 fc, fa;
+    foam_face(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), &fc, &fa);
+    const int32_t n = mesh.face_neighbour[f];
+    skew[f] = foam_skewness(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), fc, fa, centre[mesh.face_owner[f]],
+                            n >= 0 ? &centre[n] : nullptr);
+  }
+  return skew;
+}
+
 PolyMesh optimize_transition(const PolyMesh& mesh, const std::vector<double>& h_ref, const OptimizeParams& params,
                              OptimizeReport* report) {
   OptimizeReport rep;
@@ -574,6 +787,12 @@ PolyMesh optimize_transition(const PolyMesh& mesh, const std::vector<double>& h_
   rep.removed_below_g1 = opt.run_phase(0, params.gamma[0], &rep);
   rep.removed_below_g2 = opt.run_phase(1, params.gamma[1], &rep);
   rep.expanded = opt.run_phase(2, params.gamma[2], &rep);
+  // The expansions move vertices, which frees some removals that were refused: one more
+  // round of removal and expansion.
+  rep.removed_below_g2 += opt.run_phase(1, params.gamma[1], &rep);
+  rep.expanded += opt.run_phase(2, params.gamma[2], &rep);
+  rep.skewness_removed = opt.run_skewness_phase(&rep);
+  rep.skewed_faces = opt.skewed_faces(&rep.max_skewness);
   if (report) *report = rep;
   return opt.result();
 }

@@ -2,7 +2,8 @@
 // expanded, under finite-volume controls (in all three phases: see optimize.cpp). Constrained vertices (those of the reservoir
 // and well grids) never move, so conformity with the structured grids and the total
 // volume are preserved; every accepted change keeps the touched cells closed, convex
-// (if they were) and with positive volume.
+// (if they were) and with positive volume, and keeps every face within OpenFOAM's skewness
+// limit if it was; a last phase collapses skewed faces where the controls allow it.
 #pragma once
 #include <array>
 #include <string>
@@ -32,8 +33,20 @@ struct OptimizeReport {
   int rejected_planarity = 0;    ///< Q_P(V) above the cell's threshold
   int rejected_centering = 0;    ///< a site would leave its cell
   int rejected_shape = 0;        ///< expansion without mean Q_S improvement
+  int rejected_skewness = 0;     ///< a face's OpenFOAM skewness above max(limit, its level)
+  int skewness_removed = 0;      ///< skewness phase: operations that removed or unskewed a face
+  int skewed_faces = 0;          ///< after: faces of transition cells with OpenFOAM skewness > kOpenFoamSkewnessLimit
+  double max_skewness = 0;       ///< after: their largest OpenFOAM skewness
   int passes = 0;
 };
+
+/// OpenFOAM's face skewness (checkMesh flags faces above 4), per face: cell centres are
+/// geometric centroids and face centres area-weighted, computed as OpenFOAM does.
+std::vector<double> openfoam_face_skewness(const PolyMesh& mesh);
+
+/// Skewness above which the optimiser treats a face as skewed: OpenFOAM's 4, less a margin
+/// for the precision of the written points.
+inline constexpr double kOpenFoamSkewnessLimit = 3.95;
 
 /// Optimises the transition cells (region kTransition) of `mesh`. h_ref[c] is the Q_S
 /// reference length of cell c (used for transition cells). Returns the new mesh: same
