@@ -3,14 +3,12 @@
 // Geometry. Leg k of the trajectory polyline carries a right-handed frame (u_k, v_k, d_k);
 // leg k's frame is leg k-1's turned by the minimal rotation taking d_{k-1} to d_k (about
 // d_{k-1} x d_k): the rotation-minimising (parallel transport) frame, which does not twist.
-// A node of the cross-section with axis point P and plane normal m is where the line
-// P + e + t d_k (e = r (cos phi u_k + sin phi v_k)) meets the plane: t = -m.e / m.d_k.
-// Cross-sections inside a leg and at the two trajectory ends are perpendicular (t = 0); at a
-// bend vertex the plane is the bisector plane m = normalize(d_{k-1} + d_k), where the node
-// lines of both legs meet, so the bend layer is shared by both legs. Every edge along the
-// trajectory is therefore parallel to its leg: every face is planar (two parallel sides, or
-// inside a cross-section plane), and with the FV centre on the cell's mid-angle radial line
-// the ring and angular faces are orthogonal to the centre-to-centre segments.
+// Every cross-section (layer) is perpendicular to the meshed axis; a node is
+// P + r (cos phi u + sin phi v). On straight parts every cell is a right prism over an
+// annular sector: faces planar and co-circular, and with the FV centre on the cell's
+// mid-angle radial line the ring and angular faces are orthogonal to the centre-to-centre
+// segments. A bend is meshed as mirror wedges on a fillet arc (below): the meshed axis cuts
+// the corner, by a distance each bend's note states.
 //
 // End caps. Both extremities are closed. The end annulus quads of the first and last layers
 // are faces of the end cells (outer-surface faces, later claimed by transition cells). The
@@ -61,20 +59,8 @@ struct Leg {
   Vec3 a, b;       // trajectory points at its ends
   Vec3 d, u, v;    // right-handed frame, d along the leg
   double length = 0;
-  Vec3 m_start, m_end;  // normals of the cross-section planes at its ends
   double bend_start = -1, bend_end = -1;  // bend angles (degrees) at its ends, -1 at a trajectory end
-  int segments = 1;
 };
-
-struct Layer {
-  Vec3 p;   // axis point
-  Vec3 m;   // plane normal
-  int leg;  // the leg whose frame places the nodes (the incoming leg at a bend)
-};
-
-// Offset along d of the node at in-frame offset e in the plane through the axis point with
-// normal m; exactly 0 in a perpendicular plane.
-double plane_offset(Vec3 m, Vec3 d, Vec3 e) { return m == d ? 0.0 : -dot(m, e) / dot(m, d); }
 
 void validate_well(const WellSpec& ws, int w, int sectors) {
   const std::string key = well_key(w);
@@ -122,10 +108,6 @@ std::vector<Leg> make_legs(const WellSpec& ws, int w) {
     legs[k].u = normalized(u - dot(u, d) * d);
     legs[k].v = cross(d, legs[k].u);
   }
-  for (int k = 0; k < n_legs; ++k) {
-    legs[k].m_start = k == 0 ? legs[k].d : normalized(legs[k - 1].d + legs[k].d);
-    legs[k].m_end = k == n_legs - 1 ? legs[k].d : normalized(legs[k].d + legs[k + 1].d);
-  }
   return legs;
 }
 
@@ -138,45 +120,147 @@ std::vector<double> ring_radii(const WellSpec& ws) {
   return radii;
 }
 
+
 std::string bend_phrase(const Leg& g) {
   if (g.bend_start >= 0 && g.bend_end >= 0) return "its bends of " + num(g.bend_start) + " and " + num(g.bend_end) + " degrees";
   return "its bend of " + num(std::max(g.bend_start, g.bend_end)) + " degrees";
 }
 
-// Splits each leg into segments of equal length, n = max(1, round(L / segment_length)),
-// lowered while a cross-section would not lie strictly beyond the previous one along every
-// node line (the bisector planes at bends tilt the end cross-sections by up to
-// r tan(bend / 2)). Throws when even one segment does not clear the leg's bends.
-void choose_segments(const CaseSpec& cs, int w, const std::vector<double>& radii, const std::vector<double>& cos_s,
-                     const std::vector<double>& sin_s, std::vector<Leg>& legs, std::vector<std::string>& notes) {
-  const WellSpec& ws = cs.wells[w];
-  const double inf = std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < legs.size(); ++k) {
-    Leg& g = legs[k];
-    // Along its node line, a node sits at axial position t_a (start plane), j L / n
-    // (interior planes), L + t_b (end plane).
-    double max_ta = -inf, max_minus_tb = -inf, max_span = -inf;
-    for (double r : radii)
-      for (size_t s = 0; s < cos_s.size(); ++s) {
-        const Vec3 e = r * (cos_s[s] * g.u + sin_s[s] * g.v);
-        const double ta = plane_offset(g.m_start, g.d, e), tb = plane_offset(g.m_end, g.d, e);
-        max_ta = std::max(max_ta, ta);
-        max_minus_tb = std::max(max_minus_tb, -tb);
-        max_span = std::max(max_span, ta - tb);
-      }
-    const double L = g.length;
-    const int n0 = std::max(1L, std::lround(L / ws.segment_length));
-    int n = n0;
-    while (n >= 2 && !(max_ta < L / n && (n - 1) * L / n < L - max_minus_tb)) --n;
-    if (n == 1 && !(max_span < L))
-      throw InputError(well_key(w) + ".trajectory: leg " + std::to_string(k) + " too short for " + bend_phrase(g) +
-                       " (needs > " + num(max_span) + " m with drainage radius " + num(ws.drainage_radius) + ")");
-    if (n < n0)
-      notes.push_back(well_label(cs, w) + ": leg " + std::to_string(k) + " split into " + std::to_string(n) +
-                      " segments of " + num(L / n) + " m instead of " + std::to_string(n0) +
-                      " so that its cross-sections clear " + bend_phrase(g));
-    g.segments = n;
+// Distance from x to a polyline.
+double distance_to_polyline(Vec3 x, const std::vector<Vec3>& line) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k + 1 < line.size(); ++k) {
+    const Vec3 ab = line[k + 1] - line[k];
+    const double len2 = dot(ab, ab);
+    const double s = len2 > 0 ? std::clamp(dot(x - line[k], ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, norm(x - (line[k] + s * ab)));
   }
+  return best;
+}
+
+// ---- Bends as mirror wedges.
+// A bend of angle beta at trajectory point B (legs d1 -> d2) is meshed on a fillet arc of
+// radius rho tangent to both legs: the axis leaves leg 1 at T1 = B - t d1 and joins leg 2 at
+// T2 = B + t d2 (t = rho tan(beta / 2)), through k wedges. Wedge j lies between the
+// perpendicular cross-sections at stations X_j and X_{j+1} (normals d^(j), d^(j+1): d1 turned
+// by j beta / k), which are mirror images of each other through the plane with normal
+// d^(j) + d^(j+1) (X_{j+1} = X_j + delta (d^(j) + d^(j+1)), delta = rho tan(beta / (2 k))), and
+// so are their nodes, since the minimal rotation and that reflection agree on vectors normal
+// to d^(j). Every face of a wedge (ring and angular faces: a node pair and its mirror image;
+// axial faces: in a cross-section) is then a planar isosceles trapezoid or a cross-section
+// polygon: planar and co-circular, as the transition mesh needs (paper 5.4, 5.7).
+// rho > R (drainage radius) keeps the inner side of every wedge open.
+struct BendPlan {
+  int point = -1;       // trajectory point index
+  double angle = 0;     // beta (radians)
+  Vec3 axis;            // unit rotation axis, d1 x d2 / |d1 x d2|
+  double radius = 0;    // rho
+  double tangent = 0;   // t
+  int wedges = 0;       // k
+};
+
+constexpr double kMinFilletFactor = 1.05;     // rho >= 1.05 R: the wedges' inner sides stay open
+constexpr double kPreferredFilletFactor = 1.5;  // rho = 1.5 R when the legs allow it
+constexpr double kMaxWedgeAngle = kPi / 6;    // 30 degrees per wedge keeps the outer surface Gabriel
+
+// x turned by `angle` about the unit axis n (Rodrigues).
+Vec3 rotate_about(Vec3 x, Vec3 n, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return c * x + s * cross(n, x) + ((1.0 - c) * dot(n, x)) * n;
+}
+
+// Fillet radius and wedge count of every bend; throws when a leg cannot hold the wedges at
+// its ends even with the smallest fillet.
+std::vector<BendPlan> plan_bends(const WellSpec& ws, int w, const std::vector<Leg>& legs) {
+  const int n_legs = static_cast<int>(legs.size());
+  std::vector<BendPlan> plans;
+  std::vector<double> t_min(n_legs + 1, 0.0);  // per trajectory point: the smallest tangent length
+  for (int k = 1; k < n_legs; ++k) {
+    const Vec3 d1 = legs[k - 1].d, d2 = legs[k].d;
+    BendPlan p;
+    p.point = k;
+    p.angle = std::atan2(norm(cross(d1, d2)), dot(d1, d2));
+    if (p.angle == 0) continue;  // collinear points: a plain cross-section
+    p.axis = normalized(cross(d1, d2));
+    t_min[k] = kMinFilletFactor * ws.drainage_radius * std::tan(0.5 * p.angle);
+    plans.push_back(p);
+  }
+  for (int k = 0; k < n_legs; ++k) {
+    const double need = t_min[k] + t_min[k + 1];
+    if (!(need < legs[k].length)) {
+      throw InputError(well_key(w) + ".trajectory: leg " + std::to_string(k) + " too short for " + bend_phrase(legs[k]) +
+                       " (needs > " + num(need) + " m with drainage radius " + num(ws.drainage_radius) + ")");
+    }
+  }
+  for (BendPlan& p : plans) {
+    const int k = p.point;
+    // Each bend may use its smallest tangent plus half of what its legs leave free (all of
+    // it on a leg whose other end is a trajectory end).
+    auto room = [&](int leg, int other_point) {
+      const double free = legs[leg].length - t_min[k] - t_min[other_point];
+      const bool shared = other_point > 0 && other_point < n_legs && t_min[other_point] > 0;
+      return t_min[k] + (shared ? 0.5 : 1.0) * free;
+    };
+    const double cap = std::min(room(k - 1, k - 1), room(k, k + 1));
+    const double half_tan = std::tan(0.5 * p.angle);
+    // Preferred: 1.5 R, and an arc at least one segment long (gentle bends).
+    const double preferred = std::max(kPreferredFilletFactor * ws.drainage_radius, ws.segment_length / p.angle);
+    p.radius = std::max(kMinFilletFactor * ws.drainage_radius, std::min(preferred, cap / half_tan));
+    p.tangent = p.radius * half_tan;
+    const int by_angle = static_cast<int>(std::ceil(p.angle / kMaxWedgeAngle));
+    const int by_length = static_cast<int>(std::lround(p.radius * p.angle / ws.segment_length));
+    p.wedges = std::max({1, by_angle, by_length});
+  }
+  return plans;
+}
+
+// A perpendicular cross-section of the block: axis point, unit normal, in-plane frame.
+struct Station {
+  Vec3 p, d, u, v;
+  int bend_point = -1;  // trajectory point of the bend whose wedges it bounds, -1 on straight parts
+};
+
+// Stations along the trajectory: straight parts of each leg split into segments of about
+// segment_length, bends replaced by their wedges.
+std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& legs,
+                                   const std::vector<BendPlan>& plans) {
+  const int n_legs = static_cast<int>(legs.size());
+  std::vector<const BendPlan*> plan_at(n_legs + 1, nullptr);
+  for (const BendPlan& p : plans) plan_at[p.point] = &p;
+  std::vector<Station> st;
+  for (int k = 0; k < n_legs; ++k) {
+    const Leg& g = legs[k];
+    const double t0 = plan_at[k] ? plan_at[k]->tangent : 0.0;
+    const double t1 = plan_at[k + 1] ? plan_at[k + 1]->tangent : 0.0;
+    const Vec3 s0 = g.a + t0 * g.d, s1 = g.b - t1 * g.d;
+    if (k == 0) st.push_back({s0, g.d, g.u, g.v, -1});
+    // (a bend's last station, already pushed, is s0 of this leg)
+    const double straight = g.length - t0 - t1;
+    const int n = straight > 0 ? std::max(1L, std::lround(straight / ws.segment_length)) : 0;
+    for (int j = 1; j <= n; ++j) st.push_back({j == n ? s1 : s0 + (static_cast<double>(j) / n) * (s1 - s0), g.d, g.u, g.v, -1});
+    if (k + 1 == n_legs) break;
+    const Leg& h = legs[k + 1];
+    const BendPlan* p = plan_at[k + 1];
+    if (!p) continue;  // collinear: the leg's last station is the next leg's first
+    st.back().bend_point = p->point;
+    const double delta = p->radius * std::tan(0.5 * p->angle / p->wedges);
+    for (int j = 1; j <= p->wedges; ++j) {
+      const Station& prev = st.back();
+      Station s;
+      if (j == p->wedges) {
+        s = {h.a + p->tangent * h.d, h.d, h.u, h.v, p->point};
+      } else {
+        const double a = p->angle * j / p->wedges;
+        s.d = rotate_about(g.d, p->axis, a);
+        s.u = rotate_about(g.u, p->axis, a);
+        s.v = cross(s.d, s.u);
+        s.p = prev.p + delta * (prev.d + s.d);
+        s.bend_point = p->point;
+      }
+      st.push_back(s);
+    }
+  }
+  return st;
 }
 
 // Signed volume of a closed cell given as its 6 outward faces (fan around each face's node
@@ -221,11 +305,7 @@ GabrielDiagnosis diagnose_gabriel(const WellBlock& block, const std::vector<Vec3
   const std::vector<GabrielViolation> violations = gabriel_violations(block.nodes, block.surface_faces);
   diag.total = static_cast<int>(violations.size());
   if (violations.empty()) return diag;
-  // Bend layers are exactly the layers centred on interior trajectory points.
-  std::vector<int> layer_point(block.layers, -1);
-  for (int l = 1; l + 1 < block.layers; ++l)
-    for (size_t k = 1; k + 1 < trajectory.size(); ++k)
-      if (block.layer_center[l] == trajectory[k]) layer_point[l] = static_cast<int>(k);
+  const std::vector<int32_t>& layer_point = block.layer_bend;
   const int per_layer = (block.rings + 1) * block.sectors;
   const int last = block.layers - 1;
   for (const GabrielViolation& v : violations) {
@@ -281,36 +361,29 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
     sin_s[s] = std::sin(phi);
   }
 
-  std::vector<Leg> legs = make_legs(ws, w);
-  choose_segments(cs, w, block.radii, cos_s, sin_s, legs, block.notes);
-
-  // Layers: trajectory start, interior split points, bend vertices, end.
-  std::vector<Layer> layers;
-  std::vector<int> segment_leg;
-  layers.push_back({legs[0].a, legs[0].d, 0});
-  for (int k = 0; k < static_cast<int>(legs.size()); ++k) {
-    const Leg& g = legs[k];
-    for (int j = 1; j < g.segments; ++j)
-      layers.push_back({g.a + (static_cast<double>(j) / g.segments) * (g.b - g.a), g.d, k});
-    layers.push_back({g.b, g.m_end, k});
-    for (int j = 0; j < g.segments; ++j) segment_leg.push_back(k);
-  }
-  const int n_layers = static_cast<int>(layers.size());
+  const std::vector<Leg> legs = make_legs(ws, w);
+  const std::vector<BendPlan> plans = plan_bends(ws, w, legs);
+  const std::vector<Station> stations = make_stations(ws, legs, plans);
+  const int n_layers = static_cast<int>(stations.size());
   block.layers = n_layers;
-  for (const Layer& ly : layers) block.layer_center.push_back(ly.p);
+  for (const Station& st : stations) {
+    block.layer_center.push_back(st.p);
+    block.layer_bend.push_back(st.bend_point);
+  }
+  for (const BendPlan& p : plans)
+    block.notes.push_back(well_label(cs, w) + ": bend of " + num(p.angle * 180 / kPi) + " degrees at trajectory point " +
+                          std::to_string(p.point) + " meshed as " + std::to_string(p.wedges) +
+                          " mirror wedge(s) on an arc of radius " + num(p.radius) + " m: the wellbore axis leaves the"
+                          " trajectory " + num(p.tangent) + " m before the point and passes " +
+                          num(distance_to_polyline(ws.trajectory[p.point], block.layer_center)) + " m from it");
 
   // Nodes: local id = (layer * (rings + 1) + ring) * sectors + sector.
   const int rings = ws.rings;
   const int per_layer = (rings + 1) * sectors;
   block.nodes.reserve(static_cast<size_t>(n_layers) * per_layer);
-  for (const Layer& ly : layers) {
-    const Leg& g = legs[ly.leg];
+  for (const Station& st : stations)
     for (int i = 0; i <= rings; ++i)
-      for (int s = 0; s < sectors; ++s) {
-        const Vec3 e = block.radii[i] * (cos_s[s] * g.u + sin_s[s] * g.v);
-        block.nodes.push_back(ly.p + e + plane_offset(ly.m, g.d, e) * g.d);
-      }
-  }
+      for (int s = 0; s < sectors; ++s) block.nodes.push_back(st.p + block.radii[i] * (cos_s[s] * st.u + sin_s[s] * st.v));
   auto node = [&](int l, int i, int s) { return static_cast<int32_t>((l * (rings + 1) + i) * sectors + s % sectors); };
 
   // Cells: id = (segment * rings + ring) * sectors + sector.
@@ -320,8 +393,8 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   block.cell_faces.reserve(static_cast<size_t>(n_segments) * rings * sectors);
   block.cell_attrs.reserve(static_cast<size_t>(n_segments) * rings * sectors);
   for (int l = 0; l < n_segments; ++l) {
-    const Leg& g = legs[segment_leg[l]];
-    const double length = norm(layers[l + 1].p - layers[l].p);
+    const Station &s0 = stations[l], &s1 = stations[l + 1];
+    const double length = norm(s1.p - s0.p);
     for (int i = 0; i < rings; ++i)
       for (int s = 0; s < sectors; ++s) {
         const int32_t a = node(l, i, s), b = node(l, i, s + 1), c = node(l, i + 1, s + 1), d = node(l, i + 1, s);
@@ -355,16 +428,12 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
         rad.angle = sector_angle;
         rad.length = length;
         const double phi_mid = (s + 0.5) * sector_angle;
-        // On the radial line at the mid angle, halfway between where the line parallel to
-        // the leg at radius r_center meets the two cross-section planes: the axis midpoint
-        // on straight legs (ring and angular faces exactly orthogonal); next to a bend it
-        // follows the mitre, so the centre stays inside the cell on the inner side of the
-        // bend (there the ring faces are only nearly orthogonal). A position shared by all
-        // rings of a sector was tried: it makes the axial faces at the bend almost parallel
-        // to the centre-to-centre segments (Q_O of 2 degrees, negative transmissibilities).
-        const Vec3 e_mid = rad.r_center * (std::cos(phi_mid) * g.u + std::sin(phi_mid) * g.v);
-        const Vec3 x0 = layers[l].p + e_mid + plane_offset(layers[l].m, g.d, e_mid) * g.d;
-        const Vec3 x1 = layers[l + 1].p + e_mid + plane_offset(layers[l + 1].m, g.d, e_mid) * g.d;
+        // Midpoint of the point at radius r_center on the mid-angle radial line of both
+        // cross-sections: the axis midpoint on straight parts (ring and angular faces exactly
+        // orthogonal), on the mirror plane in a wedge (the point's image).
+        const double cm = std::cos(phi_mid), sm = std::sin(phi_mid);
+        const Vec3 x0 = s0.p + rad.r_center * (cm * s0.u + sm * s0.v);
+        const Vec3 x1 = s1.p + rad.r_center * (cm * s1.u + sm * s1.v);
         at.fv_center = 0.5 * (x0 + x1);
         block.cell_faces.push_back(std::move(faces));
         block.cell_attrs.push_back(at);
@@ -444,6 +513,13 @@ WellBlock make_gabriel_well_block(const CaseSpec& cs, int w) {
   return block;
 }
 
+std::vector<Vec3> meshed_axis(const WellBlock& block) {
+  std::vector<Vec3> axis;
+  for (int l = 0; l < block.layers; ++l)
+    if (l == 0 || l + 1 == block.layers || block.layer_bend[l] >= 0) axis.push_back(block.layer_center[l]);
+  return axis;
+}
+
 std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder) {
   std::vector<int32_t> ids(block.nodes.size());
   for (size_t i = 0; i < block.nodes.size(); ++i) ids[i] = builder.add_node(block.nodes[i]);
@@ -456,12 +532,26 @@ std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder
   return ids;
 }
 
+double well_block_prism_length(const CaseSpec& cs, int w) {
+  const WellSpec& ws = cs.wells.at(w);
+  const std::vector<Leg> legs = make_legs(ws, w);
+  double length = 0;
+  for (const Leg& g : legs) length += g.length;
+  // A wedge of angle a and half length delta is the prism along its mirror normal over the
+  // cross-section projected on the mirror plane (area A cos(a/2)), of height 2 |h| with h
+  // affine over it and equal to delta cos(a/2) at the centre: volume A x 2 delta cos^2(a/2).
+  // The k wedges of a bend replace the 2 t of straight legs around the bend point.
+  for (const BendPlan& p : plan_bends(ws, w, legs)) {
+    const double a = p.angle / p.wedges, delta = p.radius * std::tan(0.5 * a), c = std::cos(0.5 * a);
+    length += p.wedges * 2.0 * delta * c * c - 2.0 * p.tangent;
+  }
+  return length;
+}
+
 double exact_well_block_volume(const CaseSpec& cs, int w, int sectors) {
   const WellSpec& ws = cs.wells.at(w);
   const double annulus = regular_polygon_area(sectors, ws.drainage_radius) - regular_polygon_area(sectors, ws.radius);
-  double length = 0;
-  for (size_t k = 0; k + 1 < ws.trajectory.size(); ++k) length += norm(ws.trajectory[k + 1] - ws.trajectory[k]);
-  return annulus * length;
+  return annulus * well_block_prism_length(cs, w);
 }
 
 }  // namespace hm

@@ -1,7 +1,7 @@
 // Structured radial grid around one well trajectory (paper sections 2, 5.1).
 //
-// Layout: layers l = 0..L-1 are cross-sections along the trajectory (at a bend the
-// cross-section lies in the bisector plane of the two legs); each layer has rings+1
+// Layout: layers l = 0..L-1 are cross-sections perpendicular to the meshed axis (a bend
+// is meshed as mirror wedges on a fillet arc, see well_block.cpp); each layer has rings+1
 // node polygons (radii r_0 = radius .. r_rings = drainage_radius, geometric
 // progression), each polygon `sectors` nodes at angles 2*pi*s/sectors in the
 // rotation-minimising frame carried along the trajectory. Cell (ring, sector, segment)
@@ -24,7 +24,8 @@ struct WellBlock {
   int rings = 0, sectors = 0, layers = 0;  ///< layers = segments + 1
   std::vector<double> radii;       ///< rings + 1 polygon circumradii, radii[0] = r_w
   std::vector<Vec3> nodes;         ///< local node coordinates
-  std::vector<Vec3> layer_center;  ///< layers: axis point of each cross-section
+  std::vector<Vec3> layer_center;  ///< layers: axis point of each cross-section (the meshed axis polyline)
+  std::vector<int32_t> layer_bend; ///< layers: trajectory point of the bend whose wedges it bounds, or -1
   /// Cells: faces with local node ids, outward oriented; patch = wellbore_patch(well) for
   /// wellbore faces, kInteriorFace for everything else (outer faces are claimed by the
   /// transition mesh).
@@ -52,11 +53,19 @@ int count_gabriel_violations(const WellBlock& block);
 /// make_well_block + raise sectors until the outer surface is Gabriel (notes say so).
 WellBlock make_gabriel_well_block(const CaseSpec& cs, int w);
 
+/// The wellbore axis as meshed: the trajectory's end points and the cross-section centres of
+/// the bend wedges (it cuts each bend's corner along chords of the fillet arc).
+std::vector<Vec3> meshed_axis(const WellBlock& block);
+
 /// Adds the block's nodes and cells to the builder; returns the builder id of each local node.
 std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder);
 
-/// Exact volume of the block: per leg, (area of the outer polygon - area of the inner
-/// polygon) x leg length along the axis (legs are cut by bisector planes at bends).
+/// L* such that the block's volume is (outer - inner polygon area) x L* and the wellbore
+/// hole's is (inner polygon area) x L*: the trajectory length, less 2 t per bend, plus
+/// 2 delta cos^2(a / 2) per wedge (closed form of the mirror wedges, well_block.cpp).
+double well_block_prism_length(const CaseSpec& cs, int w);
+
+/// Exact volume of the block: (area of the outer polygon - area of the inner polygon) x L*.
 double exact_well_block_volume(const CaseSpec& cs, int w, int sectors);
 
 }  // namespace hm

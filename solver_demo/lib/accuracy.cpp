@@ -5,6 +5,7 @@
 #include <set>
 
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "peaceman.hpp"
 
@@ -30,12 +31,15 @@ AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& opt
   s.p_w = ws.bhp;
   s.drawdown = std::fabs(cs.reservoir.initial_pressure - ws.bhp);
   s.source_inset = opt.source_to_tips ? 0.0 : ws.radius;
-  s.field = make_line_source_field(ws.trajectory, ws.radius, ws.bhp, cs.reservoir.initial_pressure, s.near_radius,
+  // The well as meshed: the block cuts each bend's corner along its fillet wedges, so the
+  // exact solution's source follows that axis (the trajectory itself for straight wells).
+  const std::vector<Vec3> axis = meshed_axis(make_gabriel_well_block(cs, 0));
+  s.field = make_line_source_field(axis, ws.radius, ws.bhp, cs.reservoir.initial_pressure, s.near_radius,
                                    s.source_inset);
-  s.reference = field_reference(ws.trajectory);
+  s.reference = field_reference(axis);
   const double q_per_length = 4 * kPi * kDarcyMetric * s.permeability * s.field.coefficient / s.viscosity;
   s.exact_rate = q_per_length * s.field.source_length();
-  const double leg = norm(ws.trajectory[s.reference.leg + 1] - ws.trajectory[s.reference.leg]);
+  const double leg = norm(axis[s.reference.leg + 1] - axis[s.reference.leg]);
   s.slab_half_width = std::max(0.1 * leg, ws.segment_length);
   return s;
 }
@@ -136,17 +140,21 @@ AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyO
     const CaseSpec level_case = refine_case(cs, f);
     RefinementLevel lv;
     lv.factor = f;
+    // Each level's exact solution follows that level's meshed axis (the bend wedges are
+    // re-planned with the finer segments).
+    const AccuracySetup setup = f == 1 ? st.setup : make_accuracy_setup(level_case, opt);
     {
       const HybridMesh hm = build_hybrid_mesh(level_case);
       if (f == 1) st.notes = hm.notes;
       lv.hybrid_cells = hm.mesh.n_cells();
-      lv.hybrid = measure_accuracy(hm.mesh, hm.geometry, {}, st.setup, nullptr, f == 1 ? &st.hybrid_samples : nullptr);
+      lv.hybrid = measure_accuracy(hm.mesh, hm.geometry, {}, setup, nullptr, f == 1 ? &st.hybrid_samples : nullptr);
     }
     {
       const CartesianMesh cm = make_cartesian_mesh(level_case.reservoir);
       lv.cartesian_cells = cm.mesh.n_cells();
-      lv.peaceman = measure_accuracy(cm.mesh, cm.geo, peaceman_connections(cm, level_case.wells[0], 0), st.setup,
-                                     nullptr, f == 1 ? &st.peaceman_samples : nullptr);
+      const std::vector<WellConnection> wells =
+          peaceman_connections(cm, setup.field.polyline, level_case.wells[0].radius, 0);
+      lv.peaceman = measure_accuracy(cm.mesh, cm.geo, wells, setup, nullptr, f == 1 ? &st.peaceman_samples : nullptr);
     }
     if (f == 1) st.hybrid = lv.hybrid, st.peaceman = lv.peaceman;
     st.refinement.push_back(lv);

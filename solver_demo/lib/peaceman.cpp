@@ -88,14 +88,19 @@ double peaceman_connection_factor(Vec3 size, Vec3 perm, Vec3 extent, double r_w)
   return std::sqrt(sum2);
 }
 
-std::vector<WellConnection> peaceman_connections(const CartesianMesh& cm, const WellSpec& ws, int well) {
+std::vector<WellConnection> peaceman_connections(const CartesianMesh& cm, const std::vector<Vec3>& polyline,
+                                                 double r_w, int well) {
   std::vector<WellConnection> out;
-  for (const TrajectoryInCell& tc : trajectory_cells(cm.grid, ws.trajectory)) {
+  for (const TrajectoryInCell& tc : trajectory_cells(cm.grid, polyline)) {
     const int32_t c = cm.mesh_cell[tc.grid_cell];
     const Vec3 size = cm.grid.cell_hi(tc.grid_cell) - cm.grid.cell_lo(tc.grid_cell);
-    out.push_back({well, c, peaceman_connection_factor(size, cm.mesh.cell_perm[c], tc.extent, ws.radius), tc.midpoint});
+    out.push_back({well, c, peaceman_connection_factor(size, cm.mesh.cell_perm[c], tc.extent, r_w), tc.midpoint});
   }
   return out;
+}
+
+std::vector<WellConnection> peaceman_connections(const CartesianMesh& cm, const WellSpec& ws, int well) {
+  return peaceman_connections(cm, ws.trajectory, ws.radius, well);
 }
 
 }  // namespace hm

@@ -49,5 +49,8 @@ double peaceman_connection_factor(Vec3 size, Vec3 perm, Vec3 extent, double r_w)
 /// The Peaceman connections of well `well` on a Cartesian mesh (point = midpoint of the
 /// trajectory in the cell, where the accuracy study evaluates the exact wellbore pressure).
 std::vector<WellConnection> peaceman_connections(const CartesianMesh& cm, const WellSpec& ws, int well);
+/// The same along any polyline (the accuracy study uses the meshed axis of the well block).
+std::vector<WellConnection> peaceman_connections(const CartesianMesh& cm, const std::vector<Vec3>& polyline,
+                                                 double r_w, int well);
 
 }  // namespace hm

@@ -199,7 +199,8 @@ TEST_P(WellBlockShapes, OuterSurfaceClosedAndOutward) {
     EXPECT_TRUE(back != directed.end() && back->second == 1) << edge.first << "->" << edge.second;
   }
   // Outward: the surface encloses the solid outer-polygon tube (block + capped wellbore),
-  // whose volume is area(outer polygon) x trajectory length (divergence theorem).
+  // whose volume is area(outer polygon) x L* (divergence theorem; L* = the trajectory length
+  // on straight wells, less what the wedges cut at the bends).
   double enclosed = 0;
   int caps = 0;
   for (size_t k = 0; k < blk.surface_faces.size(); ++k) {
@@ -216,8 +217,7 @@ TEST_P(WellBlockShapes, OuterSurfaceClosedAndOutward) {
     }
   }
   EXPECT_EQ(caps, 2);
-  double length = 0;
-  for (size_t k = 0; k + 1 < p.trajectory.size(); ++k) length += norm(p.trajectory[k + 1] - p.trajectory[k]);
+  const double length = well_block_prism_length(cs, 0);
   const double outer_area = 0.5 * p.sectors * p.drainage_radius * p.drainage_radius * std::sin(2 * kPi / p.sectors);
   EXPECT_NEAR(enclosed / (outer_area * length), 1.0, 1e-12);
 }
@@ -331,37 +331,73 @@ TEST(WellBlock, FvCentresOnRadialLinesMakeRingFacesOrthogonal) {
             1e-6);
 }
 
-// Next to a bend the centres follow the mitre: every centre stays strictly inside its cell
-// (auto-centering), at the price of ring faces that are only nearly orthogonal there.
-TEST(WellBlock, FvCentresStayInsideCellsAtBends) {
-  for (double bend : {30.0, 60.0, 90.0}) {
+// Largest co-circularity misfit of a planar quad: distance of its 4th node from the circle
+// through the other three, and its distance from their plane.
+void quad_misfit(const std::vector<Vec3>& x, const std::vector<int32_t>& q, double* circle, double* plane) {
+  const Vec3 a = x[q[0]], b = x[q[1]], c = x[q[2]], d = x[q[3]];
+  const Vec3 ab = b - a, ac = c - a, n = cross(ab, ac);
+  // Circumcentre of a, b, c.
+  const Vec3 o = a + (dot(ac, ac) * cross(n, ab) + dot(ab, ab) * cross(ac, n)) / (2.0 * dot(n, n));
+  const Vec3 nu = normalized(n);
+  *plane = std::abs(dot(d - a, nu));
+  *circle = std::abs(norm((d - o) - dot(d - o, nu) * nu) - norm(a - o));
+}
+
+// Bends are mirror wedges: every quad of the block, wedges included, is planar and
+// co-circular (what the transition mesh needs to stay convex), the centres stay inside
+// their cells, and the ring faces stay orthogonal to the centre-to-centre segments.
+TEST(WellBlock, BendWedgesHavePlanarCocircularFacesAndCentredCells) {
+  for (double bend : {10.0, 30.0, 60.0, 90.0, 120.0}) {
     WellParams p;
-    p.trajectory = bent(bend);
-    p.sectors = 6;  // Gabriel at 90 degrees needs few sectors
+    p.trajectory = bent(bend, 60, 60);
     const BuiltBlock b = build(make_case(p), p.sectors);
+    double circle = 0, plane = 0;
+    int wedge_faces = 0;
+    for (size_t c = 0; c < b.block.cell_faces.size(); ++c) {
+      const int l = b.block.cell_attrs[c].radial.segment;
+      const bool wedge = b.block.layer_bend[l] >= 0 && b.block.layer_bend[l + 1] >= 0;
+      for (const CellFace& f : b.block.cell_faces[c]) {
+        double cm = 0, pm = 0;
+        quad_misfit(b.block.nodes, f.nodes, &cm, &pm);
+        circle = std::max(circle, cm);
+        plane = std::max(plane, pm);
+        wedge_faces += wedge;
+      }
+    }
+    EXPECT_GT(wedge_faces, 0) << "bend " << bend;
+    EXPECT_LT(circle, 1e-12 * 60) << "bend " << bend;
+    EXPECT_LT(plane, 1e-12 * 60) << "bend " << bend;
     const MeshGeometry geo = compute_geometry(b.mesh);
-    const CheckResult centred = check_auto_centering(b.mesh, geo);
-    EXPECT_EQ(centred.violations, 0) << "bend " << bend;
+    EXPECT_EQ(check_auto_centering(b.mesh, geo).violations, 0) << "bend " << bend;
+    EXPECT_EQ(check_convexity(b.mesh, geo).violations, 0) << "bend " << bend;
     int n = 0;
     const double ring = max_orthogonality_angle(
         b, [](const RadialCellInfo& a, const RadialCellInfo& c) { return a.sector == c.sector && a.segment == c.segment; },
         &n);
-    std::printf("[ bend      ] %g deg: worst ring-face angle %.3f rad\n", bend, ring);
-    EXPECT_LT(ring, 0.5 * bend * kPi / 180) << "bend " << bend;  // measured: 0.116, 0.245, 0.409 rad
+    std::printf("[ bend      ] %g deg: misfit circle %.1e plane %.1e, worst ring-face angle %.4f rad\n", bend, circle,
+                plane, ring);
+    EXPECT_LT(ring, 0.02) << "bend " << bend;  // measured: at most 0.013 rad (0.75 deg)
   }
-  // Fail case: the axis-midpoint centres of the first version leave cells on the inner side
-  // (a 50-degree bend with 4 m segments, as in examples/paper_single_well.yaml).
+  // Fail case: shifting one wedge cross-section along its normal breaks the mirror symmetry,
+  // and with it the co-circularity of the wedge quads.
   WellParams p;
   p.trajectory = bent(50);
-  BuiltBlock b = build(make_case(p), p.sectors);
-  for (int c = 0; c < b.mesh.n_cells(); ++c) {
-    const RadialCellInfo& r = b.mesh.cell_radial[c];
-    const Vec3 axis_mid = 0.5 * (b.block.layer_center[r.segment] + b.block.layer_center[r.segment + 1]);
-    const Vec3 centre = b.mesh.cell_fv_center[c];
-    const Vec3 along = normalized(b.block.layer_center[r.segment + 1] - b.block.layer_center[r.segment]);
-    b.mesh.cell_fv_center[c] = axis_mid + (centre - axis_mid) - dot(centre - axis_mid, along) * along;
-  }
-  EXPECT_GT(check_auto_centering(b.mesh, compute_geometry(b.mesh)).violations, 0);
+  WellBlock blk = make_well_block(make_case(p), 0, p.sectors);
+  int inner = -1;
+  for (int l = 1; l + 1 < blk.layers; ++l)
+    if (blk.layer_bend[l - 1] >= 0 && blk.layer_bend[l] >= 0 && blk.layer_bend[l + 1] >= 0) inner = l;
+  ASSERT_GE(inner, 0);
+  const Vec3 normal = normalized(blk.layer_center[inner + 1] - blk.layer_center[inner - 1]);
+  const int per_layer = (p.rings + 1) * p.sectors;
+  for (int v = 0; v < per_layer; ++v) blk.nodes[inner * per_layer + v] += 0.2 * normal;
+  double worst = 0;
+  for (const auto& faces : blk.cell_faces)
+    for (const CellFace& f : faces) {
+      double cm = 0, pm = 0;
+      quad_misfit(blk.nodes, f.nodes, &cm, &pm);
+      worst = std::max(worst, cm);
+    }
+  EXPECT_GT(worst, 1e-3);
 }
 
 // ---------------------------------------------------------------- rotation-minimising frame
@@ -389,25 +425,24 @@ TEST(WellBlock, BendLayersAreSharedAndTheFrameDoesNotTwist) {
   EXPECT_EQ(b.report.unmatched_faces, outer);
   EXPECT_EQ(b.report.misoriented_faces + b.report.overused_faces + b.report.degenerate_faces, 0);
 
-  // At each bend the node lies in the bisector plane, on the edge lines of both legs.
-  int bends_seen = 0;
-  for (int l = 1; l + 1 < blk.layers; ++l) {
-    for (size_t k = 1; k + 1 < p.trajectory.size(); ++k) {
-      if (!(blk.layer_center[l] == p.trajectory[k])) continue;
-      ++bends_seen;
-      const Vec3 d1 = normalized(p.trajectory[k] - p.trajectory[k - 1]);
-      const Vec3 d2 = normalized(p.trajectory[k + 1] - p.trajectory[k]);
-      const Vec3 m = normalized(d1 + d2);
-      for (int v = 0; v < per_layer; ++v) {
-        const Vec3 x = blk.nodes[l * per_layer + v];
-        const Vec3 prev = blk.nodes[(l - 1) * per_layer + v], next = blk.nodes[(l + 1) * per_layer + v];
-        EXPECT_NEAR(dot(x - blk.layer_center[l], m), 0, 1e-12 * 60);
-        EXPECT_NEAR(norm(cross(x - prev, d1)), 0, 1e-12 * 60);
-        EXPECT_NEAR(norm(cross(next - x, d2)), 0, 1e-12 * 60);
-      }
+  // Each bend is a run of wedge layers; the meshed axis stays on the trajectory's legs
+  // outside the wedges and cuts each corner by less than the fillet allows.
+  std::set<int32_t> bends;
+  for (int l = 0; l < blk.layers; ++l) {
+    if (blk.layer_bend[l] >= 0) {
+      bends.insert(blk.layer_bend[l]);
+      continue;
     }
+    double on_leg = 1e300;  // distance of a straight-part layer centre from the legs
+    for (size_t k = 0; k + 1 < p.trajectory.size(); ++k) {
+      const Vec3 a = p.trajectory[k], ab = p.trajectory[k + 1] - a;
+      const double s = std::clamp(dot(blk.layer_center[l] - a, ab) / dot(ab, ab), 0.0, 1.0);
+      on_leg = std::min(on_leg, norm(blk.layer_center[l] - (a + s * ab)));
+    }
+    EXPECT_LT(on_leg, 1e-12 * 100) << "layer " << l;
   }
-  EXPECT_EQ(bends_seen, 3);
+  EXPECT_EQ(bends, (std::set<int32_t>{1, 2, 3}));
+  ASSERT_EQ(blk.notes.size(), 3u);
 
   // The last polygon is the first one turned by the product of the minimal bend rotations.
   const int last = blk.layers - 1;
@@ -444,21 +479,31 @@ TEST(WellBlock, PlanarBendKeepsTheBinormalComponent) {
 
 // ---------------------------------------------------------------- segments near bends
 
-TEST(WellBlock, SegmentsNextToABendAreLengthenedWithANote) {
+TEST(WellBlock, BendNotesStateTheWedgesAndTheAxisOffset) {
   WellParams p;
   p.trajectory = bent(90, 100, 100);
-  const CaseSpec cs = make_case(p);
-  const WellBlock blk = make_well_block(cs, 0, 12);
-  // round(100 / 4) = 25 segments would put the first cross-section after the bend 4 m away,
-  // inside the 8 m the bisector plane reaches back: 12 segments of 8.33 m are the most.
-  EXPECT_EQ(blk.layers, 25);
-  ASSERT_EQ(blk.notes.size(), 2u);
+  const WellBlock blk = make_well_block(make_case(p), 0, 12);
+  // rho = 1.5 R = 12 m, t = rho tan 45 = 12 m, arc 18.8 m: 5 wedges (about one segment each).
+  // The axis is a chord polygon of the arc; its middle chord passes rho / cos 45 - rho cos 9
+  // = 5.1183 m from the corner.
+  ASSERT_EQ(blk.notes.size(), 1u);
   EXPECT_EQ(blk.notes[0],
-            "wells[0] (P1): leg 0 split into 12 segments of 8.33333 m instead of 25 so that its cross-sections clear "
-            "its bend of 90 degrees");
-  EXPECT_EQ(blk.notes[1],
-            "wells[0] (P1): leg 1 split into 12 segments of 8.33333 m instead of 25 so that its cross-sections clear "
-            "its bend of 90 degrees");
+            "wells[0] (P1): bend of 90 degrees at trajectory point 1 meshed as 5 mirror wedge(s) on an arc of radius "
+            "12 m: the wellbore axis leaves the trajectory 12 m before the point and passes 5.1183 m from it");
+  // 88 m straight on each leg: 22 segments each, plus the 5 wedges.
+  EXPECT_EQ(blk.layers, 22 + 5 + 22 + 1);
+  EXPECT_NEAR(12.0 * std::sqrt(2.0) - 12.0 * std::cos(9 * kPi / 180), 5.1183, 1e-4);
+  // The block's volume follows the closed form of the wedges.
+  BuiltBlock b = build(make_case(p), 12);
+  double total = 0;
+  for (double v : b.geo.cell_volume) total += v;
+  EXPECT_NEAR(total / exact_well_block_volume(make_case(p), 0, 12), 1.0, 1e-12);
+  // A gentle bend takes an arc of one segment (rho = 4 m / 5 deg = 45.8 m), one wedge.
+  p.trajectory = bent(5, 100, 100);
+  const WellBlock gentle = make_well_block(make_case(p), 0, 12);
+  ASSERT_EQ(gentle.notes.size(), 1u);
+  EXPECT_NE(gentle.notes[0].find("meshed as 1 mirror wedge(s) on an arc of radius 45.8366 m"), std::string::npos)
+      << gentle.notes[0];
   // Straight wells keep the requested split and say nothing.
   p.trajectory = straight({0, 0, 1}, 100);
   const WellBlock plain = make_well_block(make_case(p), 0, 12);
@@ -544,33 +589,19 @@ TEST(Gabriel, LongSegmentsOnStraightLegsStayGabriel) {
   EXPECT_EQ(brute_force_violations(blk, &surely), 0);
 }
 
-TEST(Gabriel, BendsFailWithManySectorsAndPassWithFew) {
-  // At a bend the mitred outer surface has trapezoids with an obtuse corner on the bend layer;
-  // the narrower the sectors, the deeper that corner sits in the long axial edge's sphere.
-  WellParams p;
-  p.trajectory = bent(90, 60, 60);
-  const CaseSpec cs = make_case(p);
-  const WellBlock few = make_well_block(cs, 0, 6);
-  EXPECT_EQ(count_gabriel_violations(few), 0);
-  const WellBlock many = make_well_block(cs, 0, 12);
-  const auto v = gabriel_violations(many.nodes, many.surface_faces);
-  ASSERT_FALSE(v.empty());
-  int bend_layer = -1;
-  for (int l = 0; l < many.layers; ++l)
-    if (many.layer_center[l] == p.trajectory[1]) bend_layer = l;
-  const int per_layer = (p.rings + 1) * 12;
-  for (const auto& x : v) {
-    // An outer axial edge ending on the bend layer, the offending vertex on the bend layer.
-    EXPECT_EQ(x.p / per_layer, bend_layer);
-    EXPECT_TRUE(x.a / per_layer == bend_layer || x.b / per_layer == bend_layer);
-    EXPECT_NE(x.a / per_layer, x.b / per_layer);
-    EXPECT_EQ((x.a % per_layer) / 12, p.rings);
-  }
-  int surely = 0;
-  const int maybe = brute_force_violations(many, &surely);
-  EXPECT_LE(surely, static_cast<int>(v.size()));
-  EXPECT_LE(static_cast<int>(v.size()), maybe);
-  std::printf("[ gabriel   ] 90-degree bend: 6 sectors 0 violations, 12 sectors %zu\n", v.size());
+TEST(Gabriel, BendWedgesAreGabrielUpTo120DegreesWithManySectors) {
+  // Wedges of at most 30 degrees on a fillet of 1.5 R: the wedge trapezoids keep their
+  // circumcentre inside, so no surface vertex enters an edge's diametral sphere (the
+  // bisector-plane mitre of the first version failed from 50 degrees with 12 sectors).
+  for (double bend : {30.0, 60.0, 90.0, 120.0})
+    for (int sectors : {6, 12, 24}) {
+      WellParams p;
+      p.trajectory = bent(bend, 60, 60);
+      const WellBlock blk = make_well_block(make_case(p), 0, sectors);
+      EXPECT_EQ(count_gabriel_violations(blk), 0) << bend << " deg, " << sectors << " sectors";
+      int surely = 0;
+      EXPECT_EQ(brute_force_violations(blk, &surely), 0) << bend << " deg, " << sectors << " sectors";
+    }
 }
 
 TEST(Gabriel, MakeGabrielRaisesSectorsAndSaysSo) {
@@ -617,20 +648,6 @@ TEST(Gabriel, MakeGabrielGivesUpWithTheReason) {
   // The figure in the message is right: 17 sectors pass, 16 do not.
   EXPECT_EQ(count_gabriel_violations(make_well_block(make_case(p), 0, 17)), 0);
   EXPECT_GT(count_gabriel_violations(make_well_block(make_case(p), 0, 16)), 0);
-  p.rings = 6;
-  p.sectors = 12;
-  p.trajectory = bent(90, 60, 60);
-  try {
-    make_gabriel_well_block(make_case(p), 0);
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind("wells[0] (P1): the outer surface of the radial block is not Gabriel next to the bend of 90 "
-                        "degrees at trajectory point 1 with 12 sectors (",
-                        0),
-              0u)
-        << msg;
-  }
 }
 
 // ---------------------------------------------------------------- bad input
@@ -643,19 +660,19 @@ TEST(WellBlockInput, LegTooShortForItsBend) {
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "wells[0].trajectory: leg 0 too short for its bend of 90 degrees (needs > 8 m with drainage radius 8)");
+              "wells[0].trajectory: leg 0 too short for its bend of 90 degrees (needs > 8.4 m with drainage radius 8)");
   }
   // Pass/fail: 8.5 m is enough.
   p.trajectory = {{0, 0, 0}, {0, 0, 8.5}, {10, 0, 8.5}};
   EXPECT_NO_THROW(make_well_block(make_case(p), 0, 12));
-  // The middle leg of a U sees both bends: its bisector planes reach 8 m back and 8 m ahead.
+  // The middle leg of a U holds both fillets: at least 1.05 R tan 45 = 8.4 m each.
   p.trajectory = {{0, 0, 0}, {0, 0, 20}, {15, 0, 20}, {15, 0, 0}};
   try {
     make_well_block(make_case(p), 0, 12);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "wells[0].trajectory: leg 1 too short for its bends of 90 and 90 degrees (needs > 16 m with drainage "
+              "wells[0].trajectory: leg 1 too short for its bends of 90 and 90 degrees (needs > 16.8 m with drainage "
               "radius 8)");
   }
 }

@@ -183,8 +183,9 @@ void run_case(const char* name, const CaseSpec& cs, int expected_cavities) {
               mt.min_site_margin, mt.sites_outside, mt.max_closure, mt.volume_error, mt.max_planarity_interior,
               mt.faces_below_80, mt.min_orth_reservoir, mt.min_orth_well, mt.max_circle_error, mt.max_polygon_planarity);
   for (const TransitionReport& r : hm.transition_reports) {
-    std::printf("   stages: delaunay %.3f s, sites %.3f s (%d iterations), power %.3f s\n", r.seconds_delaunay,
-                r.seconds_sites, r.correction_iterations, r.seconds_power);
+    std::printf("   stages: delaunay %.3f s, sites %.3f s (%d iterations), power %.3f s; shifts: identification %.2e m,"
+                " snap %.2e m\n", r.seconds_delaunay, r.seconds_sites, r.correction_iterations, r.seconds_power,
+                r.max_identification_shift, r.max_snap_shift);
     for (const std::string& n : r.notes) std::printf("   note: %s\n", n.c_str());
   }
   EXPECT_EQ(static_cast<int>(hm.cavities.cavities.size()), expected_cavities);
@@ -196,14 +197,15 @@ void run_case(const char* name, const CaseSpec& cs, int expected_cavities) {
   EXPECT_LT(mt.volume_error, 1e-9);
   EXPECT_GT(mt.cells, 0);
   EXPECT_EQ(mt.sites_outside, 0);
-  // Convex with planar faces, to within the non-co-circularity of the well's polygons
-  // (quads at a bend are planar trapezoids that no circle passes through: paper 5.7): a
-  // power vertex identified with such a polygon's node moves by up to that misfit.
-  const double tol = 1e-9 + 2.0 * mt.max_circle_error;
+  // Convex with planar faces, to within the non-co-circularity of the constrained polygons
+  // (a power vertex identified with a polygon's node moves by up to that misfit; paper 5.7)
+  // and the round-off of double power vertices: up to 1.8e-8 of the cell size measured next
+  // to the bend wedges, where many sites are nearly co-spherical (1e-7 allowed).
+  const double tol = 1e-7 + 2.0 * mt.max_circle_error;
   EXPECT_LT(mt.max_convexity, tol);
   EXPECT_LT(mt.max_planarity_interior, tol);
-  if (mt.max_circle_error < 1e-9) {  // co-circular polygons only: exact orthogonality
-    EXPECT_GT(mt.min_orth, 90.0 - 1e-6);
+  if (mt.max_circle_error < 1e-9) {  // co-circular polygons only: orthogonal to round-off
+    EXPECT_GT(mt.min_orth, 90.0 - 1e-5);
   } else {
     EXPECT_GT(mt.mean_orth, 89.5);  // paper, before optimisation: mean 89.78
   }
