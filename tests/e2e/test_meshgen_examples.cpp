@@ -44,6 +44,23 @@ TEST_P(MeshgenExample, MeshesAndReportsConsistently) {
   EXPECT_EQ(j["transition"]["hidden_sites"].get<int>(), 0);
   EXPECT_EQ(j["transition"]["before"]["cells"].get<int>(), cells["transition"].get<int>());
   EXPECT_GT(j["timings_s"]["total"].get<double>(), 0.0);
+
+  // fvcheck passes on the optimised mesh (issue #4): every check, paper defaults, exit 0,
+  // and its JSON agrees; the raw power diagram (--no-optimize) passes too.
+  const std::string fvcheck = std::string(HM_BIN_DIR) + "/fvcheck ";
+  const auto fv = hm_test::run_command(fvcheck + "'" + (out / "mesh.vtu").string() + "' --json '" +
+                                       (out / "fvcheck.json").string() + "'");
+  EXPECT_EQ(fv.exit_code, 0) << fv.out << fv.err;
+  const auto report = nlohmann::json::parse(hm_test::slurp(out / "fvcheck.json"));
+  EXPECT_TRUE(report["ok"].get<bool>());
+  EXPECT_EQ(report["cells"].get<int>(), cells["total"].get<int>());
+  const fs::path raw = hm_test::fresh_dir("example_raw_" + ex.name);
+  ASSERT_EQ(hm_test::run_command(std::string(HM_BIN_DIR) + "/meshgen " + HM_SOURCE_DIR + "/examples/" + ex.name +
+                                 ".yaml --no-optimize -o '" + raw.string() + "'")
+                .exit_code,
+            0);
+  const auto fv_raw = hm_test::run_command(fvcheck + "'" + (raw / "mesh.vtu").string() + "'");
+  EXPECT_EQ(fv_raw.exit_code, 0) << fv_raw.out << fv_raw.err;
 }
 
 INSTANTIATE_TEST_SUITE_P(Examples, MeshgenExample,
