@@ -33,7 +33,16 @@ struct CellMeasures {
   bool convex = false;
   bool centred = false;   // site strictly inside
   double q_o = 90, q_p = 0, q_s = 1;
+  int failed = 0;         // with limits: the first control found to fail (kFail*), 0 if none
 };
+
+// The controls a cell must pass (measure_cell stops at the first failure it finds: most
+// candidate operations are refused, and the convexity test is the expensive part).
+struct CellLimits {
+  double min_q_o = 0, max_q_p = 90;
+  bool keep_convex = false, keep_centred = false;
+};
+enum { kFailOrthogonality = 1, kFailPlanarity, kFailCentering, kFailConvexity };
 
 // Outward node cycle of face f seen from cell c.
 std::vector<int32_t> outward_cycle(const EditableMesh& m, int32_t f, int32_t c) {
@@ -138,7 +147,8 @@ double foam_skewness(const std::vector<Vec3>& nodes, const int32_t* b, const int
   return norm(sv) / fd;
 }
 
-CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std::vector<double>& h_ref, int32_t c) {
+CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std::vector<double>& h_ref, int32_t c,
+                          const CellLimits* lim = nullptr) {
   CellMeasures r;
   std::vector<std::vector<int32_t>> cycles;
   for (int32_t f : m.cell_faces[c])
@@ -179,21 +189,21 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
   r.centred = true;
   r.q_o = 90;
   r.q_p = 0;
+  std::vector<Vec3> normals(cycles.size()), centres(cycles.size());
   size_t k = 0;
   for (int32_t f : m.cell_faces[c]) {
     if (!m.alive[f]) continue;
-    const auto& cyc = cycles[k++];
+    const auto& cyc = cycles[k];
     Vec3 area, g;
     face_area_centroid(m, cyc, &area, &g);
     const double an = norm(area);
     if (an <= 1e-12 * L * L) return r;
     const Vec3 n = area / an;
+    normals[k] = n;
+    centres[k] = g;
+    ++k;
     for (size_t i = 0; i < cyc.size(); ++i)
       vol += dot(g - site, cross(m.nodes[cyc[i]] - site, m.nodes[cyc[(i + 1) % cyc.size()]] - site)) / 6.0;
-    for (int32_t v : cell_nodes)
-      if (r.convex && dot(n, m.nodes[v] - g) > tol && std::find(cyc.begin(), cyc.end(), v) == cyc.end()) r.convex = false;
-    // Convex also means every face polygon is simple with no reflex vertex (as fvcheck).
-    if (r.convex && face_polygon_defect(m.nodes, cyc.data(), cyc.data() + cyc.size(), 1e-9) != 0) r.convex = false;
     if (dot(n, site - g) >= -tol) r.centred = false;
     // Q_O (eq. 8): the segment to the other cell's FV centre (or the face centroid on the boundary).
     const int32_t other = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
@@ -201,6 +211,34 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
     const double un = norm(u);
     r.q_o = std::min(r.q_o, un > 0 ? std::asin(std::min(1.0, std::abs(dot(u / un, n)))) * kRadToDeg : 0.0);
     r.q_p = std::max(r.q_p, face_planarity_deg(m, cyc, area, g));
+    if (lim) {
+      if (r.q_o < lim->min_q_o) r.failed = kFailOrthogonality;
+      else if (r.q_p > lim->max_q_p) r.failed = kFailPlanarity;
+      else if (lim->keep_centred && !r.centred) r.failed = kFailCentering;
+      if (r.failed) {
+        r.valid = true;  // valid as far as measured: the caller reports the failed control
+        return r;
+      }
+    }
+  }
+  if (vol <= 1e-12 * L * L * L) return r;
+  // Convexity: no node of the cell outside a face's plane, and every face polygon simple
+  // with no reflex vertex (as fvcheck).
+  if (!lim || lim->keep_convex) {
+    for (size_t i = 0; i < cycles.size() && r.convex; ++i) {
+      const auto& cyc = cycles[i];
+      for (int32_t v : cell_nodes)
+        if (dot(normals[i], m.nodes[v] - centres[i]) > tol && std::find(cyc.begin(), cyc.end(), v) == cyc.end()) {
+          r.convex = false;
+          break;
+        }
+      if (r.convex && face_polygon_defect(m.nodes, cyc.data(), cyc.data() + cyc.size(), 1e-9) != 0) r.convex = false;
+    }
+    if (lim && !r.convex) {
+      r.failed = kFailConvexity;
+      r.valid = true;
+      return r;
+    }
   }
   if (vol <= 1e-12 * L * L * L) return r;
   // Q_S (eq. 7) over the distinct edges.
@@ -304,6 +342,9 @@ class Optimizer {
       convex0_[c] = cm.valid && cm.convex;
       centred0_[c] = cm.valid && cm.centred;
     }
+    qs_.assign(nc, 1.0);
+    for (int c = 0; c < nc; ++c)
+      if (src.cell_region[c] == kTransition) qs_[c] = measure_cell(m_, src_, h_ref_, c).q_s;
     centre_.resize(nc);
     for (int c = 0; c < nc; ++c) centre_[c] = cell_centre(c);
     skew_ok_.resize(m_.faces.size());
@@ -509,12 +550,17 @@ class Optimizer {
     std::vector<std::pair<int32_t, CellMeasures>> measured;
     double qs_sum = 0;
     for (int32_t c : cells) {
-      const CellMeasures cm = measure_cell(m_, src_, h_ref_, c);
+      CellLimits lim;
+      lim.min_q_o = thr_o_[c];
+      lim.max_q_p = thr_p_[c];
+      lim.keep_convex = convex0_[c];
+      lim.keep_centred = centred0_[c];
+      const CellMeasures cm = measure_cell(m_, src_, h_ref_, c, &lim);
       if (!cm.valid) return reject(&OptimizeReport::rejected_invalid);
-      if (convex0_[c] && !cm.convex) return reject(&OptimizeReport::rejected_convexity);
-      if (cm.q_o < thr_o_[c]) return reject(&OptimizeReport::rejected_orthogonality);
-      if (cm.q_p > thr_p_[c]) return reject(&OptimizeReport::rejected_planarity);
-      if (centred0_[c] && !cm.centred) return reject(&OptimizeReport::rejected_centering);
+      if (cm.failed == kFailConvexity) return reject(&OptimizeReport::rejected_convexity);
+      if (cm.failed == kFailOrthogonality) return reject(&OptimizeReport::rejected_orthogonality);
+      if (cm.failed == kFailPlanarity) return reject(&OptimizeReport::rejected_planarity);
+      if (cm.failed == kFailCentering) return reject(&OptimizeReport::rejected_centering);
       qs_sum += cm.q_s;
       measured.push_back({c, cm});
     }
@@ -546,6 +592,7 @@ class Optimizer {
       if (sk <= kSkewnessLimit) skew_ok_[f] = 1;
     for (const auto& [c, cm] : measured) {
       cell_stamp_[c] = op_count_;
+      qs_[c] = cm.q_s;
       thr_o_[c] = std::max(thr_o_[c], std::min(p_.omega_o, cm.q_o));
       thr_p_[c] = std::min(thr_p_[c], std::max(p_.omega_p, cm.q_p));
     }
@@ -728,7 +775,7 @@ class Optimizer {
     if (!m_.fixed[a])
       for (int32_t c : ball(a)) cells.insert(c);
     double qs_before = 0;
-    for (int32_t c : cells) qs_before += measure_cell(m_, src_, h_ref_, c).q_s;
+    for (int32_t c : cells) qs_before += qs_[c];
     qs_before /= std::max<size_t>(1, cells.size());
     Saved saved;
     saved.nodes = {{a, m_.nodes[a]}, {b, m_.nodes[b]}};
@@ -746,6 +793,7 @@ class Optimizer {
   OptimizeParams p_;
   EditableMesh m_;
   std::vector<double> thr_o_, thr_p_;
+  std::vector<double> qs_;          // Q_S of each transition cell as the mesh is now
   std::vector<Vec3> centre_;        // OpenFOAM cell centres (geometric centroids), kept current
   std::vector<char> skew_ok_;       // per face: its skewness is within kSkewnessLimit, and must stay so
   std::vector<char> convex0_, centred0_;  // initial state: a control never makes a cell worse
