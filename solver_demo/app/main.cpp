@@ -58,8 +58,14 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
     pb.viscosity_cp = cs.fluid.viscosity;
     pb.density = cs.fluid.density;
     pb.gravity = true;
-    for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w)
+    // The deck's PVTW: Pref = initial pressure, B_ref = 1, Cw raised to 1e-8 /bar as the exporter does.
+    pb.compressibility = std::max(cs.fluid.compressibility, 1e-8);
+    pb.reference_pressure = cs.reservoir.initial_pressure;
+    pb.formation_volume_factor = 1.0;
+    for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w) {
       pb.wells.push_back({w, cs.wells[w].bhp, cs.wells[w].trajectory.front().z});
+      pb.wellbore_head_pressure.push_back(cs.wells[w].bhp);
+    }
     sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry));
   } catch (const hm::InputError& e) {
     std::cerr << "solver_demo: " << e.what() << "\n";
@@ -87,7 +93,11 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
   }
   j["pressure"] = {{"min", pmin}, {"max", pmax}, {"mean", vol > 0 ? pv / vol : 0.0}};
   j["cells"] = mesh.mesh.n_cells();
-  j["solver"] = {{"name", sol.solver}, {"iterations", sol.iterations}, {"relative_residual", sol.relative_residual}};
+  j["solver"] = {{"name", sol.solver},
+                 {"iterations", sol.iterations},
+                 {"nonlinear_iterations", sol.nonlinear_iterations},
+                 {"relative_residual", sol.relative_residual},
+                 {"max_cell_imbalance_m3_per_day", sol.max_cell_imbalance}};
   if (!write_text(out / "solution.json", j.dump(2) + "\n")) {
     std::cerr << "solver_demo: cannot write '" << (out / "solution.json").string() << "'\n";
     return 2;
@@ -99,10 +109,11 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
     return 2;
   }
   std::cout << "solver_demo: " << cs.name << ": " << mesh.mesh.n_cells() << " cells, " << sol.solver << ", "
-            << sol.iterations << " iterations, relative residual " << sol.relative_residual << "\n";
+            << sol.nonlinear_iterations << " nonlinear / " << sol.iterations << " linear iterations, relative residual "
+            << sol.relative_residual << ", max cell imbalance " << sol.max_cell_imbalance << " m3/day\n";
   for (size_t w = 0; w < cs.wells.size(); ++w)
     std::cout << "  " << cs.wells[w].name << ": bhp " << cs.wells[w].bhp << " bar, rate "
-              << sol.well_rate_m3_per_day[w] << " rm3/day\n";
+              << sol.well_rate_m3_per_day[w] << " sm3/day\n";
   std::cout << "  wrote " << (out / "solution.json").string() << "\n  wrote " << (out / "pressure.vtu").string()
             << "\n";
   return 0;

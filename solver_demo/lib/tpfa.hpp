@@ -1,10 +1,17 @@
-// Single-phase, incompressible, steady two-point flux (TPFA) solver on a PolyMesh: exactly the
-// discrete equation OPM Flow solves for the exported deck (docs/solver.md):
+// Single-phase, steady two-point flux (TPFA) solver on a PolyMesh: exactly the discrete equation
+// OPM Flow solves for the exported deck (docs/solver.md). Incompressible:
 //
 //   sum_j T_ij/mu (p_i - p_j - G (z_i - z_j)) + sum_conn CF/mu (p_i - (BHP + G (z_i - z_ref))) = 0,
 //   G = rho g / 1e5 (bar/m), g = 9.80665, z = depth of the FV centre (positive down).
 //
-// Units (Eclipse METRIC): p in bar, T and CF in cP.rm3/day/bar, mu in cP, rates in rm3/day.
+// Slightly compressible (OPM's PVTW with zero viscosibility, `FlowProblem::compressibility` > 0):
+// the steady surface-volume balance
+//
+//   sum_j T_ij/mu b_up (p_i - p_j - g (rho_i + rho_j)/2 (z_i - z_j)) + sum_conn CF/mu b_i (p_i - p_conn) = 0,
+//   b(p) = (1 + X + X^2/2) / B_ref, X = c (p - p_ref), rho = rho_s b, b_up of the upstream cell.
+//
+// Units (Eclipse METRIC): p in bar, T and CF in cP.rm3/day/bar, mu in cP, rates in m3/day (surface
+// volumes; equal to reservoir volumes when incompressible with B_ref = 1).
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -41,7 +48,18 @@ struct FlowProblem {
   const PolyMesh* mesh = nullptr;
   const MeshGeometry* geo = nullptr;
   double viscosity_cp = 1;
-  double density = 1000;  ///< kg/m3
+  double density = 1000;  ///< kg/m3; with compressibility > 0 the surface density rho_s (rho = rho_s b(p))
+  /// Slightly compressible water as OPM's PVTW `p_ref B_ref c mu 0`: inverse formation volume factor
+  /// b(p) = (1 + X + X^2/2) / B_ref, X = c (p - p_ref); the viscosity stays mu (zero viscosibility).
+  /// 0 = incompressible (b = 1, one linear solve).
+  double compressibility = 0;          ///< 1/bar
+  double reference_pressure = 0;       ///< bar (PVTW item 1)
+  double formation_volume_factor = 1;  ///< B_ref, rm3/sm3 (PVTW item 2)
+  /// Wellbore head with compressibility: the well's fluid column between the BHP reference depth
+  /// and a connection has density rho_s b(p_head), p_head the pressure given here for that well
+  /// (index = well); wells not listed use reference_pressure. OPM evaluates its connection
+  /// densities from the state at the start of the time step (docs/solver.md).
+  std::vector<double> wellbore_head_pressure;
   bool gravity = true;
   /// Controls of the wells whose wellbore faces / connections produce or inject. Wellbore
   /// faces of a well without a control are closed (no flow), unless wellbore_pressure is set.
@@ -69,12 +87,17 @@ struct LinearSolverOptions {
 struct FlowSolution {
   std::vector<double> pressure;              ///< n_cells, bar
   std::vector<double> well_rate_m3_per_day;  ///< per well index (size: highest well seen + 1); > 0 produced
-  int iterations = 0;
-  double relative_residual = 0;              ///< ||b - A p|| / ||b||, recomputed after the solve
+  int iterations = 0;                        ///< linear iterations, summed over the nonlinear ones
+  double relative_residual = 0;              ///< ||b - A p|| / ||b|| of the last linear solve, recomputed
+  int nonlinear_iterations = 1;              ///< Picard iterations (1 when incompressible)
+  /// Mass balance of the final pressure: max over cells of |net surface outflow| (m3/day), the
+  /// nonlinear terms evaluated at that pressure (mass_balance_residual).
+  double max_cell_imbalance = 0;
   std::string solver;                        ///< e.g. "eigen-cg-ic(natural)"
 };
 
-/// Assembles and solves. Throws std::invalid_argument for an ill-posed problem (no mesh, a
+/// Assembles and solves (Picard iteration on b and rho when compressibility > 0, each step a
+/// symmetric system with the upstream b frozen, to a pressure change < 1e-12 relative). Throws std::invalid_argument for an ill-posed problem (no mesh, a
 /// connected group of cells with no pressure reference, non-finite input) and
 /// std::runtime_error when the linear solver fails to reach the tolerance.
 FlowSolution solve_tpfa(const FlowProblem& problem, const Transmissibilities& trans);
@@ -89,10 +112,19 @@ struct TpfaSystem {
   std::vector<double> val;
   std::vector<double> rhs;
 };
+/// The incompressible system (b = 1, rho = density), whatever the problem's compressibility.
 TpfaSystem assemble_tpfa(const FlowProblem& problem, const Transmissibilities& trans);
 
-/// Rates per well (and per connection) of a pressure field, with the same terms as the
-/// assembly: q = CF/mu (p_cell - p_conn). Sized like FlowSolution::well_rate_m3_per_day.
+/// Inverse formation volume factor b(p) of the problem's fluid (1 when incompressible).
+double inverse_formation_volume_factor(const FlowProblem& problem, double pressure);
+
+/// Net surface outflow of every cell (faces + connections) at a pressure field with the
+/// nonlinear terms evaluated at that field: zero at the solution.
+std::vector<double> mass_balance_residual(const FlowProblem& problem, const Transmissibilities& trans,
+                                          const std::vector<double>& pressure);
+
+/// Rates per well of a pressure field, with the same terms as the assembly:
+/// q = CF/mu b(p_cell) (p_cell - p_conn), surface m3/day. Sized like FlowSolution::well_rate_m3_per_day.
 std::vector<double> well_rates(const FlowProblem& problem, const Transmissibilities& trans,
                                const std::vector<double>& pressure);
 

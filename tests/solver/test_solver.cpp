@@ -271,6 +271,129 @@ TEST(OpmEquation, WithoutGravityTheSolutionChanges) {
             1e-3 * std::fabs(with.well_rate_m3_per_day[0]));
 }
 
+// ---------------------------------------------------------------- slightly compressible water
+
+double inverse_fvf(double c, double p_ref, double p) {  // OPM PVTW, B_ref = 1
+  const double x = c * (p - p_ref);
+  return 1 + x + x * x / 2;
+}
+
+// A still column fed by a well at the top cell's depth: the discrete hydrostatic recurrence
+// p_k - p_{k-1} = g (rho_k + rho_{k-1})/2 (z_k - z_{k-1}), rho = rho_s b(p), solved cell by cell
+// with a scalar Newton, is what the solver must return (zero rate).
+TEST(Compressible, StillColumnFollowsTheDiscreteHydrostaticRecurrence) {
+  const CartesianMesh cm = column(kColumnZ);
+  const PolyMesh& m = cm.mesh;
+  FlowProblem pb;
+  pb.mesh = &m;
+  pb.geo = &cm.geo;
+  pb.density = 1020;
+  pb.compressibility = 1e-3;  // large, so that the density change is visible
+  pb.reference_pressure = 100;
+  const double bhp = 180, z0 = m.cell_fv_center[0].z;
+  pb.connections = {{0, 0, 5.0, m.cell_fv_center[0]}};
+  pb.wells = {{0, bhp, z0}};
+  const FlowSolution sol = solve_tpfa(pb, compute_transmissibilities(m, cm.geo));
+  const double gf = kGravity / 1e5;
+  std::vector<double> expect(m.n_cells());
+  expect[0] = bhp;
+  double max_density_effect = 0;
+  for (int k = 1; k < m.n_cells(); ++k) {
+    const double dz = m.cell_fv_center[k].z - m.cell_fv_center[k - 1].z, pa = expect[k - 1];
+    const double rho_a = 1020 * inverse_fvf(1e-3, 100, pa);
+    double p = pa + rho_a * gf * dz;
+    for (int it = 0; it < 50; ++it) {
+      const double f = p - pa - (rho_a + 1020 * inverse_fvf(1e-3, 100, p)) / 2 * gf * dz;
+      const double df = 1 - 1020 * 1e-3 * (1 + 1e-3 * (p - 100)) / 2 * gf * dz;
+      p -= f / df;
+    }
+    expect[k] = p;
+    max_density_effect = std::max(max_density_effect, std::fabs(p - (bhp + 1020 * gf * (m.cell_fv_center[k].z - z0))));
+  }
+  for (int c = 0; c < m.n_cells(); ++c) EXPECT_NEAR(sol.pressure[c], expect[c], 1e-11 * expect[c]) << "cell " << c;
+  EXPECT_NEAR(sol.well_rate_m3_per_day.at(0), 0.0, 1e-8);
+  EXPECT_GT(sol.nonlinear_iterations, 1);
+  // Fail half: the density change is far above the tolerance, so an incompressible column fails.
+  EXPECT_GT(max_density_effect, 1e-4 * bhp);
+}
+
+/// The surface-volume balance of every cell, written out independently of the solver:
+/// faces T/mu b_up (p_i - p_j - g (rho_i + rho_j)/2 (z_i - z_j)) with b_up of the upstream cell,
+/// connections CF/mu b_i (p_i - BHP - g rho_s b(p_head) (z_i - z_ref)).
+struct Balance {
+  std::vector<double> res, scale, rate;
+};
+Balance compressible_balance(const TwoWellBox& t, const std::vector<double>& p) {
+  const PolyMesh& m = t.cm.mesh;
+  const double mu = t.pb.viscosity_cp, gf = kGravity / 1e5, c = t.pb.compressibility, pr = t.pb.reference_pressure;
+  Balance b{std::vector<double>(m.n_cells(), 0.0), std::vector<double>(m.n_cells(), 0.0), std::vector<double>(2, 0.0)};
+  auto z = [&](int i) { return m.cell_fv_center[i].z; };
+  auto rho = [&](int i) { return t.pb.density * inverse_fvf(c, pr, p[i]); };
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const int o = m.face_owner[f], n = m.face_neighbour[f];
+    if (n < 0) continue;
+    const double dphi = p[o] - p[n] - (rho(o) + rho(n)) / 2 * gf * (z(o) - z(n));
+    const double q = t.tr.face[f] / mu * inverse_fvf(c, pr, dphi >= 0 ? p[o] : p[n]) * dphi;
+    b.res[o] += q, b.res[n] -= q;
+    b.scale[o] += std::fabs(q), b.scale[n] += std::fabs(q);
+  }
+  for (const WellConnection& wc : t.pb.connections) {
+    const WellControl& ctl = t.pb.wells[wc.well];
+    const double head = t.pb.density * inverse_fvf(c, pr, t.pb.wellbore_head_pressure[wc.well]) * gf;
+    const double q = wc.cf / mu * inverse_fvf(c, pr, p[wc.cell]) *
+                     (p[wc.cell] - (ctl.bhp + head * (z(wc.cell) - ctl.ref_depth)));
+    b.res[wc.cell] += q;
+    b.scale[wc.cell] += std::fabs(q);
+    b.rate[wc.well] += q;
+  }
+  return b;
+}
+
+TEST(Compressible, EveryCellBalancesSurfaceVolumesWithUpwindMobilityAndMeanDensity) {
+  TwoWellBox t = two_well_box();
+  t.pb.compressibility = 2e-3;  // 20x water's, so every term matters
+  t.pb.reference_pressure = 200;
+  t.pb.wellbore_head_pressure = {150.0, 260.0};
+  const FlowSolution sol = solve_tpfa(t.pb, t.tr);
+  const Balance b = compressible_balance(t, sol.pressure);
+  for (size_t c = 0; c < b.res.size(); ++c) EXPECT_LT(std::fabs(b.res[c]), 1e-9 * b.scale[c] + 1e-12) << "cell " << c;
+  for (int w = 0; w < 2; ++w) EXPECT_NEAR(sol.well_rate_m3_per_day[w], b.rate[w], 1e-9 * std::fabs(b.rate[w]));
+  // Steady and closed: surface volumes in = out (reservoir volumes would not balance).
+  EXPECT_NEAR(b.rate[0] + b.rate[1], 0.0, 1e-9 * b.rate[0]);
+  EXPECT_LT(sol.max_cell_imbalance, 1e-9 * b.rate[0]);
+  const std::vector<double> r = mass_balance_residual(t.pb, t.tr, sol.pressure);
+  for (size_t c = 0; c < r.size(); ++c) EXPECT_NEAR(r[c], b.res[c], 1e-9 * b.scale[c] + 1e-12);
+  // Fail half: the incompressible solution of the same wells breaks this balance.
+  FlowProblem inc = t.pb;
+  inc.compressibility = 0;
+  const FlowSolution sol0 = solve_tpfa(inc, t.tr);
+  const Balance b0 = compressible_balance(t, sol0.pressure);
+  double worst = 0;
+  for (size_t c = 0; c < b0.res.size(); ++c) worst = std::max(worst, std::fabs(b0.res[c]) / (b0.scale[c] + 1e-300));
+  EXPECT_GT(worst, 1e-4);
+}
+
+TEST(Compressible, TinyCompressibilityIsTheIncompressibleSolve) {
+  TwoWellBox t = two_well_box();
+  const FlowSolution inc = solve_tpfa(t.pb, t.tr);
+  EXPECT_EQ(inc.nonlinear_iterations, 1);
+  t.pb.compressibility = 1e-12;
+  t.pb.reference_pressure = 200;
+  const FlowSolution c = solve_tpfa(t.pb, t.tr);
+  for (size_t i = 0; i < c.pressure.size(); ++i) EXPECT_NEAR(c.pressure[i], inc.pressure[i], 1e-9 * inc.pressure[i]);
+  for (int w = 0; w < 2; ++w)
+    EXPECT_NEAR(c.well_rate_m3_per_day[w], inc.well_rate_m3_per_day[w], 1e-8 * std::fabs(inc.well_rate_m3_per_day[w]));
+}
+
+TEST(Compressible, BadFluidDataIsRejected) {
+  TwoWellBox t = two_well_box();
+  t.pb.compressibility = -1e-5;
+  EXPECT_THROW(solve_tpfa(t.pb, t.tr), std::invalid_argument);
+  t.pb.compressibility = 1e-5;
+  t.pb.formation_volume_factor = 0;
+  EXPECT_THROW(solve_tpfa(t.pb, t.tr), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------- orderings
 
 TEST(Ordering, ReverseCuthillMcKeeNarrowsAScrambledMatrixAndGivesTheSameSolution) {
