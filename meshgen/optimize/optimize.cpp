@@ -502,22 +502,43 @@ class Optimizer {
   // Candidate edges (not both fixed) shorter than gamma * h, shortest (relative) first;
   // ties broken by node ids so that the result is deterministic.
   std::vector<std::pair<double, std::pair<int32_t, int32_t>>> short_edges(double gamma) const {
-    std::set<std::pair<int32_t, int32_t>> seen;
-    std::vector<std::pair<double, std::pair<int32_t, int32_t>>> out;
+    const std::vector<double> node_h = node_h_bound();
+    std::vector<std::pair<int32_t, int32_t>> edges;
     for (size_t f = 0; f < m_.faces.size(); ++f) {
       if (!m_.alive[f] || !transition_face(static_cast<int32_t>(f))) continue;
       const auto& cyc = m_.faces[f];
       for (size_t i = 0; i < cyc.size(); ++i) {
         int32_t a = cyc[i], b = cyc[(i + 1) % cyc.size()];
         if (a > b) std::swap(a, b);
-        if ((m_.fixed[a] && m_.fixed[b]) || !seen.insert({a, b}).second) continue;
-        const double h = edge_h(a, b);
-        const double l = norm(m_.nodes[a] - m_.nodes[b]);
-        if (h > 0 && l < gamma * h) out.push_back({l / h, {a, b}});
+        if (m_.fixed[a] && m_.fixed[b]) continue;
+        if (norm(m_.nodes[a] - m_.nodes[b]) >= gamma * std::min(node_h[a], node_h[b])) continue;  // long for every cell
+        edges.push_back({a, b});
       }
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::vector<std::pair<double, std::pair<int32_t, int32_t>>> out;
+    for (const auto& [a, b] : edges) {
+      const double h = edge_h(a, b);
+      const double l = norm(m_.nodes[a] - m_.nodes[b]);
+      if (h > 0 && l < gamma * h) out.push_back({l / h, {a, b}});
     }
     std::sort(out.begin(), out.end());
     return out;
+  }
+
+  // Per node, the largest h of the transition cells around it: an upper bound of the
+  // reference length of every edge at that node (edge_h), to skip long edges cheaply.
+  std::vector<double> node_h_bound() const {
+    std::vector<double> node_h(m_.nodes.size(), 0.0);
+    for (size_t f = 0; f < m_.faces.size(); ++f) {
+      if (!m_.alive[f]) continue;
+      double h = 0;
+      for (int32_t c : {m_.owner[f], m_.neighbour[f]})
+        if (c >= 0 && src_.cell_region[c] == kTransition && c < static_cast<int32_t>(h_ref_.size())) h = std::max(h, h_ref_[c]);
+      for (int32_t v : m_.faces[f]) node_h[v] = std::max(node_h[v], h);
+    }
+    return node_h;
   }
 
   std::set<int32_t> ball(int32_t v) const {
@@ -745,15 +766,18 @@ class Optimizer {
   // orthogonality control refuses.
   int collapse_small_faces(double gamma) {
     std::vector<std::pair<double, int32_t>> small;
+    const std::vector<double> node_h = node_h_bound();
     for (size_t f = 0; f < m_.faces.size(); ++f) {
       if (!m_.alive[f] || !transition_face(static_cast<int32_t>(f))) continue;
       const auto& cyc = m_.faces[f];
-      double longest = 0, h = 1e300;
+      double longest = 0, bound = 1e300;
       for (size_t i = 0; i < cyc.size(); ++i) {
-        const int32_t a = cyc[i], b = cyc[(i + 1) % cyc.size()];
-        longest = std::max(longest, norm(m_.nodes[a] - m_.nodes[b]));
-        h = std::min(h, edge_h(a, b));
+        longest = std::max(longest, norm(m_.nodes[cyc[i]] - m_.nodes[cyc[(i + 1) % cyc.size()]]));
+        bound = std::min(bound, node_h[cyc[i]]);
       }
+      if (longest >= gamma * bound) continue;  // not small for any choice of h
+      double h = 1e300;
+      for (size_t i = 0; i < cyc.size(); ++i) h = std::min(h, edge_h(cyc[i], cyc[(i + 1) % cyc.size()]));
       if (h > 0 && longest < gamma * h) small.push_back({longest / h, static_cast<int32_t>(f)});
     }
     std::sort(small.begin(), small.end());
