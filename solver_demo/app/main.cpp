@@ -64,7 +64,6 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
     pb.formation_volume_factor = 1.0;
     for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w) {
       pb.wells.push_back({w, cs.wells[w].bhp, cs.wells[w].trajectory.front().z});
-      pb.wellbore_head_pressure.push_back(cs.wells[w].bhp);
     }
     sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry));
   } catch (const hm::InputError& e) {

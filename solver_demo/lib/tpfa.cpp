@@ -98,8 +98,6 @@ void check_problem(const FlowProblem& pb, const Transmissibilities& tr) {
   if (!(pb.compressibility >= 0) || !std::isfinite(pb.compressibility) || !std::isfinite(pb.reference_pressure) ||
       !(pb.formation_volume_factor > 0) || !std::isfinite(pb.formation_volume_factor))
     throw std::invalid_argument("solve_tpfa: compressibility must be >= 0, reference pressure finite, B_ref > 0");
-  for (double p : pb.wellbore_head_pressure)
-    if (!std::isfinite(p)) throw std::invalid_argument("solve_tpfa: wellbore head pressure is not finite");
   for (const WellConnection& wc : pb.connections)
     if (wc.cell < 0 || wc.cell >= m.n_cells() || wc.well < 0 || !std::isfinite(wc.cf))
       throw std::invalid_argument("solve_tpfa: bad connection (well " + std::to_string(wc.well) + ", cell " +
@@ -119,12 +117,17 @@ int well_count(const FlowProblem& pb) {
   return n;
 }
 
-/// Hydrostatic gradient (bar/m) of well w's fluid column between its reference depth and a connection.
-double wellbore_gradient(const FlowProblem& pb, int w) {
-  if (!compressible(pb)) return pb.density * gravity_factor(pb);
-  const double p_head =
-      w < static_cast<int>(pb.wellbore_head_pressure.size()) ? pb.wellbore_head_pressure[w] : pb.reference_pressure;
-  return pb.density * inverse_fvf(pb, p_head) * gravity_factor(pb);
+double column_pressure(const FlowProblem& pb, const WellControl& ctl, double depth) {
+  const double g_s = pb.density * gravity_factor(pb) / pb.formation_volume_factor;  // bar/m at b B_ref = 1
+  const double dz = depth - ctl.ref_depth;
+  if (!compressible(pb)) return ctl.bhp + pb.density * gravity_factor(pb) * dz;
+  // u = 1 + X obeys du / (u^2 + 1) = c g_s dz / 2: atan(u) = atan(u0) + y, y = c g_s dz / 2. With
+  // t = tan(y), u = (u0 + t) / (1 - u0 t), so X = (X0 + t (2 + X0)) / (1 - u0 t); divided by c with
+  // t / c = (g_s dz / 2) tan(y)/y, which stays exact when c dz is tiny.
+  const double c = pb.compressibility, x0 = c * (ctl.bhp - pb.reference_pressure), y = c * g_s * dz / 2;
+  const double t = std::tan(y), tan_ratio = y == 0 ? 1.0 : t / y;
+  return pb.reference_pressure + ((ctl.bhp - pb.reference_pressure) + g_s * dz / 2 * tan_ratio * (2 + x0)) /
+                                     (1 - (1 + x0) * t);
 }
 
 /// Every boundary term of the problem: Dirichlet outer faces, wellbore faces, extra connections.
@@ -151,7 +154,7 @@ std::vector<BoundaryTerm> boundary_terms(const FlowProblem& pb, const Transmissi
             {o, tr.face[f] / mu * st.b[o], pb.wellbore_pressure(g.face_centroid[f]) + grad_cell * (z_cell - z_face), w});
       } else if (auto it = control.find(w); it != control.end()) {
         terms.push_back({o, tr.face[f] / mu * st.b[o],
-                         it->second->bhp + wellbore_gradient(pb, w) * (z_cell - it->second->ref_depth), w});
+                         column_pressure(pb, *it->second, z_cell), w});
       }
     }
   }
@@ -161,8 +164,7 @@ std::vector<BoundaryTerm> boundary_terms(const FlowProblem& pb, const Transmissi
     if (pb.wellbore_pressure) {
       terms.push_back({wc.cell, c, pb.wellbore_pressure(wc.point) + st.rho[wc.cell] * gf * (z_cell - wc.point.z), wc.well});
     } else if (auto it = control.find(wc.well); it != control.end()) {
-      terms.push_back({wc.cell, c, it->second->bhp + wellbore_gradient(pb, wc.well) * (z_cell - it->second->ref_depth),
-                       wc.well});
+      terms.push_back({wc.cell, c, column_pressure(pb, *it->second, z_cell), wc.well});
     }
   }
   for (const BoundaryTerm& t : terms)
@@ -248,6 +250,10 @@ TpfaSystem assemble_tpfa(const FlowProblem& pb, const Transmissibilities& tr) {
 }
 
 double inverse_formation_volume_factor(const FlowProblem& pb, double pressure) { return inverse_fvf(pb, pressure); }
+
+double wellbore_column_pressure(const FlowProblem& pb, const WellControl& control, double depth) {
+  return column_pressure(pb, control, depth);
+}
 
 std::vector<double> well_rates(const FlowProblem& pb, const Transmissibilities& tr, const std::vector<double>& p) {
   check_problem(pb, tr);

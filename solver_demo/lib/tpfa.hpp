@@ -8,7 +8,8 @@
 // the steady surface-volume balance
 //
 //   sum_j T_ij/mu b_up (p_i - p_j - g (rho_i + rho_j)/2 (z_i - z_j)) + sum_conn CF/mu b_i (p_i - p_conn) = 0,
-//   b(p) = (1 + X + X^2/2) / B_ref, X = c (p - p_ref), rho = rho_s b, b_up of the upstream cell.
+//   b(p) = (1 + X + X^2/2) / B_ref, X = c (p - p_ref), rho = rho_s b, b_up of the upstream cell,
+//   p_conn(z) the still wellbore column dp/dz = rho_s b(p) g from (z_ref, BHP).
 //
 // Units (Eclipse METRIC): p in bar, T and CF in cP.rm3/day/bar, mu in cP, rates in m3/day (surface
 // volumes; equal to reservoir volumes when incompressible with B_ref = 1).
@@ -55,11 +56,6 @@ struct FlowProblem {
   double compressibility = 0;          ///< 1/bar
   double reference_pressure = 0;       ///< bar (PVTW item 1)
   double formation_volume_factor = 1;  ///< B_ref, rm3/sm3 (PVTW item 2)
-  /// Wellbore head with compressibility: the well's fluid column between the BHP reference depth
-  /// and a connection has density rho_s b(p_head), p_head the pressure given here for that well
-  /// (index = well); wells not listed use reference_pressure. OPM evaluates its connection
-  /// densities from the state at the start of the time step (docs/solver.md).
-  std::vector<double> wellbore_head_pressure;
   bool gravity = true;
   /// Controls of the wells whose wellbore faces / connections produce or inject. Wellbore
   /// faces of a well without a control are closed (no flow), unless wellbore_pressure is set.
@@ -114,6 +110,13 @@ struct TpfaSystem {
 };
 /// The incompressible system (b = 1, rho = density), whatever the problem's compressibility.
 TpfaSystem assemble_tpfa(const FlowProblem& problem, const Transmissibilities& trans);
+
+/// Pressure of well `control`'s still fluid column at `depth`: BHP + rho g (depth - ref_depth)
+/// when incompressible, else the exact solution of dp/dz = rho_s b(p) g / 1e5 through
+/// (ref_depth, BHP): with u = 1 + X, atan(u) grows linearly in depth (c rho_s g / (2e5 B_ref)).
+/// OPM's connection densities (rho_s b at the mean pressure of consecutive connections) converge
+/// to this column. Gravity off: BHP.
+double wellbore_column_pressure(const FlowProblem& problem, const WellControl& control, double depth);
 
 /// Inverse formation volume factor b(p) of the problem's fluid (1 when incompressible).
 double inverse_formation_volume_factor(const FlowProblem& problem, double pressure);

@@ -26,7 +26,8 @@ struct ExampleRun {
 /// The steady state of the deck's water: PVTW `Pref 1.0 Cw mu 0` with Pref = initial pressure and
 /// Cw = max(case Cw, 1e-8) as the exporter writes it, b(p) = 1 + X + X^2/2, X = Cw (p - Pref),
 /// density rho_s b, face density the mean of the two cells', mobility b/mu of the upstream cell;
-/// connections CF/mu b_cell (p_cell - BHP - rho_s b(BHP) g (z_cell - z_ref)); rates in surface m3/day.
+/// connections CF/mu b_cell (p_cell - p_conn), p_conn the still wellbore column from (z_ref, BHP),
+/// integrated here by RK4 (solver_demo has a closed form); rates in surface m3/day.
 /// Picard iteration (b, rho and upstream frozen; symmetric steps) with a sparse LDLT.
 TpfaSolution compressible_reference_solve(const hm::CaseSpec& cs, const hm::PolyMesh& mesh,
                                           const hm::Transmissibilities& trans) {
@@ -38,9 +39,21 @@ TpfaSolution compressible_reference_solve(const hm::CaseSpec& cs, const hm::Poly
     return 1 + x + x * x / 2;
   };
   const auto wells = hm::well_connection_factors(mesh, trans, static_cast<int>(cs.wells.size()));
-  auto p_conn = [&](size_t w, int c) {
-    return cs.wells[w].bhp + rho_s * b(cs.wells[w].bhp) * gf * (mesh.cell_fv_center[c].z - cs.wells[w].trajectory.front().z);
+  auto column = [&](size_t w, int c) {
+    const int steps = 200;
+    const double h = (mesh.cell_fv_center[c].z - cs.wells[w].trajectory.front().z) / steps;
+    auto f = [&](double p) { return rho_s * b(p) * gf; };
+    double p = cs.wells[w].bhp;
+    for (int i = 0; i < steps; ++i) {
+      const double k1 = f(p), k2 = f(p + h / 2 * k1), k3 = f(p + h / 2 * k2), k4 = f(p + h * k3);
+      p += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    }
+    return p;
   };
+  std::map<std::pair<size_t, int>, double> conn_pressure;
+  for (size_t w = 0; w < wells.size(); ++w)
+    for (const auto& wc : wells[w]) conn_pressure[{w, wc.first}] = column(w, wc.first);
+  auto p_conn = [&](size_t w, int c) { return conn_pressure.at({w, c}); };
   std::vector<double> p(n, pref);
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   for (int it = 0; it < 30; ++it) {

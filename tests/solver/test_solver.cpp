@@ -319,7 +319,8 @@ TEST(Compressible, StillColumnFollowsTheDiscreteHydrostaticRecurrence) {
 
 /// The surface-volume balance of every cell, written out independently of the solver:
 /// faces T/mu b_up (p_i - p_j - g (rho_i + rho_j)/2 (z_i - z_j)) with b_up of the upstream cell,
-/// connections CF/mu b_i (p_i - BHP - g rho_s b(p_head) (z_i - z_ref)).
+/// connections CF/mu b_i (p_i - p_conn), p_conn the still wellbore column (wellbore_column_pressure,
+/// checked by WellboreColumnSolvesItsODE).
 struct Balance {
   std::vector<double> res, scale, rate;
 };
@@ -339,9 +340,8 @@ Balance compressible_balance(const TwoWellBox& t, const std::vector<double>& p) 
   }
   for (const WellConnection& wc : t.pb.connections) {
     const WellControl& ctl = t.pb.wells[wc.well];
-    const double head = t.pb.density * inverse_fvf(c, pr, t.pb.wellbore_head_pressure[wc.well]) * gf;
-    const double q = wc.cf / mu * inverse_fvf(c, pr, p[wc.cell]) *
-                     (p[wc.cell] - (ctl.bhp + head * (z(wc.cell) - ctl.ref_depth)));
+    const double q =
+        wc.cf / mu * inverse_fvf(c, pr, p[wc.cell]) * (p[wc.cell] - wellbore_column_pressure(t.pb, ctl, z(wc.cell)));
     b.res[wc.cell] += q;
     b.scale[wc.cell] += std::fabs(q);
     b.rate[wc.well] += q;
@@ -353,7 +353,6 @@ TEST(Compressible, EveryCellBalancesSurfaceVolumesWithUpwindMobilityAndMeanDensi
   TwoWellBox t = two_well_box();
   t.pb.compressibility = 2e-3;  // 20x water's, so every term matters
   t.pb.reference_pressure = 200;
-  t.pb.wellbore_head_pressure = {150.0, 260.0};
   const FlowSolution sol = solve_tpfa(t.pb, t.tr);
   const Balance b = compressible_balance(t, sol.pressure);
   for (size_t c = 0; c < b.res.size(); ++c) EXPECT_LT(std::fabs(b.res[c]), 1e-9 * b.scale[c] + 1e-12) << "cell " << c;
@@ -371,6 +370,37 @@ TEST(Compressible, EveryCellBalancesSurfaceVolumesWithUpwindMobilityAndMeanDensi
   double worst = 0;
   for (size_t c = 0; c < b0.res.size(); ++c) worst = std::max(worst, std::fabs(b0.res[c]) / (b0.scale[c] + 1e-300));
   EXPECT_GT(worst, 1e-4);
+}
+
+// The wellbore column against a fine RK4 integration of dp/dz = rho_s b(p) g, above and below the
+// reference depth; with c -> 0 it is the incompressible column to round-off.
+TEST(Compressible, WellboreColumnSolvesItsODE) {
+  FlowProblem pb;
+  pb.density = 1020;
+  pb.compressibility = 4e-4;
+  pb.reference_pressure = 220;
+  pb.formation_volume_factor = 1.02;
+  const WellControl ctl{0, 260.0, 1000.0};
+  for (double depth : {700.0, 990.0, 1000.0, 1060.0, 1500.0}) {
+    const int steps = 20000;
+    const double h = (depth - ctl.ref_depth) / steps;
+    auto f = [&](double p) { return pb.density * inverse_formation_volume_factor(pb, p) * kGravity / 1e5; };
+    double p = ctl.bhp;
+    for (int i = 0; i < steps; ++i) {
+      const double k1 = f(p), k2 = f(p + h / 2 * k1), k3 = f(p + h / 2 * k2), k4 = f(p + h * k3);
+      p += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    }
+    EXPECT_NEAR(wellbore_column_pressure(pb, ctl, depth), p, 1e-11 * p) << "depth " << depth;
+    // Fail half: the column at the reference density differs.
+    if (depth != ctl.ref_depth) {
+      EXPECT_GT(std::fabs(wellbore_column_pressure(pb, ctl, depth) - (260 + 1020 / 1.02 * kGravity / 1e5 * (depth - 1000))),
+                1e-5 * p);
+    }
+  }
+  pb.compressibility = 1e-14;
+  EXPECT_NEAR(wellbore_column_pressure(pb, ctl, 1060), 260 + 1020 / 1.02 * kGravity / 1e5 * 60, 1e-12 * 260);
+  pb.gravity = false;
+  EXPECT_EQ(wellbore_column_pressure(pb, ctl, 1060), 260.0);
 }
 
 TEST(Compressible, TinyCompressibilityIsTheIncompressibleSolve) {
