@@ -136,7 +136,7 @@ void run_example(const hm::CaseSpec& cs, const std::string& label, ExampleRun* r
               label.c_str(), c.max_rel_pressure, c.max_rel_rate, c.max_rel_porv, c.max_depth_diff, c.our_connections,
               c.flow_connections, c.flow_nnc, c.max_rel_connection, c.dropped_by_flow, c.dropped_sum);
   for (size_t w = 0; w < cs.wells.size(); ++w)
-    std::printf("[ figures  ] %s: well %s rate %.6g rm3/day (ours)\n", label.c_str(), cs.wells[w].name.c_str(),
+    std::printf("[ figures  ] %s: well %s rate %.6g sm3/day (ours)\n", label.c_str(), cs.wells[w].name.c_str(),
                 r->ours.well_rate[w]);
 }
 
