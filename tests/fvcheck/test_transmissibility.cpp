@@ -514,7 +514,11 @@ TEST(Transmissibility, OutermostRingFaceToTransitionCellUsesLogFormOnRadialSide)
     const int radial = m.cell_region[o] == kWell ? o : n, shell = radial == o ? n : o;
     const RadialCellInfo& r = m.cell_radial[radial];
     ASSERT_EQ(r.ring, s.rings - 1);
-    const double log_half = kDarcyMetric * theta * length * k / std::log(r.r_out / r.r_center);
+    // The radial half runs to the chord face (its centroid is r_out cos(theta/2) from the
+    // axis), where the shell's half starts: the band between chord and arc is counted once.
+    const double r_face = r.r_out * std::cos(0.5 * theta);
+    EXPECT_NEAR(norm(g.face_centroid[f] - Vec3{0, 0, g.face_centroid[f].z}), r_face, 1e-12 * r_face);
+    const double log_half = kDarcyMetric * theta * length * k / std::log(r_face / r.r_center);
     const double t_radial = radial == o ? t.half_owner[f] : t.half_neighbour[f];
     const double t_shell = shell == o ? t.half_owner[f] : t.half_neighbour[f];
     EXPECT_NEAR(t_radial, log_half, 1e-13 * log_half);
@@ -527,4 +531,81 @@ TEST(Transmissibility, OutermostRingFaceToTransitionCellUsesLogFormOnRadialSide)
     ++checked;
   }
   EXPECT_EQ(checked, s.sectors * s.segments);
+}
+
+TEST(Transmissibility, OutermostRingFaceCountsTheChordArcBandOnce) {
+  // Exact radial flow between the outermost ring's FV centre (r_c) and a transition site on
+  // the sector's mid-angle ray at r_s: theta L k / ln(r_s / r_c). The mesh's two-point value
+  // (radial log half to the chord + power-cell half from the chord) must be closer to it than
+  // the radial half to the arc r_out would be, for coarse and fine sectors. (What is left is
+  // the linear power-cell half over r_s / r_f = 1.3-1.5 here.)
+  for (int sectors : {6, 8, 12, 24}) {
+    RingSpec s;
+    s.rings = 3;
+    s.sectors = sectors;
+    s.transition_shell = true;
+    const PolyMesh m = ring_block(s);
+    const MeshGeometry g = compute_geometry(m);
+    const Transmissibilities t = compute_transmissibilities(m, g);
+    EXPECT_EQ(t.negative, 0);
+    const double theta = 2 * kPi / s.sectors, length = s.height / s.segments, k = 100;
+    int checked = 0;
+    for (int f = 0; f < m.n_faces(); ++f) {
+      const int o = m.face_owner[f], n = m.face_neighbour[f];
+      if (n < 0 || (m.cell_region[o] == kTransition) == (m.cell_region[n] == kTransition)) continue;
+      const int radial = m.cell_region[o] == kWell ? o : n, shell = radial == o ? n : o;
+      const RadialCellInfo& r = m.cell_radial[radial];
+      const Vec3 site = m.cell_fv_center[shell];
+      const double r_s = norm(site - Vec3{0, 0, site.z});
+      const double exact = kDarcyMetric * theta * length * k / std::log(r_s / r.r_center);
+      const double shell_half = shell == o ? t.half_owner[f] : t.half_neighbour[f];
+      const double arc = 1.0 / (std::log(r.r_out / r.r_center) / (kDarcyMetric * theta * length * k) + 1.0 / shell_half);
+      const double err_mesh = std::fabs(t.face[f] / exact - 1), err_arc = std::fabs(arc / exact - 1);
+      EXPECT_LT(err_mesh, err_arc) << sectors << " sectors";
+      if (checked == 0)
+        std::printf("%2d sectors, r_s / r_out %.3f: two-point error %.4f %% (radial half to the arc: %.4f %%)\n",
+                    sectors, r_s / r.r_out, 100 * (t.face[f] / exact - 1), 100 * (arc / exact - 1));
+      ++checked;
+    }
+    EXPECT_EQ(checked, s.sectors * s.segments);
+  }
+}
+
+TEST(Transmissibility, RadialCellAngularAndAxialFacesUseTheOrthogonalForm) {
+  // Neighbours across an angular or axial face of a radial block are mirror images through the
+  // face, so t = A k / d with d the distance from the FV centre to the face plane: axially half
+  // the segment length, angularly r_c sin(theta / 2). The generic form would be smaller (it
+  // divides by |c|^2, c reaching the face centroid at another radius).
+  RingSpec s;
+  s.rings = 4;
+  s.sectors = 8;
+  s.segments = 3;
+  const PolyMesh m = ring_block(s);
+  const MeshGeometry g = compute_geometry(m);
+  const Transmissibilities t = compute_transmissibilities(m, g);
+  TransmissibilityOptions generic;
+  generic.exact_radial = false;
+  const Transmissibilities tg = compute_transmissibilities(m, g, generic);
+  const double theta = 2 * kPi / s.sectors, length = s.height / s.segments, k = 100;
+  int axial = 0, angular = 0;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const int o = m.face_owner[f], n = m.face_neighbour[f];
+    if (n < 0) continue;
+    const RadialCellInfo &a = m.cell_radial[o], &b = m.cell_radial[n];
+    const double area = norm(g.face_area[f]);
+    if (a.ring == b.ring && a.sector == b.sector) {
+      const double expected = kDarcyMetric * area * k / length;  // two halves of length / 2
+      EXPECT_NEAR(t.face[f], expected, 1e-12 * expected);
+      EXPECT_LT(tg.face[f], expected * (1 - 1e-6));
+      ++axial;
+    } else if (a.ring == b.ring && a.segment == b.segment) {
+      const double d = a.r_center * std::sin(0.5 * theta);
+      const double expected = kDarcyMetric * area * k / (2 * d);
+      EXPECT_NEAR(t.face[f], expected, 1e-12 * expected);
+      EXPECT_LT(tg.face[f], expected * (1 - 1e-6));
+      ++angular;
+    }
+  }
+  EXPECT_EQ(axial, s.rings * s.sectors * (s.segments - 1));
+  EXPECT_EQ(angular, s.rings * s.sectors * s.segments);
 }
