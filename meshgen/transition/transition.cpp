@@ -53,7 +53,7 @@ std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector
 }
 
 TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
-                                 const ReservoirGrid& grid, const std::vector<WellBlock>& /*blocks*/,
+                                 const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                                  int32_t base_node_id) {
   TransitionReport report;
   using Clock = std::chrono::steady_clock;
@@ -73,26 +73,43 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     throw TransitionError(os.str(), std::move(polygons), std::move(cells));
   }
   SiteSet set = make_sites(cavity, node_coords, grid, frames, report.notes);
+  place_end_face_sites(set, cavity, node_coords, blocks, frames);
   enforce_empty_spheres(set, cavity, node_coords, grid, frames);
   int iterations = 0;
   report.site_corrections = correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
   report.correction_iterations = iterations;
+  place_tip_sites(set, cavity, node_coords, grid, blocks);
   const Clock::time_point t2 = Clock::now();
 
   TransitionCells out;
-  for (int round = 0;; ++round) {
+  int tip_rounds = 0, hidden_rounds = 0;
+  for (;;) {
     out = TransitionCells{};
     out.base_node_id = base_node_id;
     const std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out);
-    if (hidden.empty()) break;
+    if (hidden.empty()) {
+      // Free sites are optional: one whose cell came out unusable (near-degenerate sites whose
+      // power vertices were identified into a duplicate face) is dropped and the diagram rebuilt.
+      const std::vector<int> bad_tips = tip_sites_in_bad_cells(set, out);
+      if (bad_tips.empty()) break;
+      for (int s : bad_tips) set.sites[s].alive = false;
+      report.dropped_tip_sites += static_cast<int>(bad_tips.size());
+      if (++tip_rounds > kMaxHiddenRepairs)  // cannot happen twice: no free site is left
+        for (Site& s : set.sites)
+          if (s.kind == SiteKind::Free) s.alive = false;
+      continue;
+    }
     for (int s : hidden) {
       std::ostringstream os;
-      os << "site " << s << (set.sites[s].internal() ? " (internal" : " (external") << ", polygon "
-         << set.sites[s].polygons.front() << ") is hidden: moved toward its polygon and rebuilt";
+      if (set.sites[s].kind == SiteKind::Free)
+        os << "tip site " << s << " is hidden: dropped and rebuilt";
+      else
+        os << "site " << s << (set.sites[s].internal() ? " (internal" : " (external") << ", polygon "
+           << set.sites[s].polygons.front() << ") is hidden: moved toward its polygon and rebuilt";
       if (report.notes.size() < 50) report.notes.push_back(os.str());
       if (set.sites[s].internal()) ++report.hidden_sites;
     }
-    if (round == kMaxHiddenRepairs) {
+    if (hidden_rounds++ == kMaxHiddenRepairs) {
       std::ostringstream os;
       os << "transition: " << hidden.size() << " sites stay hidden after " << kMaxHiddenRepairs << " repairs";
       throw std::runtime_error(os.str());
@@ -103,6 +120,7 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     report.site_corrections +=
         correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
     report.correction_iterations += iterations;
+    report.dropped_tip_sites += drop_blocked_tip_sites(set);
   }
   // Merge the stage reports.
   TransitionReport& r = out.report;
@@ -113,15 +131,20 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
   r.correction_iterations = report.correction_iterations;
   r.hidden_sites = report.hidden_sites;
   r.hidden_repairs = report.hidden_repairs;
+  r.dropped_tip_sites = report.dropped_tip_sites;
   r.notes.insert(r.notes.begin(), report.notes.begin(), report.notes.end());
   for (const Site& s : set.sites) {
     if (!s.alive) continue;
     if (s.internal()) ++r.internal_sites;
     else if (s.kind != SiteKind::Guard) ++r.external_sites;
     if (s.kind == SiteKind::InternalBox) ++r.box_sites;
+    if (s.kind == SiteKind::Free) ++r.free_sites;
   }
   r.split_boxes = set.splits;
   r.emptiness_fixes = set.emptiness_fixes;
+  if (r.free_sites > 0 || r.dropped_tip_sites > 0)
+    r.notes.push_back(std::to_string(r.free_sites) + " tip sites (weight 0) grade the cells beyond the well ends" +
+                      (r.dropped_tip_sites > 0 ? " (" + std::to_string(r.dropped_tip_sites) + " dropped)" : ""));
   return out;
 }
 

@@ -22,6 +22,8 @@ struct TransitionReport {
   std::vector<std::string> notes;
   // ---- added by the transition module (docs/transition.md)
   int box_sites = 0;            ///< internal sites that are deactivated-cell centres (n > 1 rule)
+  int free_sites = 0;           ///< internal sites of weight 0 graded around the well ends (no polygon)
+  int dropped_tip_sites = 0;    ///< free sites dropped after sites moved or because their cell was unusable
   int split_boxes = 0;          ///< box sites replaced by per-polygon sites (sphere not empty / correction)
   int emptiness_fixes = 0;      ///< sites moved so that their sphere holds no other cavity vertex
   int hidden_repairs = 0;       ///< rebuilds after moving hidden internal sites
@@ -50,7 +52,9 @@ struct TransitionCells {
   std::vector<std::vector<CellFace>> cells;
   std::vector<Vec3> sites;        ///< FV centre of each cell (its site)
   std::vector<double> weights;    ///< power weight (radius) of each cell's site
-  std::vector<double> h_ref;      ///< mean edge length of the cell's constrained polygons (Q_S's h)
+  /// Q_S's h: mean edge length of the cell's constrained polygons; for a cell with none (a tip
+  /// site's), the mean edge length of the cell's own faces.
+  std::vector<double> h_ref;
   /// Per cell: the cavity face indices (constrained polygons) that are faces of this cell.
   std::vector<std::vector<int32_t>> cell_polygons;
   TransitionReport report;

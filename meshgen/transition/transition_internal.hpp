@@ -45,6 +45,9 @@ enum class SiteKind : int {
   ExternalBox = 2,      ///< centre of an active reservoir cell, weight = half diagonal (fixed)
   ExternalMirror = 3,   ///< reflection of the polygon's internal site through O (5.4.2)
   Guard = 4,            ///< far point of weight 0 that bounds every cell
+  /// Weight 0, strictly inside the cavity beyond a well's end, owns no constrained polygon
+  /// (grades the cells around the tip, docs/transition.md "Tip sites").
+  Free = 5,
 };
 
 struct Site {
@@ -56,9 +59,13 @@ struct Site {
   int reservoir_cell = -1;  ///< boxes: reservoir linear cell index
   int polygon = -1;       ///< InternalPolygon / ExternalMirror: its polygon
   double t = 0;           ///< InternalPolygon: parameter on the dual line
+  double t_cap = kInf;    ///< InternalPolygon: largest t the correction may grow it to (end faces)
+  double clearance = 0;   ///< Free: distance it keeps from every other site's sphere
   std::vector<int> polygons;       ///< constrained polygons of this site (cavity face indices)
   std::vector<int32_t> vertices;   ///< sorted distinct global node ids of those polygons
-  bool internal() const { return kind == SiteKind::InternalBox || kind == SiteKind::InternalPolygon; }
+  bool internal() const {
+    return kind == SiteKind::InternalBox || kind == SiteKind::InternalPolygon || kind == SiteKind::Free;
+  }
 };
 
 struct SiteSet {
@@ -95,6 +102,43 @@ std::vector<int32_t> cells_behind(const Cavity& cavity, const std::vector<Vec3>&
 void shrink_or_split(SiteSet& set, int site, double alpha, const Cavity& cavity,
                      const std::vector<Vec3>& coords, const ReservoirGrid& grid,
                      const std::vector<PolygonFrame>& frames);
+
+/// One end of a well block: the plane of its end faces (through `center`, normal `axis`
+/// pointing away from the block) and the block's ring radii.
+struct WellEnd {
+  int well = -1;
+  Vec3 center, axis;
+  std::vector<double> radii;
+  double end_length = 0;  ///< axial length of the block's segment at this end
+};
+
+/// The two ends of every block of a well in the cavity (blocks[k].well identifies it).
+std::vector<WellEnd> well_ends(const Cavity& cavity, const std::vector<WellBlock>& blocks);
+
+/// Tip grading (docs/transition.md "Tip sites"). Places the internal sites of the polygons on
+/// each well block's end faces half an end segment above their polygon (the mirror of the ring
+/// cells' FV centres), within their empty-sphere range, and caps their later growth there.
+/// Returns the number of sites placed.
+int place_end_face_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                         const std::vector<WellBlock>& blocks, const std::vector<PolygonFrame>& frames);
+
+/// Replaces the Free sites of `set` by a new set: sites of weight 0 on half-shells around
+/// each well end of the cavity (radii growing geometrically from r_w with half the ring
+/// ratio of the block), kept only where they are strictly inside the cavity, clear of every
+/// cavity vertex and outside every other site's sphere (so every site stays in its own power
+/// cell and no free site takes a constrained face). Returns the number of free sites.
+int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords, const ReservoirGrid& grid,
+                    const std::vector<WellBlock>& blocks);
+
+/// Drops the Free sites that an other site's sphere (grown by the free site's clearance) now
+/// reaches, after sites moved (hidden-site repair). Returns the number dropped.
+int drop_blocked_tip_sites(SiteSet& set);
+
+/// Free sites whose cells came out of the power diagram unusable: a face whose node set is also
+/// another face's (after vertex identification; the builder would see a face named by three
+/// cells) or a cell with fewer than 4 faces. `out` holds one cell per live internal site, in
+/// site order.
+std::vector<int> tip_sites_in_bad_cells(const SiteSet& set, const TransitionCells& out);
 
 /// Stage 5.6-5.7 (CGAL Regular_triangulation_3): power cells of the internal sites,
 /// power vertices identified combinatorially, external faces snapped to the constrained

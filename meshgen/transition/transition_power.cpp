@@ -255,8 +255,9 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     const int inner = si ? s : t, other = si ? t : s;
     if (unbounded || is_guard(other)) {
       std::ostringstream os;
-      os << "transition: the cavity leaked: internal site " << inner << " (polygon "
-         << set.sites[inner].polygons.front() << ") meets the far guard points";
+      os << "transition: the cavity leaked: internal site " << inner;
+      if (!set.sites[inner].polygons.empty()) os << " (polygon " << set.sites[inner].polygons.front() << ")";
+      os << " meets the far guard points";
       throw std::runtime_error(os.str());
     }
     // Drop repeated classes (co-spherical cells merged): a zero-area face has < 3 left.
@@ -523,6 +524,12 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     for (int q : site.polygons) {
       const auto& nodes = cavity.faces[q].nodes;
       for (size_t k = 0; k < nodes.size(); ++k, ++edges) len += norm(coords[nodes[(k + 1) % nodes.size()]] - coords[nodes[k]]);
+    }
+    if (edges == 0) {  // a tip site: no constrained polygon, the cell's own edges
+      auto at = [&](int32_t v) { return v >= out.base_node_id ? out.new_nodes[v - out.base_node_id] : coords[v]; };
+      for (const CellFace& cf : out.cells[c])
+        for (size_t k = 0; k < cf.nodes.size(); ++k, ++edges)
+          len += norm(at(cf.nodes[(k + 1) % cf.nodes.size()]) - at(cf.nodes[k]));
     }
     out.h_ref[c] = edges ? len / edges : 0.0;
     std::sort(out.cell_polygons[c].begin(), out.cell_polygons[c].end());

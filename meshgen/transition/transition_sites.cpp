@@ -20,6 +20,10 @@ constexpr double kShrink = 0.7;  // alpha of 5.5.3 (paper: 0.7 <= alpha < 1)
 // A polygon site never comes closer to its polygon than this fraction of the circumradius:
 // at t = 0 it would coincide with its reflection (same weighted point, one of them hidden).
 constexpr double kMinT = 1e-3;
+// Height of an end-face polygon's site above its polygon, in lengths of the block's end
+// segment: the mirror image of the ring cell's FV centre, which lies half a segment behind the
+// face (docs/transition.md "Tip sites").
+constexpr double kEndFaceHeight = 0.5;
 
 double shrunk(double t, double alpha, double radius) { return std::max(alpha * t, std::min(t, kMinT * radius)); }
 
@@ -114,9 +118,11 @@ int add_mirror_site(SiteSet& set, int q, const Cavity& cavity, const std::vector
 }
 
 // Largest t of polygon q's internal site that keeps its sphere (and its reflection's) clearly
-// empty.
+// empty, within the site's own cap (end faces, lower_end_face_sites).
 double max_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames) {
-  return 0.95 * 2.0 * initial_t(set, q, frames);
+  const int in = set.internal_of[q];
+  const double cap = in >= 0 ? set.sites[in].t_cap : kInf;
+  return std::min(0.95 * 2.0 * initial_t(set, q, frames), cap);
 }
 
 // Whether shrink_or_split can still change site s: boxes can be split, polygon sites (or
@@ -167,7 +173,7 @@ std::vector<int> non_empty_sites(SiteSet& set, const Cavity& cavity, const std::
   std::vector<int> bad;
   for (size_t s = 0; s < set.sites.size(); ++s) {
     Site& site = set.sites[s];
-    if (!site.alive || site.kind == SiteKind::Guard || !site.unchecked) continue;
+    if (!site.alive || site.kind == SiteKind::Guard || site.kind == SiteKind::Free || !site.unchecked) continue;
     site.unchecked = false;
     const double r = std::sqrt(site.w2);
     auto it = std::lower_bound(by_x.begin(), by_x.end(), std::make_pair(site.p.x - r, INT32_MIN));
@@ -345,9 +351,36 @@ void shrink_or_split(SiteSet& set, int s, double alpha, const Cavity& cavity, co
     case SiteKind::ExternalBox:
       split_box(set, s, cavity, coords, frames);
       break;
+    case SiteKind::Free:  // placed by place_tip_sites, which re-validates them after every move
+      site.alive = false;
+      break;
     case SiteKind::Guard:
       break;
   }
+}
+
+int place_end_face_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                         const std::vector<WellBlock>& blocks, const std::vector<PolygonFrame>& frames) {
+  int moved = 0;
+  for (const WellEnd& end : well_ends(cavity, blocks)) {
+    // Rounding of the block's node construction is ~1e-16 x the coordinates.
+    const double tol = 1e-7 * std::max(end.radii.back(), norm(end.center));
+    for (size_t q = 0; q < cavity.faces.size(); ++q) {
+      const ConstrainedFace& f = cavity.faces[q];
+      if (f.side != FaceSide::Well || f.well != end.well) continue;
+      bool on_plane = true;
+      for (int32_t v : f.nodes) on_plane = on_plane && std::abs(dot(coords[v] - end.center, end.axis)) <= tol;
+      const int s = set.internal_of[q];
+      if (!on_plane || s < 0 || set.sites[s].kind != SiteKind::InternalPolygon) continue;
+      // Mirror of the ring cell's FV centre (half a segment behind the face), within the
+      // polygon's empty-sphere range; the correction may lower it, never raise it above.
+      const double t = std::min(kEndFaceHeight * end.end_length, max_t(set, static_cast<int>(q), frames));
+      set.sites[s].t_cap = t;
+      place_polygon_site(set, s, t, cavity, coords, frames);
+      ++moved;
+    }
+  }
+  return moved;
 }
 
 int enforce_empty_spheres(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,

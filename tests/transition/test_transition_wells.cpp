@@ -243,5 +243,48 @@ TEST(TransitionWells, ThreeWells) {
   run_case("three wells", load_case(std::string(HM_SOURCE_DIR) + "/examples/three_wells.yaml"), 2);
 }
 
+
+// Tip sites (docs/transition.md "Tip sites"): the accuracy case's vertical well has a cavity
+// reaching 12 m beyond each end. Weight-0 sites grade the cells there; the mesh keeps every
+// property of run_case (each polygon exactly one face, auto-centred sites, convex cells, exact
+// volume), the free cells are exactly the transition cells with no constrained face, and their
+// size grows with the distance from the tip.
+TEST(TransitionWells, TipSitesGradeTheCellsBeyondTheEnds) {
+  const CaseSpec cs = load_case(std::string(HM_SOURCE_DIR) + "/examples/accuracy_vertical.yaml");
+  run_case("tip sites", cs, 1);
+  PipelineOptions opts;
+  opts.optimize = false;
+  const HybridMesh hm = build_hybrid_mesh(cs, opts);
+  int free_sites = 0;
+  for (const TransitionReport& r : hm.transition_reports) free_sites += r.free_sites;
+  EXPECT_GT(free_sites, 0);
+  const PolyMesh& m = hm.mesh;
+  const Vec3 top = cs.wells[0].trajectory.front(), bottom = cs.wells[0].trajectory.back();
+  int free_cells = 0;
+  double worst_ratio = 0;
+  for (int c = 0; c < m.n_cells(); ++c) {
+    if (m.cell_region[c] != kTransition) continue;
+    bool constrained = false;
+    Vec3 lo{1e300, 1e300, 1e300}, hi = -lo;
+    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+      const int32_t other = m.face_owner[*fp] == c ? m.face_neighbour[*fp] : m.face_owner[*fp];
+      constrained = constrained || other < 0 || m.cell_region[other] != kTransition;
+      for (const int32_t* v = m.face_begin(*fp); v != m.face_end(*fp); ++v)
+        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], m.nodes[*v][k]), hi[k] = std::max(hi[k], m.nodes[*v][k]);
+    }
+    if (constrained) continue;
+    ++free_cells;
+    const Vec3 x = m.cell_fv_center[c];
+    // Beyond an end plane (z is depth: the well runs from `top` down to `bottom`).
+    EXPECT_TRUE(x.z < top.z || x.z > bottom.z) << "free cell " << c << " beside the well";
+    EXPECT_GT(hm.cell_h_ref[c], 0.0);
+    const double distance = std::min(norm(x - top), norm(x - bottom));
+    worst_ratio = std::max(worst_ratio, norm(hi - lo) / distance);
+  }
+  EXPECT_EQ(free_cells, free_sites);
+  std::printf("[tip sites] %d free cells, largest diameter / distance to the tip %.2f\n", free_cells, worst_ratio);
+  EXPECT_LT(worst_ratio, 2.0);
+}
+
 }  // namespace
 }  // namespace hm

@@ -1,0 +1,216 @@
+// Tip sites (docs/transition.md "Tip sites"): free sites of weight 0 graded around each well
+// end, so that the transition cells beyond a tip grow with the distance from it instead of
+// being a single layer of needles standing on the block's end faces. CGAL-free.
+//
+// Why a free site is safe for conformity: at a point x of a constrained polygon the power of
+// the polygon's own internal site is |x - O|^2 - rho^2 <= 0 (the sphere passes through the
+// polygon's circle), while a weight-0 site F has |x - F|^2 > 0: F never takes a point of a
+// constrained polygon, and since constrained vertices keep power 0 w.r.t. their own sites and
+// positive power w.r.t. F, they stay power vertices. F lies in its own (convex) cell iff it is
+// outside every other site's sphere; that cell then contains F, inside the cavity, and touches
+// no polygon, so it lies inside the cavity. Existing sites stay in their cells (power -w^2 <= 0
+// at their own position, |P - F|^2 >= 0 for F).
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "transition_internal.hpp"
+
+namespace hm::transition_detail {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGoldenAngle = 2.39996322972865332;  // pi (3 - sqrt(5))
+// Shells per ring: the shell radii grow by the ring ratio^(1/kShellsPerRing). The linear
+// two-point flux of a log field between sites a ratio x apart is off by about (x-1)^2/12;
+// at the ring ratio of the shipped cases (2.07) one shell per ring would give ~4 %, two ~1 %.
+constexpr int kShellsPerRing = 2;
+// Shells continue to this multiple of the drainage radius (candidates outside the cavity or
+// inside other sites' spheres are dropped anyway).
+constexpr double kShellReach = 2.0;
+// Clearance of a free site from every other site's sphere, every cavity vertex and the well
+// blocks, in units of the local radial step: keeps its cell (and its neighbours') well shaped.
+constexpr double kClearance = 0.25;
+
+struct Obstacle {
+  Vec3 p;
+  double radius = 0;  ///< sphere radius (site weight), 0 for a point
+};
+
+Vec3 any_perpendicular(Vec3 a) {
+  const Vec3 ref = std::abs(a.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  return normalized(cross(a, ref));
+}
+
+// Reservoir cell holding x strictly (-1 outside the grid or on a grid plane).
+int cell_at(const ReservoirGrid& grid, Vec3 x) {
+  int ijk[3];
+  const std::vector<double>* axes[3] = {&grid.x, &grid.y, &grid.z};
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double>& c = *axes[k];
+    const auto it = std::upper_bound(c.begin(), c.end(), x[k]);
+    if (it == c.begin() || it == c.end() || *(it - 1) == x[k]) return -1;
+    ijk[k] = static_cast<int>(it - c.begin()) - 1;
+  }
+  return grid.cell_index(ijk[0], ijk[1], ijk[2]);
+}
+
+// Whether x is within `margin` of the block (its legs as cylinders of the outer radius, cut
+// at the end planes; spheres at the bends cover the bisector cuts there).
+bool near_block(const WellBlock& b, Vec3 x, double margin) {
+  const double r = b.radii.back() + margin;
+  const std::vector<Vec3>& c = b.layer_center;
+  for (size_t k = 0; k + 1 < c.size(); ++k) {
+    const Vec3 d = c[k + 1] - c[k];
+    const double len = norm(d);
+    if (len == 0) continue;
+    const Vec3 a = d / len;
+    const double s = dot(x - c[k], a);
+    if (s < 0 || s > len) continue;
+    if (norm(x - c[k] - s * a) < r) return true;
+  }
+  for (size_t k = 1; k + 1 < c.size(); ++k) {
+    const Vec3 a = normalized(c[k] - c[k - 1]), b = normalized(c[k + 1] - c[k]);
+    if (norm(cross(a, b)) > 1e-9 && norm(x - c[k]) < r) return true;  // a bend
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<WellEnd> well_ends(const Cavity& cavity, const std::vector<WellBlock>& blocks) {
+  std::vector<WellEnd> ends;
+  for (const WellBlock& b : blocks) {
+    if (std::find(cavity.wells.begin(), cavity.wells.end(), b.well) == cavity.wells.end()) continue;
+    const std::vector<Vec3>& c = b.layer_center;
+    if (c.size() < 2 || b.radii.size() < 2) continue;
+    WellEnd e;
+    e.well = b.well;
+    e.radii = b.radii;
+    e.center = c.front();
+    e.axis = normalized(c[0] - c[1]);
+    e.end_length = norm(c[0] - c[1]);
+    ends.push_back(e);
+    e.center = c.back();
+    e.axis = normalized(c[c.size() - 1] - c[c.size() - 2]);
+    e.end_length = norm(c[c.size() - 1] - c[c.size() - 2]);
+    ends.push_back(e);
+  }
+  return ends;
+}
+
+int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords, const ReservoirGrid& grid,
+                    const std::vector<WellBlock>& blocks) {
+  for (Site& s : set.sites)
+    if (s.kind == SiteKind::Free) s.alive = false;
+  const std::vector<WellEnd> ends = well_ends(cavity, blocks);
+  if (ends.empty()) return 0;
+
+  // Obstacles sorted by x - radius: every live site's sphere and every cavity vertex.
+  std::vector<Obstacle> obstacles;
+  for (const Site& s : set.sites)
+    if (s.alive && s.kind != SiteKind::Guard) obstacles.push_back({s.p, std::sqrt(s.w2)});
+  for (int32_t v : cavity.vertices) obstacles.push_back({coords[v], 0.0});
+  double max_radius = 0;
+  for (const Obstacle& o : obstacles) max_radius = std::max(max_radius, o.radius);
+  std::sort(obstacles.begin(), obstacles.end(), [](const Obstacle& a, const Obstacle& b) { return a.p.x < b.p.x; });
+  std::vector<double> xs(obstacles.size());
+  for (size_t k = 0; k < obstacles.size(); ++k) xs[k] = obstacles[k].p.x;
+  std::vector<Vec3> placed;
+  auto clear = [&](Vec3 f, double delta) {
+    const size_t lo = static_cast<size_t>(
+        std::lower_bound(xs.begin(), xs.end(), f.x - max_radius - delta) - xs.begin());
+    for (size_t k = lo; k < obstacles.size() && xs[k] <= f.x + max_radius + delta; ++k)
+      if (norm(f - obstacles[k].p) < obstacles[k].radius + delta) return false;
+    for (const Vec3& p : placed)
+      if (norm(f - p) < delta) return false;
+    return true;
+  };
+
+  int added = 0;
+  for (const WellEnd& end : ends) {
+    const double r0 = end.radii.front(), r_out = end.radii.back();
+    const int rings = static_cast<int>(end.radii.size()) - 1;
+    const double ratio = std::pow(std::pow(r_out / r0, 1.0 / rings), 1.0 / kShellsPerRing);
+    if (!(ratio > 1.0001)) continue;
+    const double step = ratio - 1.0;  // radial step / radius
+    // Polar bands at 0, dphi, ..., pi/2 - dphi/2 so that the cells are about as wide as thick.
+    const int bands = std::max(1, static_cast<int>(std::lround(0.5 * kPi / std::min(step, 0.8) - 0.5)));
+    const double dphi = 0.5 * kPi / (bands + 0.5);
+    const Vec3 u = any_perpendicular(end.axis), v = cross(end.axis, u);
+    int shell = 1;
+    for (double radius = r0 * ratio; radius <= kShellReach * r_out; radius *= ratio, ++shell) {
+      const double delta = kClearance * step * radius;
+      for (int b = 0; b <= bands; ++b) {
+        const double phi = b * dphi;
+        const int n_az = b == 0 ? 1 : std::max(3, static_cast<int>(std::lround(2.0 * kPi * std::sin(phi) / dphi)));
+        for (int k = 0; k < n_az; ++k) {
+          // Each band turned by a golden-angle multiple: no free site in the meridian plane of
+          // another band's or of the sectors' (symmetric placements make co-spherical and
+          // coplanar quadruples of sites, whose power vertices are only rounded).
+          const double psi = 2.0 * kPi * k / n_az + kGoldenAngle * (b + 3 * shell);
+          const Vec3 f = end.center + radius * (std::cos(phi) * end.axis +
+                                                std::sin(phi) * (std::cos(psi) * u + std::sin(psi) * v));
+          const int cell = cell_at(grid, f);
+          if (cell < 0 || !std::binary_search(cavity.deactivated_cells.begin(), cavity.deactivated_cells.end(), cell))
+            continue;
+          bool in_block = false;
+          for (const WellBlock& blk : blocks) in_block = in_block || near_block(blk, f, delta);
+          if (in_block || !clear(f, delta)) continue;
+          Site s;
+          s.kind = SiteKind::Free;
+          s.p = f;
+          s.w2 = 0;
+          s.clearance = delta;
+          s.unchecked = false;
+          set.sites.push_back(s);
+          placed.push_back(f);
+          ++added;
+        }
+      }
+    }
+  }
+  return added;
+}
+
+int drop_blocked_tip_sites(SiteSet& set) {
+  int dropped = 0;
+  for (Site& f : set.sites) {
+    if (!f.alive || f.kind != SiteKind::Free) continue;
+    for (const Site& s : set.sites)
+      if (s.alive && s.kind != SiteKind::Free && s.kind != SiteKind::Guard &&
+          norm(f.p - s.p) < std::sqrt(s.w2) + f.clearance) {
+        f.alive = false;
+        ++dropped;
+        break;
+      }
+  }
+  return dropped;
+}
+
+std::vector<int> tip_sites_in_bad_cells(const SiteSet& set, const TransitionCells& out) {
+  std::vector<int> site_of_cell;
+  for (size_t s = 0; s < set.sites.size(); ++s)
+    if (set.sites[s].alive && set.sites[s].internal()) site_of_cell.push_back(static_cast<int>(s));
+  std::map<std::vector<int32_t>, std::vector<int>> cells_of_face;
+  std::vector<int> bad;
+  for (size_t c = 0; c < out.cells.size() && c < site_of_cell.size(); ++c) {
+    if (out.cells[c].size() < 4 && set.sites[site_of_cell[c]].kind == SiteKind::Free) bad.push_back(site_of_cell[c]);
+    for (const CellFace& f : out.cells[c]) {
+      std::vector<int32_t> key = f.nodes;
+      std::sort(key.begin(), key.end());
+      cells_of_face[key].push_back(static_cast<int>(c));
+    }
+  }
+  for (const auto& [key, cells] : cells_of_face) {
+    if (cells.size() <= 2) continue;
+    for (int c : cells)
+      if (set.sites[site_of_cell[c]].kind == SiteKind::Free) bad.push_back(site_of_cell[c]);
+  }
+  std::sort(bad.begin(), bad.end());
+  bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
+  return bad;
+}
+
+}  // namespace hm::transition_detail
