@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fvcheck/lib/checks.hpp"
+#include "meshgen/core/geometry.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 
 namespace hm {
@@ -199,12 +200,17 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
     const double an = norm(area);
     if (an <= 1e-12 * L * L) return r;
     const Vec3 n = area / an;
+    // The plane of a (possibly non-planar) face for the centering and convexity tests goes
+    // through its area-weighted centroid, as in fvcheck (through the vertex mean, a cell of
+    // three_wells passed here and failed fvcheck's convexity by 5e-6 of its size).
+    Vec3 area_w, gw;
+    polygon_area_centroid(m.nodes, cyc.data(), cyc.data() + cyc.size(), &area_w, &gw);
     normals[k] = n;
-    centres[k] = g;
+    centres[k] = gw;
     ++k;
     for (size_t i = 0; i < cyc.size(); ++i)
       vol += dot(g - site, cross(m.nodes[cyc[i]] - site, m.nodes[cyc[(i + 1) % cyc.size()]] - site)) / 6.0;
-    if (dot(n, site - g) >= -tol) r.centred = false;
+    if (dot(n, site - gw) >= -tol) r.centred = false;
     // Q_O (eq. 8): the segment to the other cell's FV centre (or the face centroid on the boundary).
     const int32_t other = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
     const Vec3 u = (other >= 0 ? src.cell_fv_center[other] : g) - site;
