@@ -66,7 +66,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
                              {"shape", h.optimize_report.rejected_shape}}},
                            {"passes", h.optimize_report.passes}};
     }
-    int corrections = 0, hidden = 0, snapped = 0, removed = 0, internal = 0, external = 0;
+    int corrections = 0, hidden = 0, snapped = 0, removed = 0, internal = 0, external = 0, free = 0, dropped = 0;
     for (const TransitionReport& r : h.transition_reports) {
       corrections += r.site_corrections;
       hidden += r.hidden_sites;
@@ -74,8 +74,12 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
       removed += r.removed_faces;
       internal += r.internal_sites;
       external += r.external_sites;
+      free += r.free_sites;
+      dropped += r.dropped_tip_sites;
     }
-    t["sites"] = {{"internal", internal}, {"external", external}};
+    // "free": the internal sites with no constrained polygon (tip sites, docs/transition.md).
+    t["sites"] = {{"internal", internal}, {"external", external}, {"free", free}};
+    t["dropped_tip_sites"] = dropped;
     t["site_corrections"] = corrections;
     t["hidden_sites"] = hidden;
     t["snapped_vertices"] = snapped;
