@@ -63,7 +63,11 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
                              {"orthogonality", h.optimize_report.rejected_orthogonality},
                              {"planarity", h.optimize_report.rejected_planarity},
                              {"centering", h.optimize_report.rejected_centering},
-                             {"shape", h.optimize_report.rejected_shape}}},
+                             {"shape", h.optimize_report.rejected_shape},
+                             {"skewness", h.optimize_report.rejected_skewness}}},
+                           {"skewness_removed", h.optimize_report.skewness_removed},
+                           {"skewed_faces", h.optimize_report.skewed_faces},
+                           {"max_skewness", h.optimize_report.max_skewness},
                            {"passes", h.optimize_report.passes}};
     }
     int corrections = 0, hidden = 0, snapped = 0, removed = 0, internal = 0, external = 0, free = 0, dropped = 0;
