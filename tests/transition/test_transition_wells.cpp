@@ -199,8 +199,8 @@ void run_case(const char* name, const CaseSpec& cs, int expected_cavities) {
   EXPECT_EQ(mt.sites_outside, 0);
   // Convex with planar faces, to within the non-co-circularity of the constrained polygons
   // (a power vertex identified with a polygon's node moves by up to that misfit; paper 5.7)
-  // and the round-off of double power vertices: up to 1.8e-8 of the cell size measured next
-  // to the bend wedges, where many sites are nearly co-spherical (1e-7 allowed).
+  // and the numerical-coincidence merge of power vertices (closer than 1e-9 of the cavity
+  // diagonal): relative to the smallest cells that is up to ~1e-7 (measured 5e-8, three wells).
   const double tol = 1e-7 + 2.0 * mt.max_circle_error;
   EXPECT_LT(mt.max_convexity, tol);
   EXPECT_LT(mt.max_planarity_interior, tol);
