@@ -10,6 +10,7 @@
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/quality.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/cli.hpp"
 #include "meshgen/core/text_file.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/summary.hpp"
@@ -56,25 +57,18 @@ int main(int argc, char** argv) {
     } else if (a == "-h" || a == "--help") {
       usage("help");
       return 0;
-    } else if (!a.empty() && a[0] == '-') {
-      return usage("unknown option '" + a + "'");
-    } else if (case_path.empty()) {
-      case_path = a;
-    } else {
-      return usage("more than one case file given");
+    } else if (const std::string why = hm::take_case_argument(a, &case_path); !why.empty()) {
+      return usage(why);
     }
   }
-  if (case_path.empty()) return usage("no case file given");
-  if (out_dir.empty()) return usage("no output directory given (-o OUTDIR)");
+  if (const std::string why = hm::check_case_and_output(case_path, out_dir); !why.empty()) return usage(why);
 
   hm::CaseSpec cs;
   hm::HybridMesh result;
   try {
     cs = hm::load_case(case_path);
-    std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    if (ec || !fs::is_directory(out_dir)) {
-      std::cerr << "meshgen: -o: cannot create directory '" << out_dir << "': " << ec.message() << "\n";
+    if (const std::string why = hm::create_output_directory(out_dir); !why.empty()) {
+      std::cerr << "meshgen: " << why << "\n";
       return 2;
     }
     result = hm::build_hybrid_mesh(cs, opts);

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -15,6 +14,8 @@
 
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/cli.hpp"
+#include "meshgen/core/text_file.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "solver_demo/lib/accuracy.hpp"
 #include "solver_demo/lib/tpfa.hpp"
@@ -32,19 +33,6 @@ constexpr const char* kUsage =
 int usage(const std::string& why) {
   std::cerr << "solver_demo: " << why << "\n" << kUsage;
   return 2;
-}
-
-bool write_text(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) return false;
-    f << text;
-    if (!f.good()) return false;
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  return !ec;
 }
 
 int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
@@ -97,8 +85,8 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
                  {"nonlinear_iterations", sol.nonlinear_iterations},
                  {"relative_residual", sol.relative_residual},
                  {"max_cell_imbalance_m3_per_day", sol.max_cell_imbalance}};
-  if (!write_text(out / "solution.json", j.dump(2) + "\n")) {
-    std::cerr << "solver_demo: cannot write '" << (out / "solution.json").string() << "'\n";
+  if (std::string error; !hm::write_text_file((out / "solution.json").string(), j.dump(2) + "\n", &error)) {
+    std::cerr << "solver_demo: " << error << "\n";
     return 2;
   }
   const hm::WriteStatus st = hm::write_vtu((out / "pressure.vtu").string(), mesh.mesh,
@@ -181,16 +169,11 @@ int main(int argc, char** argv) {
     } else if (a == "-h" || a == "--help") {
       std::cout << kUsage;
       return 0;
-    } else if (!a.empty() && a[0] == '-') {
-      return usage("unknown option '" + a + "'");
-    } else if (case_path.empty()) {
-      case_path = a;
-    } else {
-      return usage("more than one case file given");
+    } else if (const std::string why = hm::take_case_argument(a, &case_path); !why.empty()) {
+      return usage(why);
     }
   }
-  if (case_path.empty()) return usage("no case file given");
-  if (out_dir.empty()) return usage("no output directory given (-o OUTDIR)");
+  if (const std::string why = hm::check_case_and_output(case_path, out_dir); !why.empty()) return usage(why);
 
   hm::CaseSpec cs;
   try {
@@ -199,11 +182,8 @@ int main(int argc, char** argv) {
     std::cerr << "solver_demo: " << e.what() << "\n";
     return 2;
   }
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (ec || !fs::is_directory(out_dir)) {
-    std::cerr << "solver_demo: -o: cannot create directory '" << out_dir << "'" << (ec ? ": " + ec.message() : "")
-              << "\n";
+  if (const std::string why = hm::create_output_directory(out_dir); !why.empty()) {
+    std::cerr << "solver_demo: " << why << "\n";
     return 2;
   }
   return accuracy ? run_accuracy(cs, out_dir, levels, acc_opt) : run_flow(cs, out_dir);

@@ -2,12 +2,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "accuracy.hpp"
+#include "meshgen/core/text_file.hpp"
 
 namespace hm {
 
@@ -46,15 +46,8 @@ nlohmann::json errors_json(const AccuracyErrors& e) {
 }
 
 WriteStatus write_text(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) return {false, path + ": cannot open for writing"};
-    out << text;
-    out.flush();
-    if (!out) return {false, path + ": write failed"};
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) return {false, path + ": cannot rename the temporary file"};
+  std::string error;
+  if (!write_text_file(path, text, &error)) return {false, error};
   return {};
 }
 

@@ -497,6 +497,29 @@ TEST(Transmissibility, RingZeroConnectionFactorIsTheLogForm) {
   }
 }
 
+namespace {
+
+// The faces between a ring cell and a transition cell of a ring block with a transition
+// shell, with the face's radial (well) and shell (transition) cell and their half values.
+struct ShellFace {
+  int face, radial, shell;
+  double half_radial, half_shell;
+};
+
+std::vector<ShellFace> shell_faces(const PolyMesh& m, const Transmissibilities& t) {
+  std::vector<ShellFace> out;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const int o = m.face_owner[f], n = m.face_neighbour[f];
+    if (n < 0 || (m.cell_region[o] == kTransition) == (m.cell_region[n] == kTransition)) continue;
+    const bool owner_radial = m.cell_region[o] == kWell;
+    out.push_back({f, owner_radial ? o : n, owner_radial ? n : o, owner_radial ? t.half_owner[f] : t.half_neighbour[f],
+                   owner_radial ? t.half_neighbour[f] : t.half_owner[f]});
+  }
+  return out;
+}
+
+}  // namespace
+
 TEST(Transmissibility, OutermostRingFaceToTransitionCellUsesLogFormOnRadialSide) {
   RingSpec s;
   s.rings = 3;
@@ -508,20 +531,17 @@ TEST(Transmissibility, OutermostRingFaceToTransitionCellUsesLogFormOnRadialSide)
   EXPECT_EQ(t.negative, 0);
   const double theta = 2 * kPi / s.sectors, length = s.height / s.segments, k = 100;
   int checked = 0;
-  for (int f = 0; f < m.n_faces(); ++f) {
-    const int o = m.face_owner[f], n = m.face_neighbour[f];
-    if (n < 0 || (m.cell_region[o] == kTransition) == (m.cell_region[n] == kTransition)) continue;
-    const int radial = m.cell_region[o] == kWell ? o : n, shell = radial == o ? n : o;
-    const RadialCellInfo& r = m.cell_radial[radial];
+  for (const ShellFace& sf : shell_faces(m, t)) {
+    const int f = sf.face, shell = sf.shell, o = m.face_owner[f];
+    const RadialCellInfo& r = m.cell_radial[sf.radial];
     ASSERT_EQ(r.ring, s.rings - 1);
     // The radial half runs to the chord face (its centroid is r_out cos(theta/2) from the
     // axis), where the shell's half starts: the band between chord and arc is counted once.
     const double r_face = r.r_out * std::cos(0.5 * theta);
     EXPECT_NEAR(norm(g.face_centroid[f] - Vec3{0, 0, g.face_centroid[f].z}), r_face, 1e-12 * r_face);
     const double log_half = kDarcyMetric * theta * length * k / std::log(r_face / r.r_center);
-    const double t_radial = radial == o ? t.half_owner[f] : t.half_neighbour[f];
-    const double t_shell = shell == o ? t.half_owner[f] : t.half_neighbour[f];
-    EXPECT_NEAR(t_radial, log_half, 1e-13 * log_half);
+    const double t_shell = sf.half_shell;
+    EXPECT_NEAR(sf.half_radial, log_half, 1e-13 * log_half);
     // Shell side: power-cell form A k / (n . c).
     const Vec3 n_out = normalized((shell == o ? 1.0 : -1.0) * g.face_area[f]);
     const double d = dot(n_out, g.face_centroid[f] - m.cell_fv_center[shell]);
@@ -550,16 +570,14 @@ TEST(Transmissibility, OutermostRingFaceCountsTheChordArcBandOnce) {
     EXPECT_EQ(t.negative, 0);
     const double theta = 2 * kPi / s.sectors, length = s.height / s.segments, k = 100;
     int checked = 0;
-    for (int f = 0; f < m.n_faces(); ++f) {
-      const int o = m.face_owner[f], n = m.face_neighbour[f];
-      if (n < 0 || (m.cell_region[o] == kTransition) == (m.cell_region[n] == kTransition)) continue;
-      const int radial = m.cell_region[o] == kWell ? o : n, shell = radial == o ? n : o;
-      const RadialCellInfo& r = m.cell_radial[radial];
-      const Vec3 site = m.cell_fv_center[shell];
+    for (const ShellFace& sf : shell_faces(m, t)) {
+      const int f = sf.face;
+      const RadialCellInfo& r = m.cell_radial[sf.radial];
+      const Vec3 site = m.cell_fv_center[sf.shell];
       const double r_s = norm(site - Vec3{0, 0, site.z});
       const double exact = kDarcyMetric * theta * length * k / std::log(r_s / r.r_center);
-      const double shell_half = shell == o ? t.half_owner[f] : t.half_neighbour[f];
-      const double arc = 1.0 / (std::log(r.r_out / r.r_center) / (kDarcyMetric * theta * length * k) + 1.0 / shell_half);
+      const double arc =
+          1.0 / (std::log(r.r_out / r.r_center) / (kDarcyMetric * theta * length * k) + 1.0 / sf.half_shell);
       const double err_mesh = std::fabs(t.face[f] / exact - 1), err_arc = std::fabs(arc / exact - 1);
       EXPECT_LT(err_mesh, err_arc) << sectors << " sectors";
       if (checked == 0)
