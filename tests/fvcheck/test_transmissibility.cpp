@@ -518,16 +518,33 @@ std::vector<ShellFace> shell_faces(const PolyMesh& m, const Transmissibilities& 
   return out;
 }
 
+// A 3-ring block wrapped in a transition shell, with its transmissibilities.
+struct ShellBlock {
+  RingSpec s;
+  PolyMesh m;
+  MeshGeometry g;
+  Transmissibilities t;
+};
+
+ShellBlock shell_block(int sectors) {
+  ShellBlock b;
+  b.s.rings = 3;
+  b.s.sectors = sectors;
+  b.s.transition_shell = true;
+  b.m = ring_block(b.s);
+  b.g = compute_geometry(b.m);
+  b.t = compute_transmissibilities(b.m, b.g);
+  return b;
+}
+
 }  // namespace
 
 TEST(Transmissibility, OutermostRingFaceToTransitionCellUsesLogFormOnRadialSide) {
-  RingSpec s;
-  s.rings = 3;
-  s.sectors = 8;
-  s.transition_shell = true;
-  const PolyMesh m = ring_block(s);
-  const MeshGeometry g = compute_geometry(m);
-  const Transmissibilities t = compute_transmissibilities(m, g);
+  const ShellBlock b = shell_block(8);
+  const RingSpec& s = b.s;
+  const PolyMesh& m = b.m;
+  const MeshGeometry& g = b.g;
+  const Transmissibilities& t = b.t;
   EXPECT_EQ(t.negative, 0);
   const double theta = 2 * kPi / s.sectors, length = s.height / s.segments, k = 100;
   int checked = 0;
@@ -560,13 +577,10 @@ TEST(Transmissibility, OutermostRingFaceCountsTheChordArcBandOnce) {
   // the radial half to the arc r_out would be, for coarse and fine sectors. (What is left is
   // the linear power-cell half over r_s / r_f = 1.3-1.5 here.)
   for (int sectors : {6, 8, 12, 24}) {
-    RingSpec s;
-    s.rings = 3;
-    s.sectors = sectors;
-    s.transition_shell = true;
-    const PolyMesh m = ring_block(s);
-    const MeshGeometry g = compute_geometry(m);
-    const Transmissibilities t = compute_transmissibilities(m, g);
+    const ShellBlock b = shell_block(sectors);
+    const RingSpec& s = b.s;
+    const PolyMesh& m = b.m;
+    const Transmissibilities& t = b.t;
     EXPECT_EQ(t.negative, 0);
     const double theta = 2 * kPi / s.sectors, length = s.height / s.segments, k = 100;
     int checked = 0;
