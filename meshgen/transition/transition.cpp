@@ -107,7 +107,12 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
         os << "site " << s << (set.sites[s].internal() ? " (internal" : " (external") << ", polygon "
            << set.sites[s].polygons.front() << ") is hidden: moved toward its polygon and rebuilt";
       if (report.notes.size() < 50) report.notes.push_back(os.str());
-      if (set.sites[s].internal()) ++report.hidden_sites;
+      if (set.sites[s].kind == SiteKind::Free) {
+        set.sites[s].alive = false;
+        ++report.dropped_tip_sites;
+      } else if (set.sites[s].internal()) {
+        ++report.hidden_sites;
+      }
     }
     if (hidden_rounds++ == kMaxHiddenRepairs) {
       std::ostringstream os;
@@ -115,8 +120,12 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
       throw std::runtime_error(os.str());
     }
     ++report.hidden_repairs;
-    for (int s : hidden) shrink_or_split(set, s, kHiddenShrink, cavity, node_coords, grid, frames);
+    for (int s : hidden)
+      if (set.sites[s].alive) shrink_or_split(set, s, kHiddenShrink, cavity, node_coords, grid, frames);
     enforce_empty_spheres(set, cavity, node_coords, grid, frames);
+    // Free sites now inside a moved sphere go first, so that the correction never shrinks a
+    // polygon or box site on account of an optional site; and again after it.
+    report.dropped_tip_sites += drop_blocked_tip_sites(set);
     report.site_corrections +=
         correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
     report.correction_iterations += iterations;

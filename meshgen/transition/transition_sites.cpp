@@ -118,7 +118,7 @@ int add_mirror_site(SiteSet& set, int q, const Cavity& cavity, const std::vector
 }
 
 // Largest t of polygon q's internal site that keeps its sphere (and its reflection's) clearly
-// empty, within the site's own cap (end faces, lower_end_face_sites).
+// empty, within the site's own cap (end faces, place_end_face_sites).
 double max_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames) {
   const int in = set.internal_of[q];
   const double cap = in >= 0 ? set.sites[in].t_cap : kInf;

@@ -57,7 +57,7 @@ int cell_at(const ReservoirGrid& grid, Vec3 x) {
 }
 
 // Whether x is within `margin` of the block (its legs as cylinders of the outer radius, cut
-// at the end planes; spheres at the bends cover the bisector cuts there).
+// at the end planes; spheres at the wedge stations cover the joints between pieces).
 bool near_block(const WellBlock& b, Vec3 x, double margin) {
   const double r = b.radii.back() + margin;
   const std::vector<Vec3>& c = b.layer_center;
@@ -70,10 +70,8 @@ bool near_block(const WellBlock& b, Vec3 x, double margin) {
     if (s < 0 || s > len) continue;
     if (norm(x - c[k] - s * a) < r) return true;
   }
-  for (size_t k = 1; k + 1 < c.size(); ++k) {
-    const Vec3 a = normalized(c[k] - c[k - 1]), b = normalized(c[k + 1] - c[k]);
-    if (norm(cross(a, b)) > 1e-9 && norm(x - c[k]) < r) return true;  // a bend
-  }
+  for (size_t k = 1; k + 1 < c.size(); ++k)
+    if (b.layer_bend[k] >= 0 && norm(x - c[k]) < r) return true;  // a wedge station
   return false;
 }
 
