@@ -28,7 +28,6 @@ struct RadialSides {
   int32_t inner = -1;  ///< face at r_in (wellbore face for ring 0)
   int32_t outer = -1;  ///< face at r_out
   double k_perp = 0;
-  Vec3 axis;           ///< unit well axis (zero if the cell's geometry did not give one)
 };
 
 bool same_column(const RadialCellInfo& a, const RadialCellInfo& b) {
@@ -107,16 +106,15 @@ RadialSides classify_radial_cell(const PolyMesh& m, const MeshGeometry& g, int c
   if (quality < 1e-3 && norm(axial_sum) > 0) axis = axial_sum, quality = 1;
   const Vec3 k = m.cell_perm[c];
   out.k_perp = quality >= 1e-3 ? transverse_permeability(k, normalized(axis)) : std::cbrt(k.x * k.y * k.z);
-  if (quality >= 1e-3) out.axis = normalized(axis);
   return out;
 }
 
 // theta L k / |ln(r_f / r_c)| with L the face's own mean length along the axis,
 // |A_f| / (2 r_f sin(theta / 2)) (the face is a chord strip of that width). On a straight leg
-// that is the cell's axial length; next to a bend, where cross-sections lie in the bisector
-// plane, the ring faces are trapezoids longer on the outside of the bend and shorter on the
-// inside, and the cell's axial length would misstate their flow (measured on the bent
-// accuracy case: lateral error 2.44 % -> 0.31 % of the drawdown, docs/accuracy.md).
+// that is the cell's axial length; in a bend wedge the ring faces are trapezoids longer on
+// the outside of the bend and shorter on the inside, and the cell's axial length would
+// misstate their flow (measured on the bent accuracy case with the earlier bisector-plane
+// bends: lateral error 2.44 % -> 0.31 % of the drawdown, docs/accuracy.md).
 // `r_log` is the radius the log form runs to: the ring polygon's circumradius r_face, except
 // on the outermost ring's face toward a transition cell (outer_face_radius).
 double log_half(const RadialCellInfo& r, double r_face, double k_perp, double face_area, double r_log) {
@@ -128,14 +126,14 @@ double log_half(const RadialCellInfo& r, double r_face, double k_perp, double fa
 // The outermost ring's outer face is a chord; the transition cell beyond measures its half from
 // the chord plane (power-cell form), so the radial half must stop there too, or the band between
 // chord and arc r_out is counted on both sides (docs/accuracy.md, diagnosis item 3). It runs to
-// the face centroid's distance from the axis: r_center + the centroid's offset from the FV
-// centre across the axis (both lie on the sector's mid-angle ray; r_out cos(theta/2) for a
-// straight leg). Falls back on r_out when the axis is unknown or the result is not in
-// (r_center, r_out].
-double outer_face_radius(const RadialCellInfo& r, Vec3 axis, Vec3 fv_center, Vec3 face_centroid) {
-  if (norm(axis) == 0) return r.r_out;
-  const Vec3 c = face_centroid - fv_center;
-  const double r_f = r.r_center + norm(c - dot(c, axis) * axis);
+// the face centroid's distance from the axis: r_center + the centroid's signed offset from the
+// FV centre along the face's outward normal (both lie on the sector's mid-angle ray;
+// r_out cos(theta/2) for a straight leg). Falls back on r_out when the result is not in
+// (r_center, r_out] (a chord inside r_center: 3 or 4 sectors with close rings).
+double outer_face_radius(const RadialCellInfo& r, Vec3 area_out, Vec3 fv_center, Vec3 face_centroid) {
+  const double a = norm(area_out);
+  if (!(a > 0)) return r.r_out;
+  const double r_f = r.r_center + dot(face_centroid - fv_center, area_out) / a;
   return r_f > r.r_center && r_f <= r.r_out ? r_f : r.r_out;
 }
 
@@ -169,14 +167,16 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
     if (f == rs.outer) {
       const int32_t nb = m.face_owner[f] == c ? m.face_neighbour[f] : m.face_owner[f];
       const double r_log = nb >= 0 && m.cell_region[nb] == kTransition
-                               ? outer_face_radius(rc, rs.axis, m.cell_fv_center[c], g.face_centroid[f])
+                               ? outer_face_radius(rc, area_out, m.cell_fv_center[c], g.face_centroid[f])
                                : rc.r_out;
       return unit * log_half(rc, rc.r_out, rs.k_perp, norm(area_out), r_log);
     }
     if (m.cell_region[c] == kTransition) return unit * orthogonal_half(area_out, m.cell_perm[c], to_face);
     // A radial cell's angular and axial faces: the neighbour's FV centre is the mirror image of
-    // this one through the face (same radius, the next sector or segment), so the face is
-    // orthogonal to the segment between them and the orthogonal form is exact for a linear field.
+    // this one through the face (same radius, the next sector, or the next segment of the same
+    // straight part or wedge), so the face is orthogonal to the segment between them and the
+    // orthogonal form is exact for a linear field; across the joint between a straight part
+    // and a wedge, and on the block's end faces, it is the orthogonal part only.
     // The generic form would divide by |c|^2 and lose the radial offset between the FV centre
     // and the face centroid (a 0.2 m end segment of ring 5: half the transmissibility).
     if (opt.exact_radial && rc.well >= 0) return unit * orthogonal_half(area_out, m.cell_perm[c], to_face);
