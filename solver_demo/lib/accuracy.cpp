@@ -33,7 +33,7 @@ AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& opt
   s.source_inset = opt.source_to_tips ? 0.0 : ws.radius;
   // The well as meshed: the block cuts each bend's corner along its fillet wedges, so the
   // exact solution's source follows that axis (the trajectory itself for straight wells).
-  const std::vector<Vec3> axis = meshed_axis(make_gabriel_well_block(cs, 0));
+  const std::vector<Vec3> axis = meshed_axis(make_well_block(cs, 0, ws.sectors));  // independent of sectors
   s.field = make_line_source_field(axis, ws.radius, ws.bhp, cs.reservoir.initial_pressure, s.near_radius,
                                    s.source_inset);
   s.reference = field_reference(axis);

@@ -98,6 +98,10 @@ void check_problem(const FlowProblem& pb, const Transmissibilities& tr) {
   if (!(pb.compressibility >= 0) || !std::isfinite(pb.compressibility) || !std::isfinite(pb.reference_pressure) ||
       !(pb.formation_volume_factor > 0) || !std::isfinite(pb.formation_volume_factor))
     throw std::invalid_argument("solve_tpfa: compressibility must be >= 0, reference pressure finite, B_ref > 0");
+  // The incompressible solve works in reservoir volumes with b = 1: a B_ref other than 1 would
+  // silently change the meaning of the rates (surface volumes need the compressible path).
+  if (pb.compressibility == 0 && pb.formation_volume_factor != 1)
+    throw std::invalid_argument("solve_tpfa: B_ref must be 1 when compressibility is 0");
   for (const WellConnection& wc : pb.connections)
     if (wc.cell < 0 || wc.cell >= m.n_cells() || wc.well < 0 || !std::isfinite(wc.cf))
       throw std::invalid_argument("solve_tpfa: bad connection (well " + std::to_string(wc.well) + ", cell " +
@@ -188,8 +192,12 @@ FaceTerm face_term(const FlowProblem& pb, const Transmissibilities& tr, const Fl
       (st.rho[c] + st.rho[other]) / 2 * gravity_factor(pb) * (m.cell_fv_center[c].z - m.cell_fv_center[other].z);
   double b_up = 1.0;
   if (st.p != nullptr) {
-    const double dphi = (*st.p)[c] - (*st.p)[other] - drop;
-    b_up = dphi >= 0 ? st.b[c] : st.b[other];
+    // Decided once per face, from the owner's side (a tie goes to the owner), so that both
+    // rows of the face use the same b and the matrix stays symmetric.
+    const int32_t own = m.face_owner[f], nei = m.face_neighbour[f];
+    const double dz = m.cell_fv_center[own].z - m.cell_fv_center[nei].z;
+    const double dphi = (*st.p)[own] - (*st.p)[nei] - (st.rho[own] + st.rho[nei]) / 2 * gravity_factor(pb) * dz;
+    b_up = dphi >= 0 ? st.b[own] : st.b[nei];
   }
   return {t * b_up, drop};
 }

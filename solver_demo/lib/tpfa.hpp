@@ -93,7 +93,7 @@ struct FlowSolution {
 };
 
 /// Assembles and solves (Picard iteration on b and rho when compressibility > 0, each step a
-/// symmetric system with the upstream b frozen, to a pressure change < 1e-12 relative). Throws std::invalid_argument for an ill-posed problem (no mesh, a
+/// symmetric system with the upstream b frozen, to a pressure change < 1e-11 relative). Throws std::invalid_argument for an ill-posed problem (no mesh, a
 /// connected group of cells with no pressure reference, non-finite input) and
 /// std::runtime_error when the linear solver fails to reach the tolerance.
 FlowSolution solve_tpfa(const FlowProblem& problem, const Transmissibilities& trans);

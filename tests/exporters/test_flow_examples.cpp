@@ -56,7 +56,8 @@ TpfaSolution compressible_reference_solve(const hm::CaseSpec& cs, const hm::Poly
   auto p_conn = [&](size_t w, int c) { return conn_pressure.at({w, c}); };
   std::vector<double> p(n, pref);
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-  for (int it = 0; it < 30; ++it) {
+  bool converged = false;
+  for (int it = 0; it < 30 && !converged; ++it) {
     std::vector<Eigen::Triplet<double>> trip;
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
     for (int f = 0; f < mesh.n_faces(); ++f) {
@@ -86,8 +87,9 @@ TpfaSolution compressible_reference_solve(const hm::CaseSpec& cs, const hm::Poly
     double change = 0;
     for (int c = 0; c < n; ++c) change = std::max(change, std::abs(x[c] - p[c]));
     p.assign(x.data(), x.data() + n);
-    if (change < 1e-9 * pref) break;
+    converged = change < 1e-9 * pref;
   }
+  EXPECT_TRUE(converged) << "the reference Picard iteration did not converge in 30 steps";
   TpfaSolution s;
   s.pressure = p;
   s.well_rate.assign(wells.size(), 0.0);

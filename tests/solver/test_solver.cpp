@@ -422,6 +422,12 @@ TEST(Compressible, BadFluidDataIsRejected) {
   t.pb.compressibility = 1e-5;
   t.pb.formation_volume_factor = 0;
   EXPECT_THROW(solve_tpfa(t.pb, t.tr), std::invalid_argument);
+  // B_ref only has a meaning on the compressible path.
+  t.pb.compressibility = 0;
+  t.pb.formation_volume_factor = 1.02;
+  EXPECT_THROW(solve_tpfa(t.pb, t.tr), std::invalid_argument);
+  t.pb.formation_volume_factor = 1;
+  EXPECT_NO_THROW(solve_tpfa(t.pb, t.tr));
 }
 
 // ---------------------------------------------------------------- orderings
