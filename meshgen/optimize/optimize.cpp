@@ -246,7 +246,6 @@ CellMeasures measure_cell(const EditableMesh& m, const PolyMesh& src, const std:
       return r;
     }
   }
-  if (vol <= 1e-12 * L * L * L) return r;
   // Q_S (eq. 7) over the distinct edges.
   const double h = h_ref.size() > static_cast<size_t>(c) && h_ref[c] > 0 ? h_ref[c] : L;
   r.q_s = 1;
@@ -340,6 +339,7 @@ class Optimizer {
     convex0_.assign(nc, 0);
     centred0_.assign(nc, 0);
     cell_stamp_.assign(nc, 0);
+    qs_.assign(nc, 1.0);
     for (int c = 0; c < nc; ++c) {
       if (src.cell_region[c] != kTransition) continue;
       const CellMeasures cm = measure_cell(m_, src_, h_ref_, c);
@@ -347,10 +347,8 @@ class Optimizer {
       thr_p_[c] = std::max(p.omega_p, cm.q_p);
       convex0_[c] = cm.valid && cm.convex;
       centred0_[c] = cm.valid && cm.centred;
+      qs_[c] = cm.q_s;
     }
-    qs_.assign(nc, 1.0);
-    for (int c = 0; c < nc; ++c)
-      if (src.cell_region[c] == kTransition) qs_[c] = measure_cell(m_, src_, h_ref_, c).q_s;
     centre_.resize(nc);
     for (int c = 0; c < nc; ++c) centre_[c] = cell_centre(c);
     skew_ok_.resize(m_.faces.size());
@@ -587,11 +585,10 @@ class Optimizer {
 
   // Validity (closed, non-degenerate, positive volume, still convex if it was) and the FV
   // controls of paper 6.2 (per-cell orthogonality and planarity thresholds,
-  // auto-centering) on every touched cell; for an expansion also a better mean Q_S.
-  bool accept(const std::set<int32_t>& cells, const std::set<int32_t>* must_improve_qs, double qs_before,
-              int32_t target_face = -1, double target_skew = 0) {
+  // auto-centering) on every touched cell. (An expansion's shape test is its caller's:
+  // try_expand_ends compares the mean Q_S from edge lengths first.)
+  bool accept(const std::set<int32_t>& cells, int32_t target_face = -1, double target_skew = 0) {
     std::vector<std::pair<int32_t, CellMeasures>> measured;
-    double qs_sum = 0;
     for (int32_t c : cells) {
       CellLimits lim;
       lim.min_q_o = thr_o_[c];
@@ -604,11 +601,8 @@ class Optimizer {
       if (cm.failed == kFailOrthogonality) return reject(&OptimizeReport::rejected_orthogonality);
       if (cm.failed == kFailPlanarity) return reject(&OptimizeReport::rejected_planarity);
       if (cm.failed == kFailCentering) return reject(&OptimizeReport::rejected_centering);
-      qs_sum += cm.q_s;
       measured.push_back({c, cm});
     }
-    if (must_improve_qs && qs_sum / std::max<size_t>(1, cells.size()) <= qs_before)
-      return reject(&OptimizeReport::rejected_shape);
     // OpenFOAM skewness of every face of the touched cells (their centres moved): a face
     // within the limit stays within it. (A cap at each skewed face's own level refused
     // operations that removed skewed faces elsewhere: three_wells kept 138 instead of 106.)
@@ -738,7 +732,7 @@ class Optimizer {
       m_.faces[f] = cyc;
       if (cyc.size() < 3) m_.alive[f] = 0;
     }
-    if (!accept(cells, nullptr, 0, skew_face, skew_before)) {
+    if (!accept(cells, skew_face, skew_before)) {
       restore(s);
       return false;
     }
@@ -768,7 +762,10 @@ class Optimizer {
   bool reduce_skewness(int32_t f) {
     const double before = face_skewness(f, {});
     const std::vector<int32_t> cyc = m_.faces[f];
-    for (size_t k = 0; k <= cyc.size(); ++k)
+    // With a constrained vertex the face can only go to that vertex: one attempt.
+    const bool any_fixed = std::any_of(cyc.begin(), cyc.end(), [&](int32_t v) { return m_.fixed[v] != 0; });
+    const size_t targets = any_fixed ? 0 : cyc.size();
+    for (size_t k = 0; k <= targets; ++k)
       if (try_merge(cyc, static_cast<int>(k), f, before)) return true;
     std::vector<std::pair<double, std::pair<int32_t, int32_t>>> edges;
     for (size_t i = 0; i < cyc.size(); ++i) {
@@ -846,7 +843,7 @@ class Optimizer {
       restore(saved);
       return reject(&OptimizeReport::rejected_shape);
     }
-    if (!accept(cells, nullptr, 0)) {
+    if (!accept(cells)) {
       restore(saved);
       return false;
     }

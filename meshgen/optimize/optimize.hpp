@@ -33,7 +33,7 @@ struct OptimizeReport {
   int rejected_planarity = 0;    ///< Q_P(V) above the cell's threshold
   int rejected_centering = 0;    ///< a site would leave its cell
   int rejected_shape = 0;        ///< expansion without mean Q_S improvement
-  int rejected_skewness = 0;     ///< a face's OpenFOAM skewness above max(limit, its level)
+  int rejected_skewness = 0;     ///< a face within the skewness limit pushed above it (or the target face not unskewed)
   int skewness_removed = 0;      ///< skewness phase: operations that removed or unskewed a face
   int skewed_faces = 0;          ///< after: faces of transition cells with OpenFOAM skewness > kOpenFoamSkewnessLimit
   double max_skewness = 0;       ///< after: their largest OpenFOAM skewness
