@@ -278,9 +278,10 @@ SiteSet make_sites(const Cavity& cavity, const std::vector<Vec3>& coords, const 
     if (cf.outside_cell >= 0) by_outside[cf.outside_cell].push_back(q);
   }
   // External sites first (placing a polygon site needs to know its partner's kind).
-  for (const auto& [cell, polygons] : by_outside) {
+  // A reservoir cell's centre with the half-diagonal weight, shared by its polygons.
+  auto add_box_site = [&](SiteKind kind, int cell, const std::vector<int>& polygons, std::vector<int>& site_of) {
     Site s;
-    s.kind = SiteKind::ExternalBox;
+    s.kind = kind;
     s.reservoir_cell = cell;
     const Box b = reservoir_box(grid, cell);
     s.p = b.center;
@@ -288,24 +289,13 @@ SiteSet make_sites(const Cavity& cavity, const std::vector<Vec3>& coords, const 
     s.polygons = polygons;
     s.vertices = vertices_of(cavity, polygons);
     set.sites.push_back(s);
-    for (int q : polygons) set.external_of[q] = static_cast<int>(set.sites.size()) - 1;
-  }
+    for (int q : polygons) site_of[q] = static_cast<int>(set.sites.size()) - 1;
+  };
+  for (const auto& [cell, polygons] : by_outside) add_box_site(SiteKind::ExternalBox, cell, polygons, set.external_of);
   // Internal sites: a box site per deactivated cell with n > 1 polygons (P = V, the
   // intersection of their dual lines = the cell centre), a polygon site otherwise.
-  for (const auto& [cell, polygons] : by_inside) {
-    if (polygons.size() > 1) {
-      Site s;
-      s.kind = SiteKind::InternalBox;
-      s.reservoir_cell = cell;
-      const Box b = reservoir_box(grid, cell);
-      s.p = b.center;
-      s.w2 = b.w2;
-      s.polygons = polygons;
-      s.vertices = vertices_of(cavity, polygons);
-      set.sites.push_back(s);
-      for (int q : polygons) set.internal_of[q] = static_cast<int>(set.sites.size()) - 1;
-    }
-  }
+  for (const auto& [cell, polygons] : by_inside)
+    if (polygons.size() > 1) add_box_site(SiteKind::InternalBox, cell, polygons, set.internal_of);
   for (int q = 0; q < nq; ++q) {
     if (set.external_of[q] >= 0) continue;
     // Well polygons, end caps, and reservoir polygons on the outer boundary: mirrors.

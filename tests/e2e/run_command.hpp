@@ -40,6 +40,19 @@ inline CommandResult run_command(const std::string& command, int timeout_s = 600
   return r;
 }
 
+/// A path quoted for the shell.
+inline std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+/// Removes a test's directory at scope exit (flow and checkMesh outputs are large), unless
+/// HM_KEEP_TEST_OUTPUT is set.
+struct RemoveAtExit {
+  std::filesystem::path dir;
+  ~RemoveAtExit() {
+    std::error_code ec;
+    if (std::getenv("HM_KEEP_TEST_OUTPUT") == nullptr) std::filesystem::remove_all(dir, ec);
+  }
+};
+
 /// A fresh temporary directory for one test.
 inline std::filesystem::path fresh_dir(const std::string& name) {
   namespace fs = std::filesystem;

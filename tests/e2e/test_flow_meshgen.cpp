@@ -14,6 +14,8 @@
 
 namespace fs = std::filesystem;
 using hm_test::fresh_dir;
+using hm_test::q;
+using hm_test::RemoveAtExit;
 using hm_test::run_command;
 using hm_test::slurp;
 
@@ -21,17 +23,7 @@ namespace {
 
 const std::string kMeshgen = std::string(HM_BIN_DIR) + "/meshgen";
 const std::string kSolver = std::string(HM_BIN_DIR) + "/solver_demo";
-std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 
-// Removes a test's directory at scope exit (flow and checkMesh outputs are large), unless
-// HM_KEEP_TEST_OUTPUT is set.
-struct RemoveAtExit {
-  fs::path dir;
-  ~RemoveAtExit() {
-    std::error_code ec;
-    if (std::getenv("HM_KEEP_TEST_OUTPUT") == nullptr) fs::remove_all(dir, ec);
-  }
-};
 
 bool have(const std::string& exe) { return run_command("sh -c 'command -v " + exe + "'", 10).exit_code == 0; }
 

@@ -10,6 +10,7 @@
 
 namespace fs = std::filesystem;
 using hm_test::fresh_dir;
+using hm_test::q;
 using hm_test::run_command;
 using hm_test::slurp;
 
@@ -68,7 +69,6 @@ fs::path write(const fs::path& d, const std::string& name, const std::string& te
   return d / name;
 }
 
-std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 
 }  // namespace
 

@@ -12,23 +12,15 @@
 
 namespace fs = std::filesystem;
 using hm_test::fresh_dir;
+using hm_test::q;
+using hm_test::RemoveAtExit;
 using hm_test::run_command;
 using hm_test::slurp;
 
 namespace {
 
 const std::string kMeshgen = std::string(HM_BIN_DIR) + "/meshgen";
-std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
 
-// Removes a test's directory at scope exit (flow and checkMesh outputs are large), unless
-// HM_KEEP_TEST_OUTPUT is set.
-struct RemoveAtExit {
-  fs::path dir;
-  ~RemoveAtExit() {
-    std::error_code ec;
-    if (std::getenv("HM_KEEP_TEST_OUTPUT") == nullptr) fs::remove_all(dir, ec);
-  }
-};
 
 void check_example(const std::string& example) {
   if (run_command("sh -c 'command -v checkMesh'", 10).exit_code != 0)
