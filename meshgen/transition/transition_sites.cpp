@@ -90,29 +90,28 @@ double initial_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& fra
   return 0.5 * reach;
 }
 
-int add_polygon_site(SiteSet& set, int q, const Cavity& cavity, const std::vector<Vec3>& coords,
-                     const std::vector<PolygonFrame>& frames) {
+// A site of one polygon (placed by the caller); returns its id.
+int push_polygon_site(SiteSet& set, SiteKind kind, int q, const Cavity& cavity) {
   Site s;
-  s.kind = SiteKind::InternalPolygon;
+  s.kind = kind;
   s.polygon = q;
   s.polygons = {q};
   s.vertices = vertices_of(cavity, s.polygons);
   set.sites.push_back(s);
   const int id = static_cast<int>(set.sites.size()) - 1;
-  set.internal_of[q] = id;
+  (kind == SiteKind::ExternalMirror ? set.external_of : set.internal_of)[q] = id;
+  return id;
+}
+
+int add_polygon_site(SiteSet& set, int q, const Cavity& cavity, const std::vector<Vec3>& coords,
+                     const std::vector<PolygonFrame>& frames) {
+  const int id = push_polygon_site(set, SiteKind::InternalPolygon, q, cavity);
   place_polygon_site(set, id, initial_t(set, q, frames), cavity, coords, frames);
   return id;
 }
 
 int add_mirror_site(SiteSet& set, int q, const Cavity& cavity, const std::vector<PolygonFrame>& frames) {
-  Site s;
-  s.kind = SiteKind::ExternalMirror;
-  s.polygon = q;
-  s.polygons = {q};
-  s.vertices = vertices_of(cavity, s.polygons);
-  set.sites.push_back(s);
-  const int id = static_cast<int>(set.sites.size()) - 1;
-  set.external_of[q] = id;
+  const int id = push_polygon_site(set, SiteKind::ExternalMirror, q, cavity);
   update_mirror(set, q, frames);
   return id;
 }
