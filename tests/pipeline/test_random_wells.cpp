@@ -1,4 +1,4 @@
-// Robustness: random straight deviated wells (fixed seed) in a refined reservoir. Every
+// Robustness: random straight deviated wells and random bent wells (fixed seeds) in a refined reservoir. Every
 // case must give a conforming mesh whose volume is the box minus the wellbore holes, or a
 // clear InputError; never another failure.
 #include <gtest/gtest.h>
@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "fvcheck/lib/checks.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 
@@ -60,4 +61,56 @@ TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
   }
   std::printf("[ random    ] %d meshed, %d refused as input\n", meshed, refused);
   EXPECT_GE(meshed, 8);
+}
+
+// Random bent wells (two legs, bends of 10-110 degrees in random planes): the bend wedges must
+// give a conforming mesh, convex transition cells with their sites inside (fvcheck), and a
+// volume equal to the box minus the wellbore hole, whose exact volume is the inner polygon's
+// area times the block's prism length (wedges included).
+TEST(RandomWells, BentWellsMeshConvexAndExactOrAreRefusedAsInput) {
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<double> u(0, 1);
+  int meshed = 0, refused = 0;
+  for (int t = 0; t < 12; ++t) {
+    CaseSpec cs;
+    cs.name = "random_bent";
+    cs.reservoir.x = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
+    cs.reservoir.y = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
+    cs.reservoir.z = axis({980, 995}, 1005, 1055, 4, {1065, 1080});
+    const double bend = (10 + 100 * u(rng)) * M_PI / 180, turn = 2 * M_PI * u(rng);
+    const Vec3 a{120 + 4 * u(rng), 120 + 4 * u(rng), 1012 + 4 * u(rng)};
+    const Vec3 b = a + Vec3{0, 0, 14};
+    // Second leg: turned by `bend` from the vertical, azimuth `turn`.
+    const Vec3 d2{std::sin(bend) * std::cos(turn), std::sin(bend) * std::sin(turn), std::cos(bend)};
+    WellSpec w;
+    w.name = "B";
+    w.trajectory = {a, b, b + 14.0 * d2};
+    w.radius = 0.1;
+    w.drainage_radius = 3;
+    w.rings = 4;
+    w.sectors = 12;
+    w.segment_length = 3;
+    cs.wells.push_back(w);
+    SCOPED_TRACE("case " + std::to_string(t) + ", bend " + std::to_string(bend * 180 / M_PI) + " deg");
+    try {
+      PipelineOptions opts;
+      opts.optimize = false;
+      const HybridMesh h = build_hybrid_mesh(cs, opts);
+      ASSERT_TRUE(h.build_report.ok);
+      const int sectors = h.blocks.at(0).sectors;
+      const double hole = 0.5 * sectors * w.radius * w.radius * std::sin(2 * M_PI / sectors) *
+                          well_block_prism_length(cs, 0);
+      const double expected = 200.0 * 200.0 * 100.0 - hole;
+      EXPECT_NEAR(total_volume(h.geometry), expected, 1e-9 * expected);
+      EXPECT_EQ(check_convexity(h.mesh, h.geometry).violations, 0);
+      EXPECT_EQ(check_auto_centering(h.mesh, h.geometry).violations, 0);
+      EXPECT_EQ(check_conformity(h.mesh, h.geometry).violations, 0);
+      ++meshed;
+    } catch (const InputError& e) {
+      ++refused;
+      std::printf("[ refused   ] case %d: %s\n", t, e.what());
+    }
+  }
+  std::printf("[ random    ] bent: %d meshed, %d refused as input\n", meshed, refused);
+  EXPECT_GE(meshed, 10);
 }
