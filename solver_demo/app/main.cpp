@@ -35,25 +35,11 @@ int usage(const std::string& why) {
   return 2;
 }
 
-int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
-  hm::HybridMesh mesh;
-  hm::FlowSolution sol;
+// Runs `work`; an InputError is the user's (exit 2), anything else a failure (exit 1); 0 if it ran.
+template <class Work>
+int guarded(Work work) {
   try {
-    mesh = hm::build_hybrid_mesh(cs);
-    hm::FlowProblem pb;
-    pb.mesh = &mesh.mesh;
-    pb.geo = &mesh.geometry;
-    pb.viscosity_cp = cs.fluid.viscosity;
-    pb.density = cs.fluid.density;
-    pb.gravity = true;
-    // The deck's PVTW: Pref = initial pressure, B_ref = 1, Cw raised to 1e-8 /bar as the exporter does.
-    pb.compressibility = std::max(cs.fluid.compressibility, 1e-8);
-    pb.reference_pressure = cs.reservoir.initial_pressure;
-    pb.formation_volume_factor = 1.0;
-    for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w) {
-      pb.wells.push_back({w, cs.wells[w].bhp, cs.wells[w].trajectory.front().z});
-    }
-    sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry));
+    work();
   } catch (const hm::InputError& e) {
     std::cerr << "solver_demo: " << e.what() << "\n";
     return 2;
@@ -61,6 +47,30 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
     std::cerr << "solver_demo: " << e.what() << "\n";
     return 1;
   }
+  return 0;
+}
+
+int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
+  hm::HybridMesh mesh;
+  hm::FlowSolution sol;
+  if (const int rc = guarded([&] {
+        mesh = hm::build_hybrid_mesh(cs);
+        hm::FlowProblem pb;
+        pb.mesh = &mesh.mesh;
+        pb.geo = &mesh.geometry;
+        pb.viscosity_cp = cs.fluid.viscosity;
+        pb.density = cs.fluid.density;
+        pb.gravity = true;
+        // The deck's PVTW: Pref = initial pressure, B_ref = 1, Cw raised to 1e-8 /bar as the exporter does.
+        pb.compressibility = std::max(cs.fluid.compressibility, 1e-8);
+        pb.reference_pressure = cs.reservoir.initial_pressure;
+        pb.formation_volume_factor = 1.0;
+        for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w) {
+          pb.wells.push_back({w, cs.wells[w].bhp, cs.wells[w].trajectory.front().z});
+        }
+        sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry));
+      }))
+    return rc;
 
   nlohmann::json j;
   j["case"] = cs.name;
@@ -114,15 +124,7 @@ std::string percent(double v) {
 
 int run_accuracy(const hm::CaseSpec& cs, const fs::path& out, int levels, const hm::AccuracyOptions& opt) {
   hm::AccuracyStudy st;
-  try {
-    st = hm::run_accuracy_study(cs, levels, opt);
-  } catch (const hm::InputError& e) {
-    std::cerr << "solver_demo: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "solver_demo: " << e.what() << "\n";
-    return 1;
-  }
+  if (const int rc = guarded([&] { st = hm::run_accuracy_study(cs, levels, opt); })) return rc;
   for (const auto& [name, status] :
        {std::pair{std::string("accuracy.json"), hm::write_accuracy_json((out / "accuracy.json").string(), st)},
         std::pair{std::string("accuracy.svg"), hm::write_accuracy_svg((out / "accuracy.svg").string(), st)}})

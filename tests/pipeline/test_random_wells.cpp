@@ -20,6 +20,26 @@ std::vector<double> axis(std::initializer_list<double> coarse_lo, double fine_lo
   v.insert(v.end(), coarse_hi);
   return v;
 }
+
+// A 200 x 200 x 100 m reservoir refined to 4 m around (100-140, 100-140, 1005-1055), one well.
+CaseSpec random_case(const std::string& name, const WellSpec& well) {
+  CaseSpec cs;
+  cs.name = name;
+  cs.reservoir.x = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
+  cs.reservoir.y = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
+  cs.reservoir.z = axis({980, 995}, 1005, 1055, 4, {1065, 1080});
+  cs.wells.push_back(well);
+  return cs;
+}
+
+// The box minus the wellbore hole: the inner polygon's area times the block's prism length
+// (the trajectory length for a straight well; wedges included at bends).
+double box_minus_hole(const CaseSpec& cs, const HybridMesh& h) {
+  const int sectors = h.blocks.at(0).sectors;
+  const double r_w = cs.wells[0].radius;
+  return 200.0 * 200.0 * 100.0 -
+         0.5 * sectors * r_w * r_w * std::sin(2 * M_PI / sectors) * well_block_prism_length(cs, 0);
+}
 }  // namespace
 
 TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
@@ -27,11 +47,6 @@ TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
   std::uniform_real_distribution<double> u(0, 1);
   int meshed = 0, refused = 0;
   for (int t = 0; t < 10; ++t) {
-    CaseSpec cs;
-    cs.name = "random";
-    cs.reservoir.x = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
-    cs.reservoir.y = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
-    cs.reservoir.z = axis({980, 995}, 1005, 1055, 4, {1065, 1080});
     const double inc = u(rng) * M_PI / 2, az = u(rng) * 2 * M_PI, len = 10 + 10 * u(rng);
     const Vec3 a{112 + 16 * u(rng), 112 + 16 * u(rng), 1015 + 8 * u(rng)};
     const Vec3 b = a + len * Vec3{std::sin(inc) * std::cos(az), std::sin(inc) * std::sin(az), std::cos(inc)};
@@ -43,15 +58,14 @@ TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
     w.rings = 5;
     w.sectors = 12;
     w.segment_length = 4;
-    cs.wells.push_back(w);
+    const CaseSpec cs = random_case("random", w);
     SCOPED_TRACE("case " + std::to_string(t));
     try {
       PipelineOptions opts;
       opts.optimize = false;
       const HybridMesh h = build_hybrid_mesh(cs, opts);
       ASSERT_TRUE(h.build_report.ok);
-      const double wellbore = 0.5 * w.sectors * w.radius * w.radius * std::sin(2 * M_PI / w.sectors) * len;
-      const double expected = (200.0 * 200.0 * 100.0) - wellbore;
+      const double expected = box_minus_hole(cs, h);
       EXPECT_NEAR(total_volume(h.geometry), expected, 1e-9 * expected);
       ++meshed;
     } catch (const InputError& e) {
@@ -72,11 +86,6 @@ TEST(RandomWells, BentWellsMeshConvexAndExactOrAreRefusedAsInput) {
   std::uniform_real_distribution<double> u(0, 1);
   int meshed = 0, refused = 0;
   for (int t = 0; t < 12; ++t) {
-    CaseSpec cs;
-    cs.name = "random_bent";
-    cs.reservoir.x = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
-    cs.reservoir.y = axis({0, 40, 70, 90}, 100, 140, 4, {150, 170, 200});
-    cs.reservoir.z = axis({980, 995}, 1005, 1055, 4, {1065, 1080});
     const double bend = (10 + 100 * u(rng)) * M_PI / 180, turn = 2 * M_PI * u(rng);
     const Vec3 a{120 + 4 * u(rng), 120 + 4 * u(rng), 1012 + 4 * u(rng)};
     const Vec3 b = a + Vec3{0, 0, 14};
@@ -90,17 +99,14 @@ TEST(RandomWells, BentWellsMeshConvexAndExactOrAreRefusedAsInput) {
     w.rings = 4;
     w.sectors = 12;
     w.segment_length = 3;
-    cs.wells.push_back(w);
+    const CaseSpec cs = random_case("random_bent", w);
     SCOPED_TRACE("case " + std::to_string(t) + ", bend " + std::to_string(bend * 180 / M_PI) + " deg");
     try {
       PipelineOptions opts;
       opts.optimize = false;
       const HybridMesh h = build_hybrid_mesh(cs, opts);
       ASSERT_TRUE(h.build_report.ok);
-      const int sectors = h.blocks.at(0).sectors;
-      const double hole = 0.5 * sectors * w.radius * w.radius * std::sin(2 * M_PI / sectors) *
-                          well_block_prism_length(cs, 0);
-      const double expected = 200.0 * 200.0 * 100.0 - hole;
+      const double expected = box_minus_hole(cs, h);
       EXPECT_NEAR(total_volume(h.geometry), expected, 1e-9 * expected);
       EXPECT_EQ(check_convexity(h.mesh, h.geometry).violations, 0);
       EXPECT_EQ(check_auto_centering(h.mesh, h.geometry).violations, 0);
