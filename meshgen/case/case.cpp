@@ -326,7 +326,8 @@ std::vector<Vec3> read_trajectory(const YAML::Node& n, const std::string& path, 
 
 WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_budget) {
   const Fields f(n, path,
-                 {"name", "type", "trajectory", "radius", "drainage_radius", "rings", "sectors", "segment_length", "bhp"});
+                 {"name", "type", "trajectory", "radius", "drainage_radius", "rings", "sectors", "segment_length", "bhp",
+                  "end_caps"});
   WellSpec w;
   w.name = read_string(f.required("name"), f.path("name"));
   require(matches_name_charset(w.name), f.path("name"), "must match [A-Za-z0-9_-]+");
@@ -351,6 +352,12 @@ WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_
   require(w.segment_length > 0, f.path("segment_length"), "must be > 0");
   w.bhp = read_number(f.required("bhp"), f.path("bhp"));
   require(w.bhp > 0, f.path("bhp"), "must be > 0");
+  if (auto e = f.get("end_caps")) {
+    const std::string s = e->IsScalar() ? e->Scalar() : std::string();
+    if (e->IsScalar() && s == "flat") w.end_caps = EndCaps::Flat;
+    else if (e->IsScalar() && s == "hemisphere") w.end_caps = EndCaps::Hemisphere;
+    else fail(f.path("end_caps"), "expected flat or hemisphere, got " + describe(*e));
+  }
   return w;
 }
 
@@ -389,6 +396,7 @@ void check_wells(const CaseSpec& cs) {
     double segments = 0;
     for (size_t i = 0; i + 1 < w.trajectory.size(); ++i)
       segments += std::max(1.0, std::ceil(norm(w.trajectory[i + 1] - w.trajectory[i]) / w.segment_length));
+    if (w.end_caps == EndCaps::Hemisphere) segments += 2.0 * hemisphere_cap_bands(w.sectors);
     const double cells = double(w.rings) * double(w.sectors) * segments;
     total_cells += cells;
     if (total_cells > kMaxCells)

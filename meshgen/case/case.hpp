@@ -26,6 +26,12 @@ struct ReservoirSpec {
 
 enum class WellType { Producer, Injector };
 
+/// How the radial block closes at the trajectory's two ends (docs/case-format.md).
+enum class EndCaps {
+  Flat,        ///< flat end faces through the end points; the transition mesh fills beyond them
+  Hemisphere,  ///< a radial half-ball block per end (paper 5.1, "segments of a sphere")
+};
+
 struct WellSpec {
   std::string name;
   WellType type = WellType::Producer;
@@ -36,7 +42,11 @@ struct WellSpec {
   int sectors = 12;               ///< angular cells, >= 3 (raised when Gabriel needs it)
   double segment_length = 4.0;    ///< target cell length along the trajectory (m), > 0
   double bhp = 150;               ///< bottom-hole pressure (bar)
+  EndCaps end_caps = EndCaps::Hemisphere;  ///< closing of the block at both ends
 };
+
+/// Latitude bands of a hemispherical end cap: about as wide as a sector (sectors / 4, >= 1).
+inline int hemisphere_cap_bands(int sectors) { return sectors < 6 ? 1 : (sectors + 2) / 4; }
 
 struct TransitionSpec {
   double dilation = 1.5;                       ///< >= 1

@@ -201,7 +201,11 @@ std::vector<BendPlan> plan_bends(const WellSpec& ws, int w, const std::vector<Le
     p.radius = std::max(kMinFilletFactor * ws.drainage_radius, std::min(preferred, cap / half_tan));
     p.tangent = p.radius * half_tan;
     const int by_angle = static_cast<int>(std::ceil(p.angle / kMaxWedgeAngle));
-    const int by_length = static_cast<int>(std::lround(p.radius * p.angle / ws.segment_length));
+    // No wedge longer than a segment on the outside of the bend (arc radius rho + R): longer
+    // wedges there cost accuracy (docs/accuracy.md: 2 wedges on the bent case, 0.95 % of the
+    // drawdown next to the bend; 4 wedges, 0.38 %).
+    const int by_length =
+        static_cast<int>(std::ceil((p.radius + ws.drainage_radius) * p.angle / ws.segment_length - 1e-9));
     p.wedges = std::max({1, by_angle, by_length});
   }
   return plans;
@@ -213,10 +217,23 @@ struct Station {
   int bend_point = -1;  // trajectory point of the bend whose wedges it bounds, -1 on straight parts
 };
 
+// Distances from a trajectory end of the extra stations of a block with hemispherical caps:
+// r_k - r_w for the rings' radii r_k below segment_length. Near a well's end the field varies
+// along the axis on the scale of the distance to the end, as it does radially: the cap's
+// cells next to the end cross-section are as small as the rings, and so must be the layers
+// of the cylinder behind it (docs/architecture.md, "End caps").
+std::vector<double> end_grading(const WellSpec& ws, const std::vector<double>& radii) {
+  std::vector<double> g;
+  if (ws.end_caps != EndCaps::Hemisphere) return g;
+  for (size_t k = 1; k < radii.size() && radii[k] - radii[0] < ws.segment_length; ++k) g.push_back(radii[k] - radii[0]);
+  return g;
+}
+
 // Stations along the trajectory: straight parts of each leg split into segments of about
-// segment_length, bends replaced by their wedges.
+// segment_length, bends replaced by their wedges; with hemispherical caps, the stations of
+// end_grading at both trajectory ends.
 std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& legs,
-                                   const std::vector<BendPlan>& plans) {
+                                   const std::vector<BendPlan>& plans, const std::vector<double>& radii) {
   const int n_legs = static_cast<int>(legs.size());
   std::vector<const BendPlan*> plan_at(n_legs + 1, nullptr);
   for (const BendPlan& p : plans) plan_at[p.point] = &p;
@@ -225,12 +242,24 @@ std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& l
     const Leg& g = legs[k];
     const double t0 = plan_at[k] ? plan_at[k]->tangent : 0.0;
     const double t1 = plan_at[k + 1] ? plan_at[k + 1]->tangent : 0.0;
-    const Vec3 s0 = g.a + t0 * g.d, s1 = g.b - t1 * g.d;
+    Vec3 s0 = g.a + t0 * g.d, s1 = g.b - t1 * g.d;
     if (k == 0) st.push_back({s0, g.d, g.u, g.v, -1});
     // (a bend's last station, already pushed, is s0 of this leg)
-    const double straight = g.length - t0 - t1;
+    // Graded stations at the trajectory's ends, as many as leave half a segment between them.
+    std::vector<double> lo = k == 0 ? end_grading(ws, radii) : std::vector<double>{};
+    std::vector<double> hi = k + 1 == n_legs ? end_grading(ws, radii) : std::vector<double>{};
+    const double full = g.length - t0 - t1;
+    while (!(lo.empty() && hi.empty()) &&
+           (lo.empty() ? 0.0 : lo.back()) + (hi.empty() ? 0.0 : hi.back()) > full - 0.5 * ws.segment_length)
+      (lo.size() >= hi.size() ? lo : hi).pop_back();
+    for (double d : lo) st.push_back({s0 + d * g.d, g.d, g.u, g.v, -1});
+    if (!lo.empty()) s0 = s0 + lo.back() * g.d;
+    if (!hi.empty()) s1 = s1 - hi.back() * g.d;
+    const double straight = g.length - t0 - t1 - (lo.empty() ? 0.0 : lo.back()) - (hi.empty() ? 0.0 : hi.back());
     const int n = straight > 0 ? std::max(1L, std::lround(straight / ws.segment_length)) : 0;
     for (int j = 1; j <= n; ++j) st.push_back({j == n ? s1 : s0 + (static_cast<double>(j) / n) * (s1 - s0), g.d, g.u, g.v, -1});
+    for (int j = static_cast<int>(hi.size()) - 2; j >= -1; --j)  // hi.back() was s1
+      st.push_back({j < 0 ? g.b : g.b - hi[j] * g.d, g.d, g.u, g.v, -1});
     if (k + 1 == n_legs) break;
     const Leg& h = legs[k + 1];
     const BendPlan* p = plan_at[k + 1];
@@ -301,8 +330,13 @@ GabrielDiagnosis diagnose_gabriel(const WellBlock& block, const std::vector<Vec3
   const std::vector<int32_t>& layer_point = block.layer_bend;
   const int per_layer = (block.rings + 1) * block.sectors;
   const int last = block.layers - 1;
+  // Hemispherical caps' nodes come after the layers' (start cap first): they count as the
+  // end layer of their cap.
+  const int32_t layer_nodes = block.layers * per_layer;
+  const int32_t per_cap = (static_cast<int32_t>(block.nodes.size()) - layer_nodes) / 2;
+  auto layer_of = [&](int32_t v) { return v < layer_nodes ? v / per_layer : (v - layer_nodes < per_cap ? 0 : last); };
   for (const GabrielViolation& v : violations) {
-    const int la = v.a / per_layer, lb = v.b / per_layer, lp = v.p / per_layer;
+    const int la = layer_of(v.a), lb = layer_of(v.b), lp = layer_of(v.p);
     int point = -1;
     for (int l : {la, lb, lp})
       if (layer_point[l] >= 0) point = layer_point[l];
@@ -333,6 +367,68 @@ int min_end_face_sectors(double ratio) {
 
 double regular_polygon_area(int n, double r) { return 0.5 * n * r * r * std::sin(2.0 * kPi / n); }
 
+// ---- Hemispherical end caps (paper 5.1: "segments of a sphere ... on each extremity").
+// The cap at an end point E (outward axis a, the end cross-section's frame u, v) continues
+// the rings as spherical shells: node (ring i, latitude j, sector s) is
+// E + r_i (cos alpha_j (cos phi_s u + sin phi_s v) + sin alpha_j a), alpha_0 = 0 (the end
+// cross-section's own nodes), alpha_B = pi/2 (one pole node per ring). Every face is planar
+// and co-circular: shell and cone faces are isosceles trapezoids (a node pair and its mirror
+// image through the sector's mid-meridian plane), meridian faces lie in a plane through the
+// axis with two nodes on each of two circles about E, polar shell faces are isosceles triangles.
+// The FV centre of cell (i, j, s) is E + sqrt(r_i r_{i+1}) (cos beta_j m_s + sin beta_j a) on
+// the mid-meridian m_s, with beta_j the direction of the circumcentre of the band's shell
+// faces, so the shell faces are orthogonal to the centre-to-centre segments; the interior
+// band limits alpha_1..alpha_{B-1} are chosen so that each cone face is orthogonal too:
+// its plane contains the ray at latitude atan(tan(alpha) / cos(h)) (h = half the sector
+// angle), which must bisect the two centre latitudes beta_{j-1} and beta_j.
+struct CapLatitudes {
+  std::vector<double> alpha;  // B + 1 band limits
+  std::vector<double> beta;   // B FV-centre latitudes
+};
+
+CapLatitudes cap_latitudes(int bands, double sector_angle) {
+  const double ch = std::cos(0.5 * sector_angle);
+  CapLatitudes c;
+  c.alpha.resize(bands + 1);
+  c.beta.resize(bands);
+  for (int j = 0; j <= bands; ++j) c.alpha[j] = 0.5 * kPi * j / bands;
+  auto circumcentre_latitude = [&](double a0, double a1) {
+    return std::atan2(ch * (std::cos(a0) - std::cos(a1)), std::sin(a1) - std::sin(a0));
+  };
+  // Fixed point (a contraction: converges in ~100-400 steps for 1-12 bands, measured).
+  for (int it = 0; it < 2000; ++it) {
+    for (int j = 0; j < bands; ++j) c.beta[j] = circumcentre_latitude(c.alpha[j], c.alpha[j + 1]);
+    double change = 0;
+    for (int j = 1; j < bands; ++j) {
+      const double next = std::atan(ch * std::tan(0.5 * (c.beta[j - 1] + c.beta[j])));
+      change = std::max(change, std::abs(next - c.alpha[j]));
+      c.alpha[j] = next;
+    }
+    if (change < 1e-15) break;
+  }
+  c.alpha[bands] = 0.5 * kPi;
+  for (int j = 0; j < bands; ++j) c.beta[j] = circumcentre_latitude(c.alpha[j], c.alpha[j + 1]);
+  return c;
+}
+
+// Orients a closed convex cell's faces outward (normal away from the mean of its nodes).
+void orient_outward(const std::vector<Vec3>& x, std::vector<CellFace>& faces) {
+  Vec3 inside;
+  int n = 0;
+  for (const CellFace& f : faces)
+    for (int32_t v : f.nodes) inside += x[v], ++n;
+  inside = inside / static_cast<double>(n);
+  for (CellFace& f : faces) {
+    Vec3 normal, mean;
+    const size_t k = f.nodes.size();
+    for (size_t i = 0; i < k; ++i) {
+      normal += cross(x[f.nodes[i]], x[f.nodes[(i + 1) % k]]);
+      mean += x[f.nodes[i]];
+    }
+    if (dot(normal, mean / static_cast<double>(k) - inside) < 0) std::reverse(f.nodes.begin(), f.nodes.end());
+  }
+}
+
 }  // namespace
 
 WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
@@ -356,7 +452,7 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
 
   const std::vector<Leg> legs = make_legs(ws, w);
   const std::vector<BendPlan> plans = plan_bends(ws, w, legs);
-  const std::vector<Station> stations = make_stations(ws, legs, plans);
+  const std::vector<Station> stations = make_stations(ws, legs, plans, block.radii);
   const int n_layers = static_cast<int>(stations.size());
   block.layers = n_layers;
   for (const Station& st : stations) {
@@ -434,6 +530,83 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   }
   auto cell = [&](int l, int i, int s) { return static_cast<int32_t>((l * rings + i) * sectors + s); };
 
+  // Hemispherical caps (cap_latitudes): cells appended after the cylinder's, nodes after its
+  // nodes; the end cross-section's nodes are the caps' latitude-0 nodes. Returns the cells'
+  // outer shell faces (cell id, face index).
+  std::vector<std::pair<int32_t, int>> cap_outer;
+  auto add_cap = [&](bool at_start) {
+    const int bands = hemisphere_cap_bands(sectors);
+    const CapLatitudes lat = cap_latitudes(bands, sector_angle);
+    const int layer = at_start ? 0 : n_layers - 1;
+    const Station& st = stations[layer];
+    const Vec3 e = st.p, a = at_start ? -1.0 * st.d : st.d;
+    const int32_t base = static_cast<int32_t>(block.nodes.size());
+    // Nodes: latitudes 1..B-1 ((j - 1) * (rings + 1) + i) * sectors + s, then one pole per ring.
+    for (int j = 1; j < bands; ++j)
+      for (int i = 0; i <= rings; ++i)
+        for (int s = 0; s < sectors; ++s)
+          block.nodes.push_back(e + block.radii[i] * (std::cos(lat.alpha[j]) * (cos_s[s] * st.u + sin_s[s] * st.v) +
+                                                      std::sin(lat.alpha[j]) * a));
+    const int32_t pole_base = static_cast<int32_t>(block.nodes.size());
+    for (int i = 0; i <= rings; ++i) block.nodes.push_back(e + block.radii[i] * a);
+    auto cap_node = [&](int i, int j, int s) -> int32_t {
+      if (j == 0) return node(layer, i, s);
+      if (j == bands) return pole_base + i;
+      return base + static_cast<int32_t>(((j - 1) * (rings + 1) + i) * sectors + s % sectors);
+    };
+    for (int j = 0; j < bands; ++j)
+      for (int i = 0; i < rings; ++i)
+        for (int s = 0; s < sectors; ++s) {
+          const int32_t A = cap_node(i, j, s), B = cap_node(i, j, s + 1), C = cap_node(i + 1, j, s + 1),
+                        D = cap_node(i + 1, j, s);
+          const int32_t A2 = cap_node(i, j + 1, s), B2 = cap_node(i, j + 1, s + 1), C2 = cap_node(i + 1, j + 1, s + 1),
+                        D2 = cap_node(i + 1, j + 1, s);
+          const bool polar = j + 1 == bands;  // A2 == B2 and C2 == D2: the pole nodes
+          std::vector<CellFace> faces;
+          faces.push_back({polar ? std::vector<int32_t>{A, B, B2} : std::vector<int32_t>{A, B, B2, A2},
+                           i == 0 ? wellbore : kInteriorFace});  // inner shell (wellbore at ring 0)
+          faces.push_back({polar ? std::vector<int32_t>{D, C, C2} : std::vector<int32_t>{D, C, C2, D2},
+                           kInteriorFace});                                       // outer shell
+          faces.push_back({{A, D, D2, A2}, kInteriorFace});                       // meridian at sector s
+          faces.push_back({{B, C, C2, B2}, kInteriorFace});                       // meridian at sector s + 1
+          faces.push_back({{A, B, C, D}, kInteriorFace});                         // cone at alpha_j (end plane: j = 0)
+          if (!polar) faces.push_back({{A2, B2, C2, D2}, kInteriorFace});         // cone at alpha_{j+1}
+          orient_outward(block.nodes, faces);
+          const double vol = hexahedron_volume(block.nodes, faces);
+          if (!(vol > 0))
+            throw InputError(well_key(w) + ".end_caps: cap cell (ring " + std::to_string(i) + ", band " +
+                             std::to_string(j) + ", sector " + std::to_string(s) + ") is degenerate (volume " +
+                             num(vol) + " m3)");
+          CellAttributes at;
+          at.region = kWell;
+          at.perm = cs.reservoir.permeability;
+          at.porosity = cs.reservoir.porosity;
+          RadialCellInfo& rad = at.radial;
+          rad.well = w;
+          rad.ring = i;
+          rad.sector = s;
+          rad.segment = at_start ? -1 : n_segments;
+          rad.band = j;
+          rad.cap_center = e;
+          rad.r_in = block.radii[i];
+          rad.r_out = block.radii[i + 1];
+          rad.r_center = std::sqrt(rad.r_in * rad.r_out);
+          rad.angle = sector_angle;
+          const double phi_mid = (s + 0.5) * sector_angle;
+          const Vec3 m = std::cos(phi_mid) * st.u + std::sin(phi_mid) * st.v;
+          at.fv_center = e + rad.r_center * (std::cos(lat.beta[j]) * m + std::sin(lat.beta[j]) * a);
+          if (i + 1 == rings) cap_outer.push_back({static_cast<int32_t>(block.cell_faces.size()), 1});
+          block.cell_faces.push_back(std::move(faces));
+          block.cell_attrs.push_back(at);
+        }
+  };
+  const bool hemispheres = ws.end_caps == EndCaps::Hemisphere;
+  block.hemisphere_caps = hemispheres;
+  if (hemispheres) {
+    add_cap(true);
+    add_cap(false);
+  }
+
   // Outer surface, normals out of the block.
   auto add_surface = [&](std::vector<int32_t> poly, int32_t c, int32_t patch) {
     block.surface_faces.push_back(std::move(poly));
@@ -443,6 +616,10 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   for (int l = 0; l < n_segments; ++l)
     for (int s = 0; s < sectors; ++s)
       add_surface(block.cell_faces[cell(l, rings - 1, s)][1].nodes, cell(l, rings - 1, s), kInteriorFace);
+  if (hemispheres) {
+    for (const auto& [c, k] : cap_outer) add_surface(block.cell_faces[c][k].nodes, c, kInteriorFace);
+    return block;
+  }
   for (int i = 0; i < rings; ++i)
     for (int s = 0; s < sectors; ++s) {
       add_surface(block.cell_faces[cell(0, i, s)][4].nodes, cell(0, i, s), kInteriorFace);
@@ -540,10 +717,39 @@ double well_block_prism_length(const CaseSpec& cs, int w) {
   return length;
 }
 
+double hemisphere_cap_volume(double radius, int sectors) {
+  // The cap's polyhedral half-ball is the union of the pyramids from its centre E over its
+  // shell faces (E lies in the plane of its remaining face, the end cross-section).
+  const int bands = hemisphere_cap_bands(sectors);
+  const double angle = 2.0 * kPi / sectors;
+  const CapLatitudes lat = cap_latitudes(bands, angle);
+  auto at = [&](double alpha, double phi) {
+    return radius * Vec3{std::cos(alpha) * std::cos(phi), std::cos(alpha) * std::sin(phi), std::sin(alpha)};
+  };
+  double volume = 0;
+  for (int j = 0; j < bands; ++j) {
+    const Vec3 a = at(lat.alpha[j], 0), b = at(lat.alpha[j], angle), c = at(lat.alpha[j + 1], angle),
+               d = at(lat.alpha[j + 1], 0);
+    // Tetrahedra E-a-b-c and E-a-c-d (the second vanishes at the pole, where c = d).
+    volume += (std::abs(dot(a, cross(b, c))) + std::abs(dot(a, cross(c, d)))) / 6.0;
+  }
+  return sectors * volume;
+}
+
 double exact_well_block_volume(const CaseSpec& cs, int w, int sectors) {
   const WellSpec& ws = cs.wells.at(w);
   const double annulus = regular_polygon_area(sectors, ws.drainage_radius) - regular_polygon_area(sectors, ws.radius);
-  return annulus * well_block_prism_length(cs, w);
+  const double caps = ws.end_caps == EndCaps::Hemisphere
+                          ? 2.0 * (hemisphere_cap_volume(ws.drainage_radius, sectors) -
+                                   hemisphere_cap_volume(ws.radius, sectors))
+                          : 0.0;
+  return annulus * well_block_prism_length(cs, w) + caps;
+}
+
+double exact_wellbore_hole_volume(const CaseSpec& cs, int w, int sectors) {
+  const WellSpec& ws = cs.wells.at(w);
+  const double caps = ws.end_caps == EndCaps::Hemisphere ? 2.0 * hemisphere_cap_volume(ws.radius, sectors) : 0.0;
+  return regular_polygon_area(sectors, ws.radius) * well_block_prism_length(cs, w) + caps;
 }
 
 }  // namespace hm

@@ -37,6 +37,10 @@ struct WellBlock {
   std::vector<std::vector<int32_t>> surface_faces;
   std::vector<int32_t> surface_cell;
   std::vector<int32_t> surface_patch;
+  /// Both ends closed by hemispherical caps (case end_caps: hemisphere): their cells follow
+  /// the cylinder's, their nodes follow the layers' (start cap first), and the outer surface
+  /// is the cylinder's side plus the caps' outer shells (no end faces, no wellbore polygons).
+  bool hemisphere_caps = false;
   int sectors_requested = 0;       ///< as in the case file
   std::vector<std::string> notes;  ///< what was changed to make it valid (e.g. sectors raised)
 };
@@ -65,7 +69,16 @@ std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder
 /// 2 delta cos^2(a / 2) per wedge (closed form of the mirror wedges, well_block.cpp).
 double well_block_prism_length(const CaseSpec& cs, int w);
 
-/// Exact volume of the block: (area of the outer polygon - area of the inner polygon) x L*.
+/// Volume of a hemispherical cap's polyhedral half-ball of the given radius (the region inside
+/// its shell faces at that radius and the end cross-section), from the cap's node positions.
+double hemisphere_cap_volume(double radius, int sectors);
+
+/// Exact volume of the block: (area of the outer polygon - area of the inner polygon) x L*,
+/// plus with hemispherical caps twice (cap volume at R - cap volume at r_w).
 double exact_well_block_volume(const CaseSpec& cs, int w, int sectors);
+
+/// Exact volume of the wellbore hole the block leaves: inner polygon area x L*, plus twice
+/// the cap volume at r_w with hemispherical caps.
+double exact_wellbore_hole_volume(const CaseSpec& cs, int w, int sectors);
 
 }  // namespace hm

@@ -57,7 +57,8 @@ int cell_at(const ReservoirGrid& grid, Vec3 x) {
 }
 
 // Whether x is within `margin` of the block (its legs as cylinders of the outer radius, cut
-// at the end planes; spheres at the wedge stations cover the joints between pieces).
+// at the end planes; spheres at the wedge stations cover the joints between pieces, and at
+// the end points the hemispherical caps if it has them).
 bool near_block(const WellBlock& b, Vec3 x, double margin) {
   const double r = b.radii.back() + margin;
   const std::vector<Vec3>& c = b.layer_center;
@@ -72,6 +73,7 @@ bool near_block(const WellBlock& b, Vec3 x, double margin) {
   }
   for (size_t k = 1; k + 1 < c.size(); ++k)
     if (b.layer_bend[k] >= 0 && norm(x - c[k]) < r) return true;  // a wedge station
+  if (b.hemisphere_caps && !c.empty() && (norm(x - c.front()) < r || norm(x - c.back()) < r)) return true;
   return false;
 }
 

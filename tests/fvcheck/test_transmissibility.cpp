@@ -137,7 +137,7 @@ PolyMesh ring_block(const RingSpec& s) {
           at.region = kTransition;
         } else {
           at.region = kWell;
-          at.radial = {0, i, j, l, r_in, r_out, r_c, theta, dz};
+          at.radial = {0, i, j, l, r_in, r_out, r_c, theta, dz, -1, {}};
         }
         add_convex_cell(
             b, {{a, bb, c, d}, {a2, b2, c2, d2}, {a, a2, d2, d}, {bb, b2, c2, c}, {a, bb, b2, a2}, {d, c, c2, d2}},
