@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "fvcheck/lib/checks.hpp"
@@ -30,6 +31,7 @@ struct WellParams {
   double radius = 0.1;
   double drainage_radius = 8.0;
   double segment_length = 4.0;
+  EndCaps end_caps = EndCaps::Hemisphere;  // the case default
 };
 
 CaseSpec make_case(const WellParams& p) {
@@ -48,6 +50,7 @@ CaseSpec make_case(const WellParams& p) {
   w.rings = p.rings;
   w.sectors = p.sectors;
   w.segment_length = p.segment_length;
+  w.end_caps = p.end_caps;
   cs.wells.push_back(w);
   return cs;
 }
@@ -62,6 +65,8 @@ std::vector<Vec3> bent(double bend_deg, double l1 = 40, double l2 = 40) {
 std::vector<Vec3> straight(Vec3 direction, double length = 40) {
   return {{10, -5, 3}, Vec3{10, -5, 3} + length * normalized(direction)};
 }
+
+const char* caps_name(EndCaps caps) { return caps == EndCaps::Flat ? "flat" : "hemisphere"; }
 
 std::string first_problem(const std::vector<std::string>& v) { return v.empty() ? "" : v[0]; }
 
@@ -133,15 +138,30 @@ struct ShapeCase {
   std::vector<Vec3> trajectory;
 };
 
-class WellBlockShapes : public ::testing::TestWithParam<ShapeCase> {};
+// Closure, exact volume and a closed outward outer surface are properties of every block:
+// each trajectory runs with flat ends and with hemispherical caps.
+class WellBlockShapes : public ::testing::TestWithParam<std::tuple<ShapeCase, EndCaps>> {
+ protected:
+  WellParams params() const {
+    WellParams p;
+    p.trajectory = std::get<0>(GetParam()).trajectory;
+    p.end_caps = std::get<1>(GetParam());
+    return p;
+  }
+  std::string label() const {
+    return std::string(std::get<0>(GetParam()).name) + " " + caps_name(std::get<1>(GetParam()));
+  }
+};
 
 TEST_P(WellBlockShapes, CellsClosedNotInvertedAndVolumeExact) {
-  WellParams p;
-  p.trajectory = GetParam().trajectory;
+  const WellParams p = params();
   const CaseSpec cs = make_case(p);
   const BuiltBlock b = build(cs, p.sectors);
   const WellBlock& blk = b.block;
-  ASSERT_EQ(blk.cell_faces.size(), static_cast<size_t>((blk.layers - 1) * blk.rings * blk.sectors));
+  const bool hemispheres = p.end_caps == EndCaps::Hemisphere;
+  ASSERT_EQ(blk.hemisphere_caps, hemispheres);
+  const int bands = hemispheres ? hemisphere_cap_bands(p.sectors) : 0;
+  ASSERT_EQ(blk.cell_faces.size(), static_cast<size_t>((blk.layers - 1 + 2 * bands) * blk.rings * blk.sectors));
 
   // The block alone: everything matches except the outer-surface faces, which are declared
   // interior (the transition mesh claims them).
@@ -158,14 +178,15 @@ TEST_P(WellBlockShapes, CellsClosedNotInvertedAndVolumeExact) {
     if (b.mesh.face_patch[f] == wellbore_patch(0)) ++wellbore;
   }
   for (size_t k = 0; k < blk.surface_faces.size(); ++k) {
-    if (blk.surface_cell[k] < 0) continue;  // end caps are no cell faces
+    if (blk.surface_cell[k] < 0) continue;  // flat ends' wellbore polygons are no cell faces
     std::vector<int32_t> g;
     for (int32_t v : blk.surface_faces[k]) g.push_back(b.ids[v]);
     expected.insert(face_key(g).first);
   }
   EXPECT_EQ(unmatched, expected);
   EXPECT_EQ(b.report.unmatched_faces, static_cast<int>(expected.size()));
-  EXPECT_EQ(wellbore, (blk.layers - 1) * blk.sectors);
+  // Ring-0 faces of the cylinder, plus the inner shell faces of both caps.
+  EXPECT_EQ(wellbore, (blk.layers - 1 + 2 * bands) * blk.sectors);
 
   double total = 0;
   for (int c = 0; c < b.mesh.n_cells(); ++c) {
@@ -176,17 +197,17 @@ TEST_P(WellBlockShapes, CellsClosedNotInvertedAndVolumeExact) {
     total += b.geo.cell_volume[c];
   }
   const double exact = exact_well_block_volume(cs, 0, p.sectors);
-  EXPECT_NEAR(total / exact, 1.0, 1e-12) << GetParam().name << ": " << total << " vs " << exact;
+  EXPECT_NEAR(total / exact, 1.0, 1e-12) << label() << ": " << total << " vs " << exact;
   RecordProperty("volume_relative_error", std::to_string(std::abs(total / exact - 1)));
-  std::printf("[ volume    ] %-12s cells %5d  relative error %.2e\n", GetParam().name, b.mesh.n_cells(),
+  std::printf("[ volume    ] %-23s cells %5d  relative error %.2e\n", label().c_str(), b.mesh.n_cells(),
               std::abs(total / exact - 1));
 }
 
 TEST_P(WellBlockShapes, OuterSurfaceClosedAndOutward) {
-  WellParams p;
-  p.trajectory = GetParam().trajectory;
+  const WellParams p = params();
   const CaseSpec cs = make_case(p);
   const WellBlock blk = make_well_block(cs, 0, p.sectors);
+  const bool hemispheres = p.end_caps == EndCaps::Hemisphere;
   ASSERT_EQ(blk.surface_faces.size(), blk.surface_cell.size());
   ASSERT_EQ(blk.surface_faces.size(), blk.surface_patch.size());
   // Every surface edge in exactly two polygons, with opposite directions.
@@ -200,35 +221,54 @@ TEST_P(WellBlockShapes, OuterSurfaceClosedAndOutward) {
   }
   // Outward: the surface encloses the solid outer-polygon tube (block + capped wellbore),
   // whose volume is area(outer polygon) x L* (divergence theorem; L* = the trajectory length
-  // on straight wells, less what the wedges cut at the bends).
+  // on straight wells, less what the wedges cut at the bends), plus with hemispherical caps
+  // the two polyhedral half-balls of radius R.
   double enclosed = 0;
-  int caps = 0;
+  int wellbore_polygons = 0;
   for (size_t k = 0; k < blk.surface_faces.size(); ++k) {
     Vec3 area, centroid;
     const auto& poly = blk.surface_faces[k];
     polygon_area_centroid(blk.nodes, poly.data(), poly.data() + poly.size(), &area, &centroid);
     enclosed += dot(centroid, area) / 3.0;
     if (blk.surface_cell[k] < 0) {
-      ++caps;
+      ++wellbore_polygons;
       EXPECT_EQ(blk.surface_patch[k], wellbore_patch(0));
       EXPECT_EQ(static_cast<int>(poly.size()), blk.sectors);
     } else {
       EXPECT_EQ(blk.surface_patch[k], kInteriorFace);
     }
   }
-  EXPECT_EQ(caps, 2);
+  // Flat: the side, both end annuli and the two wellbore polygons; hemispheres: the side and
+  // the caps' outer shells only.
+  const int side = (blk.layers - 1) * blk.sectors;
+  if (hemispheres) {
+    EXPECT_EQ(wellbore_polygons, 0);
+    EXPECT_EQ(blk.surface_faces.size(), static_cast<size_t>(side + 2 * hemisphere_cap_bands(blk.sectors) * blk.sectors));
+  } else {
+    EXPECT_EQ(wellbore_polygons, 2);
+    EXPECT_EQ(blk.surface_faces.size(), static_cast<size_t>(side + 2 * blk.rings * blk.sectors + 2));
+  }
   const double length = well_block_prism_length(cs, 0);
   const double outer_area = 0.5 * p.sectors * p.drainage_radius * p.drainage_radius * std::sin(2 * kPi / p.sectors);
-  EXPECT_NEAR(enclosed / (outer_area * length), 1.0, 1e-12);
+  const double caps = hemispheres ? 2 * hemisphere_cap_volume(p.drainage_radius, p.sectors) : 0.0;
+  EXPECT_NEAR(enclosed / (outer_area * length + caps), 1.0, 1e-12) << label();
+  // The same figure as the block plus its hole.
+  EXPECT_NEAR(enclosed / (exact_well_block_volume(cs, 0, p.sectors) + exact_wellbore_hole_volume(cs, 0, p.sectors)), 1.0,
+              1e-12)
+      << label();
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Trajectories, WellBlockShapes,
-    ::testing::Values(ShapeCase{"vertical", straight({0, 0, 1})}, ShapeCase{"deviated45", straight({1, 1, std::sqrt(2.0)})},
-                      ShapeCase{"horizontal", straight({1, 0, 0})}, ShapeCase{"bend30", bent(30)},
-                      ShapeCase{"bend60", bent(60)}, ShapeCase{"bend90", bent(90)},
-                      ShapeCase{"twobends3d", {{0, 0, 0}, {0, 0, 30}, {20, 5, 50}, {25, 35, 60}}}),
-    [](const ::testing::TestParamInfo<ShapeCase>& info) { return std::string(info.param.name); });
+    ::testing::Combine(
+        ::testing::Values(ShapeCase{"vertical", straight({0, 0, 1})}, ShapeCase{"deviated45", straight({1, 1, std::sqrt(2.0)})},
+                          ShapeCase{"horizontal", straight({1, 0, 0})}, ShapeCase{"bend30", bent(30)},
+                          ShapeCase{"bend60", bent(60)}, ShapeCase{"bend90", bent(90)},
+                          ShapeCase{"twobends3d", {{0, 0, 0}, {0, 0, 30}, {20, 5, 50}, {25, 35, 60}}}),
+        ::testing::Values(EndCaps::Flat, EndCaps::Hemisphere)),
+    [](const ::testing::TestParamInfo<std::tuple<ShapeCase, EndCaps>>& info) {
+      return std::string(std::get<0>(info.param).name) + "_" + caps_name(std::get<1>(info.param));
+    });
 
 // ---------------------------------------------------------------- cell data
 
@@ -236,6 +276,7 @@ TEST(WellBlock, CellAttributesAndNodeRadii) {
   WellParams p;
   p.trajectory = straight({0, 1, 1}, 20);
   p.segment_length = 5;
+  p.end_caps = EndCaps::Flat;  // the node and cell index layout of a flat block (no graded end layers)
   const CaseSpec cs = make_case(p);
   const WellBlock blk = make_well_block(cs, 0, 8);
   ASSERT_EQ(blk.layers, 5);
@@ -301,23 +342,36 @@ double max_orthogonality_angle(const BuiltBlock& b, Pick pick, int* n_faces) {
 }
 }  // namespace
 
+// The cylinder's cells (band -1); the caps' faces are checked in EndCaps.* below.
+bool cylinder_pair(const RadialCellInfo& a, const RadialCellInfo& c) { return a.band < 0 && c.band < 0; }
+
 TEST(WellBlock, FvCentresOnRadialLinesMakeRingFacesOrthogonal) {
-  for (const auto& traj : {straight({0, 0, 1}), straight({1, -2, 2})}) {
-    WellParams p;
-    p.trajectory = traj;
-    const BuiltBlock b = build(make_case(p), p.sectors);
-    int n = 0;
-    const double ring = max_orthogonality_angle(
-        b, [](const RadialCellInfo& a, const RadialCellInfo& c) { return a.sector == c.sector && a.segment == c.segment; },
-        &n);
-    EXPECT_EQ(n, (b.block.layers - 1) * (p.rings - 1) * p.sectors);
-    EXPECT_LT(ring, 1e-9);
-    const double angular = max_orthogonality_angle(
-        b, [](const RadialCellInfo& a, const RadialCellInfo& c) { return a.ring == c.ring && a.segment == c.segment; }, &n);
-    EXPECT_EQ(n, (b.block.layers - 1) * p.rings * p.sectors);
-    EXPECT_LT(angular, 1e-9);
-    std::printf("[ orthog.   ] worst ring-face angle %.2e rad, angular-face angle %.2e rad\n", ring, angular);
-  }
+  for (EndCaps caps : {EndCaps::Flat, EndCaps::Hemisphere})
+    for (const auto& traj : {straight({0, 0, 1}), straight({1, -2, 2})}) {
+      WellParams p;
+      p.trajectory = traj;
+      p.end_caps = caps;
+      const BuiltBlock b = build(make_case(p), p.sectors);
+      int n = 0;
+      const double ring = max_orthogonality_angle(
+          b,
+          [](const RadialCellInfo& a, const RadialCellInfo& c) {
+            return cylinder_pair(a, c) && a.sector == c.sector && a.segment == c.segment;
+          },
+          &n);
+      EXPECT_EQ(n, (b.block.layers - 1) * (p.rings - 1) * p.sectors) << caps_name(caps);
+      EXPECT_LT(ring, 1e-9) << caps_name(caps);
+      const double angular = max_orthogonality_angle(
+          b,
+          [](const RadialCellInfo& a, const RadialCellInfo& c) {
+            return cylinder_pair(a, c) && a.ring == c.ring && a.segment == c.segment;
+          },
+          &n);
+      EXPECT_EQ(n, (b.block.layers - 1) * p.rings * p.sectors) << caps_name(caps);
+      EXPECT_LT(angular, 1e-9) << caps_name(caps);
+      std::printf("[ orthog.   ] %-10s worst ring-face angle %.2e rad, angular-face angle %.2e rad\n", caps_name(caps),
+                  ring, angular);
+    }
   // Pass/fail: the same check on centres moved off their radial lines (a ring-dependent
   // shift across the vertical axis) fails.
   WellParams p;
@@ -331,52 +385,63 @@ TEST(WellBlock, FvCentresOnRadialLinesMakeRingFacesOrthogonal) {
             1e-6);
 }
 
-// Largest co-circularity misfit of a planar quad: distance of its 4th node from the circle
-// through the other three, and its distance from their plane.
-void quad_misfit(const std::vector<Vec3>& x, const std::vector<int32_t>& q, double* circle, double* plane) {
-  const Vec3 a = x[q[0]], b = x[q[1]], c = x[q[2]], d = x[q[3]];
+// Largest planarity and co-circularity misfits of a polygon: distances of its 4th, 5th, ...
+// nodes from the plane of the first three and from the circle through them (0 for a triangle).
+void face_misfit(const std::vector<Vec3>& x, const std::vector<int32_t>& q, double* circle, double* plane) {
+  const Vec3 a = x[q[0]], b = x[q[1]], c = x[q[2]];
   const Vec3 ab = b - a, ac = c - a, n = cross(ab, ac);
   // Circumcentre of a, b, c.
   const Vec3 o = a + (dot(ac, ac) * cross(n, ab) + dot(ab, ab) * cross(ac, n)) / (2.0 * dot(n, n));
   const Vec3 nu = normalized(n);
-  *plane = std::abs(dot(d - a, nu));
-  *circle = std::abs(norm((d - o) - dot(d - o, nu) * nu) - norm(a - o));
+  *plane = *circle = 0;
+  for (size_t k = 3; k < q.size(); ++k) {
+    const Vec3 d = x[q[k]];
+    *plane = std::max(*plane, std::abs(dot(d - a, nu)));
+    *circle = std::max(*circle, std::abs(norm((d - o) - dot(d - o, nu) * nu) - norm(a - o)));
+  }
 }
 
 // Bends are mirror wedges: every quad of the block, wedges included, is planar and
 // co-circular (what the transition mesh needs to stay convex), the centres stay inside
 // their cells, and the ring faces stay orthogonal to the centre-to-centre segments.
 TEST(WellBlock, BendWedgesHavePlanarCocircularFacesAndCentredCells) {
-  for (double bend : {10.0, 30.0, 60.0, 90.0, 120.0}) {
-    WellParams p;
-    p.trajectory = bent(bend, 60, 60);
-    const BuiltBlock b = build(make_case(p), p.sectors);
-    double circle = 0, plane = 0;
-    int wedge_faces = 0;
-    for (size_t c = 0; c < b.block.cell_faces.size(); ++c) {
-      const int l = b.block.cell_attrs[c].radial.segment;
-      const bool wedge = b.block.layer_bend[l] >= 0 && b.block.layer_bend[l + 1] >= 0;
-      for (const CellFace& f : b.block.cell_faces[c]) {
-        double cm = 0, pm = 0;
-        quad_misfit(b.block.nodes, f.nodes, &cm, &pm);
-        circle = std::max(circle, cm);
-        plane = std::max(plane, pm);
-        wedge_faces += wedge;
+  for (EndCaps caps : {EndCaps::Flat, EndCaps::Hemisphere}) {
+    for (double bend : {10.0, 30.0, 60.0, 90.0, 120.0}) {
+      WellParams p;
+      p.trajectory = bent(bend, 60, 60);
+      p.end_caps = caps;
+      const BuiltBlock b = build(make_case(p), p.sectors);
+      double circle = 0, plane = 0;
+      int wedge_faces = 0;
+      for (size_t c = 0; c < b.block.cell_faces.size(); ++c) {
+        const RadialCellInfo& r = b.block.cell_attrs[c].radial;
+        const int l = r.segment;  // -1 or layers - 1 in a cap
+        const bool wedge = r.band < 0 && b.block.layer_bend[l] >= 0 && b.block.layer_bend[l + 1] >= 0;
+        for (const CellFace& f : b.block.cell_faces[c]) {
+          double cm = 0, pm = 0;
+          face_misfit(b.block.nodes, f.nodes, &cm, &pm);
+          circle = std::max(circle, cm);
+          plane = std::max(plane, pm);
+          wedge_faces += wedge;
+        }
       }
+      EXPECT_GT(wedge_faces, 0) << "bend " << bend << " " << caps_name(caps);
+      EXPECT_LT(circle, 1e-12 * 60) << "bend " << bend << " " << caps_name(caps);
+      EXPECT_LT(plane, 1e-12 * 60) << "bend " << bend << " " << caps_name(caps);
+      const MeshGeometry geo = compute_geometry(b.mesh);
+      EXPECT_EQ(check_auto_centering(b.mesh, geo).violations, 0) << "bend " << bend << " " << caps_name(caps);
+      EXPECT_EQ(check_convexity(b.mesh, geo).violations, 0) << "bend " << bend << " " << caps_name(caps);
+      int n = 0;
+      const double ring = max_orthogonality_angle(
+          b,
+          [](const RadialCellInfo& a, const RadialCellInfo& c) {
+            return cylinder_pair(a, c) && a.sector == c.sector && a.segment == c.segment;
+          },
+          &n);
+      std::printf("[ bend      ] %3g deg %-10s: misfit circle %.1e plane %.1e, worst ring-face angle %.4f rad\n", bend,
+                  caps_name(caps), circle, plane, ring);
+      EXPECT_LT(ring, 0.02) << "bend " << bend << " " << caps_name(caps);  // measured: at most 0.013 rad (0.75 deg)
     }
-    EXPECT_GT(wedge_faces, 0) << "bend " << bend;
-    EXPECT_LT(circle, 1e-12 * 60) << "bend " << bend;
-    EXPECT_LT(plane, 1e-12 * 60) << "bend " << bend;
-    const MeshGeometry geo = compute_geometry(b.mesh);
-    EXPECT_EQ(check_auto_centering(b.mesh, geo).violations, 0) << "bend " << bend;
-    EXPECT_EQ(check_convexity(b.mesh, geo).violations, 0) << "bend " << bend;
-    int n = 0;
-    const double ring = max_orthogonality_angle(
-        b, [](const RadialCellInfo& a, const RadialCellInfo& c) { return a.sector == c.sector && a.segment == c.segment; },
-        &n);
-    std::printf("[ bend      ] %g deg: misfit circle %.1e plane %.1e, worst ring-face angle %.4f rad\n", bend, circle,
-                plane, ring);
-    EXPECT_LT(ring, 0.02) << "bend " << bend;  // measured: at most 0.013 rad (0.75 deg)
   }
   // Fail case: shifting one wedge cross-section along its normal breaks the mirror symmetry,
   // and with it the co-circularity of the wedge quads.
@@ -394,7 +459,7 @@ TEST(WellBlock, BendWedgesHavePlanarCocircularFacesAndCentredCells) {
   for (const auto& faces : blk.cell_faces)
     for (const CellFace& f : faces) {
       double cm = 0, pm = 0;
-      quad_misfit(blk.nodes, f.nodes, &cm, &pm);
+      face_misfit(blk.nodes, f.nodes, &cm, &pm);
       worst = std::max(worst, cm);
     }
   EXPECT_GT(worst, 1e-3);
@@ -482,16 +547,34 @@ TEST(WellBlock, PlanarBendKeepsTheBinormalComponent) {
 TEST(WellBlock, BendNotesStateTheWedgesAndTheAxisOffset) {
   WellParams p;
   p.trajectory = bent(90, 100, 100);
+  p.end_caps = EndCaps::Flat;  // uniform layers on the legs (graded end layers: below)
   const WellBlock blk = make_well_block(make_case(p), 0, 12);
-  // rho = 1.5 R = 12 m, t = rho tan 45 = 12 m, arc 18.8 m: 5 wedges (about one segment each).
-  // The axis is a chord polygon of the arc; its middle chord passes rho / cos 45 - rho cos 9
-  // = 5.1183 m from the corner.
+  // rho = 1.5 R = 12 m, t = rho tan 45 = 12 m. Wedges: no more than 30 degrees each (3), and
+  // no wedge longer than a segment on the outside of the bend, on the arc of radius rho + R =
+  // 20 m: 20 m x pi/2 / 4 m = 7.85, so 8 wedges of 11.25 degrees (the arc alone, 18.8 m,
+  // would need only 5: the rule before the end-caps commit). With an even count a station
+  // lies on the bisector, at rho from the arc centre, and is the axis point nearest to the
+  // corner (both chords from it turn back toward the centre): rho / cos 45 - rho = 4.97056 m.
   ASSERT_EQ(blk.notes.size(), 1u);
   EXPECT_EQ(blk.notes[0],
-            "wells[0] (P1): bend of 90 degrees at trajectory point 1 meshed as 5 mirror wedge(s) on an arc of radius "
-            "12 m: the wellbore axis leaves the trajectory 12 m before the point and passes 5.1183 m from it");
-  // 88 m straight on each leg: 22 segments each, plus the 5 wedges.
-  EXPECT_EQ(blk.layers, 22 + 5 + 22 + 1);
+            "wells[0] (P1): bend of 90 degrees at trajectory point 1 meshed as 8 mirror wedge(s) on an arc of radius "
+            "12 m: the wellbore axis leaves the trajectory 12 m before the point and passes 4.97056 m from it");
+  // 88 m straight on each leg: 22 segments each, plus the 8 wedges.
+  EXPECT_EQ(blk.layers, 22 + 8 + 22 + 1);
+  // The wedges' outer axial edges (ring R, on the arc of radius about rho + R) are at most a
+  // segment long, and 7 wedges would have made them longer: 2 (rho + R) sin(pi / 28) > 4 m.
+  const int per_layer = (p.rings + 1) * 12;
+  double longest_outer = 0;
+  for (int l = 0; l + 1 < blk.layers; ++l) {
+    if (blk.layer_bend[l] < 0 || blk.layer_bend[l + 1] < 0) continue;
+    for (int s = 0; s < 12; ++s)
+      longest_outer = std::max(longest_outer, norm(blk.nodes[(l + 1) * per_layer + p.rings * 12 + s] -
+                                                   blk.nodes[l * per_layer + p.rings * 12 + s]));
+  }
+  EXPECT_LE(longest_outer, p.segment_length);
+  EXPECT_GT(2 * 20.0 * std::sin(kPi / 28), p.segment_length);
+  std::printf("[ wedges    ] 90 deg bend: longest outer wedge edge %.4f m (segment %.1f m)\n", longest_outer,
+              p.segment_length);
   // The same distance from the block itself: the corner to the meshed axis polyline.
   const std::vector<Vec3> axis = meshed_axis(blk);
   double to_axis = 1e300;
@@ -500,23 +583,41 @@ TEST(WellBlock, BendNotesStateTheWedgesAndTheAxisOffset) {
     const double s = std::clamp(dot(x - a, ab) / dot(ab, ab), 0.0, 1.0);
     to_axis = std::min(to_axis, norm(x - (a + s * ab)));
   }
-  EXPECT_NEAR(to_axis, 12.0 * std::sqrt(2.0) - 12.0 * std::cos(9 * kPi / 180), 1e-9);
-  // The block's volume follows the closed form of the wedges.
-  BuiltBlock b = build(make_case(p), 12);
-  double total = 0;
-  for (double v : b.geo.cell_volume) total += v;
-  EXPECT_NEAR(total / exact_well_block_volume(make_case(p), 0, 12), 1.0, 1e-12);
-  // A gentle bend takes an arc of one segment (rho = 4 m / 5 deg = 45.8 m), one wedge.
+  EXPECT_NEAR(to_axis, 12.0 * std::sqrt(2.0) - 12.0, 1e-9);
+  // The block's volume follows the closed form of the wedges, with either end.
+  for (EndCaps caps : {EndCaps::Flat, EndCaps::Hemisphere}) {
+    p.end_caps = caps;
+    BuiltBlock b = build(make_case(p), 12);
+    double total = 0;
+    for (double v : b.geo.cell_volume) total += v;
+    EXPECT_NEAR(total / exact_well_block_volume(make_case(p), 0, 12), 1.0, 1e-12) << caps_name(caps);
+    // The caps change the ends, not the bend.
+    EXPECT_EQ(b.block.notes, blk.notes) << caps_name(caps);
+    // Hemispheres grade the first and last layers (r_k - r_w for the 5 rings below 4 m, the
+    // last at 3.754 m): 100 - 12 - 3.754 = 84.2 m straight on each leg gives 21 segments
+    // plus the 5 graded layers.
+    EXPECT_EQ(b.block.layers, caps == EndCaps::Flat ? 22 + 8 + 22 + 1 : (5 + 21) + 8 + (21 + 5) + 1) << caps_name(caps);
+  }
+  // A gentle bend takes an arc of one segment (rho = 4 m / 5 deg = 45.8 m); on its outside
+  // (rho + R) x 5 deg = 4.70 m is longer than a segment: 2 wedges. The axis then passes
+  // through the bisector station, rho / cos 2.5 - rho = 0.0436679 m from the corner.
   p.trajectory = bent(5, 100, 100);
   const WellBlock gentle = make_well_block(make_case(p), 0, 12);
   ASSERT_EQ(gentle.notes.size(), 1u);
-  EXPECT_NE(gentle.notes[0].find("meshed as 1 mirror wedge(s) on an arc of radius 45.8366 m"), std::string::npos)
+  EXPECT_NE(gentle.notes[0].find("meshed as 2 mirror wedge(s) on an arc of radius 45.8366 m"), std::string::npos)
       << gentle.notes[0];
-  // Straight wells keep the requested split and say nothing.
+  EXPECT_NE(gentle.notes[0].find("passes 0.0436679 m from it"), std::string::npos) << gentle.notes[0];
+  // Straight wells keep the requested split and say nothing; hemispheres add the 5 graded
+  // layers at each end and split the remaining 92.5 m into 23 segments.
   p.trajectory = straight({0, 0, 1}, 100);
+  p.end_caps = EndCaps::Flat;
   const WellBlock plain = make_well_block(make_case(p), 0, 12);
   EXPECT_EQ(plain.layers, 26);
   EXPECT_TRUE(plain.notes.empty());
+  p.end_caps = EndCaps::Hemisphere;
+  const WellBlock capped = make_well_block(make_case(p), 0, 12);
+  EXPECT_EQ(capped.layers, 1 + 5 + 23 + 5);
+  EXPECT_TRUE(capped.notes.empty());
 }
 
 // ---------------------------------------------------------------- Gabriel
@@ -558,9 +659,11 @@ TEST(Gabriel, KdTreeSearchAgreesWithBruteForce) {
 TEST(Gabriel, EndFacesFailWithTooFewSectorsAndPassWithEnough) {
   // Ring ratio q = 80^(1/6) = 2.075: the angular edge of ring i contains the ring i-1 vertices
   // at its two angles iff 1/q = 0.482 > cos(2 pi / sectors). 5 sectors: cos 72 deg = 0.309, fails;
-  // 6 sectors: cos 60 deg = 0.5, passes.
+  // 6 sectors: cos 60 deg = 0.5, passes. Flat ends: the end annuli are on the outer surface
+  // (hemispherical caps hide them; their outer shells are checked in EndCaps.* below).
   WellParams p;
   p.trajectory = straight({0, 0, 1}, 40);
+  p.end_caps = EndCaps::Flat;
   const CaseSpec cs = make_case(p);
   for (int sectors : {4, 5, 6, 12}) {
     const WellBlock blk = make_well_block(cs, 0, sectors);
@@ -585,10 +688,12 @@ TEST(Gabriel, EndFacesFailWithTooFewSectorsAndPassWithEnough) {
 TEST(Gabriel, LongSegmentsOnStraightLegsStayGabriel) {
   // The outer surface of a straight leg is made of rectangles: an axial edge of length h has
   // every other vertex at distance^2 >= chord^2 + h^2 / 4 from its midpoint, so even 50 m
-  // segments against 8 m chords are Gabriel.
+  // segments against 8 m chords are Gabriel (flat ends: 6 sectors keep the end annuli
+  // Gabriel, and the layers are the uniform 50 m ones).
   WellParams p;
   p.trajectory = straight({1, 0, 1}, 200);
   p.segment_length = 50;
+  p.end_caps = EndCaps::Flat;
   const CaseSpec cs = make_case(p);
   const WellBlock blk = make_well_block(cs, 0, 6);
   EXPECT_EQ(blk.layers, 5);
@@ -601,20 +706,25 @@ TEST(Gabriel, BendWedgesAreGabrielUpTo120DegreesWithManySectors) {
   // Wedges of at most 30 degrees on a fillet of 1.5 R: the wedge trapezoids keep their
   // circumcentre inside, so no surface vertex enters an edge's diametral sphere (the
   // bisector-plane mitre of the first version failed from 50 degrees with 12 sectors).
-  for (double bend : {30.0, 60.0, 90.0, 120.0})
-    for (int sectors : {6, 12, 24}) {
-      WellParams p;
-      p.trajectory = bent(bend, 60, 60);
-      const WellBlock blk = make_well_block(make_case(p), 0, sectors);
-      EXPECT_EQ(count_gabriel_violations(blk), 0) << bend << " deg, " << sectors << " sectors";
-      int surely = 0;
-      EXPECT_EQ(brute_force_violations(blk, &surely), 0) << bend << " deg, " << sectors << " sectors";
-    }
+  for (EndCaps caps : {EndCaps::Flat, EndCaps::Hemisphere})
+    for (double bend : {30.0, 60.0, 90.0, 120.0})
+      for (int sectors : {6, 12, 24}) {
+        WellParams p;
+        p.trajectory = bent(bend, 60, 60);
+        p.end_caps = caps;
+        const WellBlock blk = make_well_block(make_case(p), 0, sectors);
+        EXPECT_EQ(count_gabriel_violations(blk), 0) << bend << " deg, " << sectors << " sectors, " << caps_name(caps);
+        int surely = 0;
+        EXPECT_EQ(brute_force_violations(blk, &surely), 0)
+            << bend << " deg, " << sectors << " sectors, " << caps_name(caps);
+      }
 }
 
 TEST(Gabriel, MakeGabrielRaisesSectorsAndSaysSo) {
+  // Flat ends: their annuli are what more sectors repair.
   WellParams p;
   p.trajectory = straight({0, 0, 1}, 40);
+  p.end_caps = EndCaps::Flat;
   p.sectors = 4;
   const WellBlock raised = make_gabriel_well_block(make_case(p), 0);
   EXPECT_EQ(raised.sectors, 6);
@@ -642,6 +752,7 @@ TEST(Gabriel, MakeGabrielRaisesSectorsAndSaysSo) {
 TEST(Gabriel, MakeGabrielGivesUpWithTheReason) {
   WellParams p;
   p.trajectory = straight({0, 0, 1}, 40);
+  p.end_caps = EndCaps::Flat;  // the end annuli's reason
   p.sectors = 3;
   p.rings = 60;  // ratio 1.076 needs 17 sectors, 4 x 3 = 12 allowed
   try {
