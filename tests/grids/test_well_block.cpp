@@ -1,5 +1,6 @@
 // Radial well block: closure, exact volumes, orthogonality, rotation-minimising frame,
-// Gabriel condition (pass/fail pairs) and input errors.
+// Gabriel condition (pass/fail pairs) and input errors, with flat ends and with
+// hemispherical end caps (cap cells, their faces, graded end layers, the end_caps key).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -813,4 +814,439 @@ TEST(WellBlockInput, BendAbove120DegreesAndDegenerateSpecs) {
   EXPECT_THROW(make_well_block(make_case(p), 0, 2), InputError);
   p.drainage_radius = 0.05;
   EXPECT_THROW(make_well_block(make_case(p), 0, 12), InputError);
+}
+
+// ---------------------------------------------------------------- hemispherical end caps
+
+namespace {
+
+struct CapTrajectory {
+  const char* name;
+  std::vector<Vec3> trajectory;
+};
+
+// (trajectory, sectors, rings)
+using CapParam = std::tuple<CapTrajectory, int, int>;
+
+bool is_cap(const RadialCellInfo& r) { return r.band >= 0; }
+
+// Worst angle (rad) between the centre-to-centre segment and the shared face's normal, per
+// kind of face next to a cap cell: shell (ring to ring), cone (band to band), meridian
+// (sector to sector), end plane (cylinder to band 0). `odd` counts faces between two cells
+// that differ in more than one index (there should be none).
+struct CapFaceAngles {
+  double shell = 0, cone = 0, meridian = 0, end_plane = 0;
+  int n_shell = 0, n_cone = 0, n_meridian = 0, n_end_plane = 0, odd = 0;
+};
+
+CapFaceAngles cap_face_angles(const PolyMesh& mesh, const MeshGeometry& geo) {
+  CapFaceAngles out;
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    const int c1 = mesh.face_owner[f], c2 = mesh.face_neighbour[f];
+    if (c2 < 0) continue;
+    const RadialCellInfo &a = mesh.cell_radial[c1], &c = mesh.cell_radial[c2];
+    if (!is_cap(a) && !is_cap(c)) continue;
+    const Vec3 link = mesh.cell_fv_center[c2] - mesh.cell_fv_center[c1];
+    const double angle = std::atan2(norm(cross(link, geo.face_area[f])), dot(link, geo.face_area[f]));
+    const int differ = (a.ring != c.ring) + (a.sector != c.sector) + (a.band != c.band);
+    if (is_cap(a) != is_cap(c)) {
+      // Band 0 of a cap and the end cell of the cylinder (segment 0 before the start cap at
+      // segment -1, the last segment before the end cap at segment `segments`).
+      const RadialCellInfo &capped = is_cap(a) ? a : c, &cylinder = is_cap(a) ? c : a;
+      if (capped.band != 0 || a.ring != c.ring || a.sector != c.sector || std::abs(capped.segment - cylinder.segment) != 1)
+        ++out.odd;
+      out.end_plane = std::max(out.end_plane, angle);
+      ++out.n_end_plane;
+    } else if (differ != 1 || a.segment != c.segment) {
+      ++out.odd;
+    } else if (a.ring != c.ring) {
+      out.shell = std::max(out.shell, angle);
+      ++out.n_shell;
+    } else if (a.band != c.band) {
+      out.cone = std::max(out.cone, angle);
+      ++out.n_cone;
+    } else {
+      out.meridian = std::max(out.meridian, angle);
+      ++out.n_meridian;
+    }
+  }
+  return out;
+}
+
+// Sum of a block cell's outward face area vectors, and the sum of their norms (scale).
+Vec3 block_cell_area_sum(const WellBlock& blk, size_t c, double* scale) {
+  Vec3 sum;
+  *scale = 0;
+  for (const CellFace& f : blk.cell_faces[c]) {
+    Vec3 area, centroid;
+    polygon_area_centroid(blk.nodes, f.nodes.data(), f.nodes.data() + f.nodes.size(), &area, &centroid);
+    sum += area;
+    *scale += norm(area);
+  }
+  return sum;
+}
+
+// Largest signed distance of `x` beyond the planes of a block cell's faces (outward
+// normals): negative iff x is strictly inside a convex cell.
+double beyond_faces(const WellBlock& blk, size_t c, Vec3 x) {
+  double worst = -1e300;
+  for (const CellFace& f : blk.cell_faces[c]) {
+    Vec3 area, centroid;
+    polygon_area_centroid(blk.nodes, f.nodes.data(), f.nodes.data() + f.nodes.size(), &area, &centroid);
+    worst = std::max(worst, dot(x - centroid, normalized(area)));
+  }
+  return worst;
+}
+
+// Directed surface edges without exactly one reverse partner, or used more than once
+// (0 for a closed, consistently oriented surface).
+int open_surface_edges(const std::vector<std::vector<int32_t>>& polygons) {
+  std::map<std::pair<int32_t, int32_t>, int> directed;
+  for (const auto& poly : polygons)
+    for (size_t i = 0; i < poly.size(); ++i) ++directed[{poly[i], poly[(i + 1) % poly.size()]}];
+  int bad = 0;
+  for (const auto& [edge, uses] : directed) {
+    auto back = directed.find({edge.second, edge.first});
+    bad += uses != 1 || back == directed.end() || back->second != 1;
+  }
+  return bad;
+}
+
+}  // namespace
+
+class HemisphereCaps : public ::testing::TestWithParam<CapParam> {
+ protected:
+  WellParams params() const {
+    WellParams p;
+    p.trajectory = std::get<0>(GetParam()).trajectory;
+    p.sectors = std::get<1>(GetParam());
+    p.rings = std::get<2>(GetParam());
+    p.end_caps = EndCaps::Hemisphere;
+    return p;
+  }
+  std::string label() const {
+    return std::string(std::get<0>(GetParam()).name) + ", " + std::to_string(std::get<1>(GetParam())) + " sectors, " +
+           std::to_string(std::get<2>(GetParam())) + " rings";
+  }
+};
+
+// Every cap cell: closed, positive, its nodes on the spheres of radius r_in and r_out about
+// its end point, its faces planar and co-circular; the cells after the cylinder's, start
+// cap first, bands x rings x sectors each.
+TEST_P(HemisphereCaps, CellsClosedPositivePlanarCocircularOnSphericalShells) {
+  const WellParams p = params();
+  const BuiltBlock b = build(make_case(p), p.sectors);
+  const WellBlock& blk = b.block;
+  const int bands = hemisphere_cap_bands(p.sectors);
+  const size_t cylinder = static_cast<size_t>((blk.layers - 1) * p.rings * p.sectors);
+  const size_t per_cap = static_cast<size_t>(bands * p.rings * p.sectors);
+  ASSERT_EQ(blk.cell_faces.size(), cylinder + 2 * per_cap);
+  ASSERT_EQ(b.mesh.n_cells(), static_cast<int>(blk.cell_faces.size()));
+  EXPECT_EQ(b.report.overused_faces + b.report.misoriented_faces + b.report.degenerate_faces, 0)
+      << first_problem(b.report.problems);
+  double worst_circle = 0, worst_plane = 0, worst_closure = 0;
+  int faces = 0, triangles = 0;
+  for (size_t c = cylinder; c < blk.cell_faces.size(); ++c) {
+    const RadialCellInfo& r = blk.cell_attrs[c].radial;
+    const bool start = c < cylinder + per_cap;
+    ASSERT_GE(r.band, 0) << "cell " << c;
+    EXPECT_LT(r.band, bands);
+    EXPECT_EQ(r.segment, start ? -1 : blk.layers - 1);
+    EXPECT_EQ(r.cap_center, start ? p.trajectory.front() : p.trajectory.back());
+    EXPECT_EQ(b.mesh.cell_radial[c].band, r.band);
+    // Closed: the outward area vectors of its faces sum to zero.
+    double scale = 0;
+    const double closure = norm(block_cell_area_sum(blk, c, &scale)) / scale;
+    worst_closure = std::max(worst_closure, closure);
+    EXPECT_LT(closure, 1e-12) << label() << ", cell " << c;
+    EXPECT_GT(b.geo.cell_volume[c], 0) << label() << ", cell " << c;
+    // A polar cell (last band) has 5 faces: its outer cone degenerates to the pole nodes.
+    EXPECT_EQ(blk.cell_faces[c].size(), r.band + 1 == bands ? 5u : 6u);
+    for (const CellFace& f : blk.cell_faces[c]) {
+      ++faces;
+      triangles += f.nodes.size() == 3;
+      double diameter = 0;
+      for (int32_t v : f.nodes) {
+        const double d = norm(blk.nodes[v] - r.cap_center);
+        const double scale_d = 1e-12 * (norm(r.cap_center) + r.r_out);
+        EXPECT_TRUE(std::abs(d - r.r_in) < scale_d || std::abs(d - r.r_out) < scale_d)
+            << label() << ", cell " << c << ": node " << v << " at " << d << " from its end point";
+        for (int32_t w : f.nodes) diameter = std::max(diameter, norm(blk.nodes[w] - blk.nodes[v]));
+      }
+      double circle = 0, plane = 0;
+      face_misfit(blk.nodes, f.nodes, &circle, &plane);
+      worst_circle = std::max(worst_circle, circle / diameter);
+      worst_plane = std::max(worst_plane, plane / diameter);
+    }
+  }
+  // Polar shell faces (inner and outer) are the only triangles.
+  EXPECT_EQ(triangles, 2 * 2 * p.rings * p.sectors);
+  EXPECT_LT(worst_circle, 1e-12) << label();
+  EXPECT_LT(worst_plane, 1e-12) << label();
+  std::printf("[ cap cells ] %-32s %5d faces: misfit / diameter circle %.1e plane %.1e, closure %.1e\n",
+              label().c_str(), faces, worst_circle, worst_plane, worst_closure);
+}
+
+// Shell, cone and meridian faces are orthogonal to the centre-to-centre segments; the end
+// plane between the cylinder and band 0 is not (the cylinder's centre lies half a layer
+// before it, the cap's at latitude beta_0 after it), but stays within 10 degrees.
+TEST_P(HemisphereCaps, ShellConeMeridianFacesOrthogonalEndPlaneNearly) {
+  const WellParams p = params();
+  const BuiltBlock b = build(make_case(p), p.sectors);
+  const int bands = hemisphere_cap_bands(p.sectors);
+  const CapFaceAngles a = cap_face_angles(b.mesh, b.geo);
+  EXPECT_EQ(a.odd, 0);
+  EXPECT_EQ(a.n_shell, 2 * bands * (p.rings - 1) * p.sectors);
+  EXPECT_EQ(a.n_cone, 2 * (bands - 1) * p.rings * p.sectors);
+  EXPECT_EQ(a.n_meridian, 2 * bands * p.rings * p.sectors);
+  EXPECT_EQ(a.n_end_plane, 2 * p.rings * p.sectors);
+  EXPECT_LT(a.shell, 1e-9) << label();
+  EXPECT_LT(a.cone, 1e-9) << label();
+  EXPECT_LT(a.meridian, 1e-9) << label();
+  EXPECT_LT(a.end_plane, 10 * kPi / 180) << label();
+  std::printf("[ cap orth. ] %-32s shell %.1e cone %.1e meridian %.1e rad, end plane %.2f deg\n", label().c_str(),
+              a.shell, a.cone, a.meridian, a.end_plane * 180 / kPi);
+}
+
+// Every FV centre (cap and cylinder) strictly on the inner side of each of its cell's faces.
+TEST_P(HemisphereCaps, FvCentresStrictlyInsideTheirCells) {
+  const WellParams p = params();
+  const WellBlock blk = make_well_block(make_case(p), 0, p.sectors);
+  double worst = -1e300;  // largest (face plane distance / r_out): negative inside
+  for (size_t c = 0; c < blk.cell_faces.size(); ++c) {
+    const double beyond = beyond_faces(blk, c, blk.cell_attrs[c].fv_center);
+    EXPECT_LT(beyond, 0) << label() << ", cell " << c << " band " << blk.cell_attrs[c].radial.band;
+    worst = std::max(worst, beyond / blk.cell_attrs[c].radial.r_out);
+  }
+  std::printf("[ cap fv    ] %-32s closest FV centre to a face: %.2e r_out inside\n", label().c_str(), -worst);
+}
+
+// The outer surface (cylinder side + caps' outer shells): closed, each polygon facing away
+// from its cell's centre, enclosing block + wellbore hole, and Gabriel.
+TEST_P(HemisphereCaps, OuterSurfaceClosedOutwardAndGabriel) {
+  const WellParams p = params();
+  const CaseSpec cs = make_case(p);
+  const WellBlock blk = make_well_block(cs, 0, p.sectors);
+  const int bands = hemisphere_cap_bands(p.sectors);
+  ASSERT_EQ(blk.surface_faces.size(), static_cast<size_t>((blk.layers - 1 + 2 * bands) * p.sectors));
+  EXPECT_EQ(open_surface_edges(blk.surface_faces), 0) << label();
+  double enclosed = 0;
+  for (size_t k = 0; k < blk.surface_faces.size(); ++k) {
+    const std::vector<int32_t>& poly = blk.surface_faces[k];
+    ASSERT_GE(blk.surface_cell[k], 0);
+    EXPECT_EQ(blk.surface_patch[k], kInteriorFace);
+    const CellAttributes& at = blk.cell_attrs[blk.surface_cell[k]];
+    EXPECT_EQ(at.radial.ring, p.rings - 1);
+    Vec3 area, centroid;
+    polygon_area_centroid(blk.nodes, poly.data(), poly.data() + poly.size(), &area, &centroid);
+    EXPECT_GT(dot(centroid - at.fv_center, area), 0) << label() << ", surface polygon " << k;
+    enclosed += dot(centroid, area) / 3.0;
+  }
+  const double solid = exact_well_block_volume(cs, 0, p.sectors) + exact_wellbore_hole_volume(cs, 0, p.sectors);
+  EXPECT_NEAR(enclosed / solid, 1.0, 1e-12) << label();
+  const int violations = count_gabriel_violations(blk);
+  int surely = 0;
+  const int maybe = brute_force_violations(blk, &surely);
+  EXPECT_EQ(violations, 0) << label();
+  EXPECT_LE(surely, violations) << label();
+  std::printf("[ cap gabr. ] %-32s %d violations (brute force: %d sure, %d within 1e-9)\n", label().c_str(), violations,
+              surely, maybe);
+  // Fail case: without one cap polygon the surface is open along its edges.
+  std::vector<std::vector<int32_t>> holed = blk.surface_faces;
+  holed.pop_back();
+  EXPECT_GT(open_surface_edges(holed), 0);
+}
+
+// The block's volume is the closed form, and each cap holds the polyhedral half-ball at R
+// less the one at r_w.
+TEST_P(HemisphereCaps, VolumeExact) {
+  const WellParams p = params();
+  const CaseSpec cs = make_case(p);
+  const BuiltBlock b = build(cs, p.sectors);
+  double total = 0, start_cap = 0, end_cap = 0;
+  for (int c = 0; c < b.mesh.n_cells(); ++c) {
+    total += b.geo.cell_volume[c];
+    const RadialCellInfo& r = b.mesh.cell_radial[c];
+    if (r.band >= 0) (r.segment < 0 ? start_cap : end_cap) += b.geo.cell_volume[c];
+  }
+  const double exact = exact_well_block_volume(cs, 0, p.sectors);
+  const double cap = hemisphere_cap_volume(p.drainage_radius, p.sectors) - hemisphere_cap_volume(p.radius, p.sectors);
+  EXPECT_NEAR(total / exact, 1.0, 1e-12) << label();
+  EXPECT_NEAR(start_cap / cap, 1.0, 1e-12) << label();
+  EXPECT_NEAR(end_cap / cap, 1.0, 1e-12) << label();
+  std::printf("[ cap vol.  ] %-32s block %.2e, caps %.2e %.2e relative error\n", label().c_str(),
+              std::abs(total / exact - 1), std::abs(start_cap / cap - 1), std::abs(end_cap / cap - 1));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Trajectories, HemisphereCaps,
+    ::testing::Combine(::testing::Values(CapTrajectory{"vertical", straight({0, 0, 1})},
+                                         CapTrajectory{"deviated", straight({1, 1, std::sqrt(2.0)})},
+                                         CapTrajectory{"horizontal", straight({1, 0, 0})},
+                                         CapTrajectory{"bend60", bent(60)}),
+                       ::testing::Values(6, 12, 24), ::testing::Values(4, 5, 6)),
+    [](const ::testing::TestParamInfo<CapParam>& info) {
+      return std::string(std::get<0>(info.param).name) + "_" + std::to_string(std::get<1>(info.param)) + "sectors_" +
+             std::to_string(std::get<2>(info.param)) + "rings";
+    });
+
+// The checks above fail on broken caps: a reversed face (closure), a node off its sphere
+// (planarity, co-circularity), centres off their latitude (orthogonality), a centre beyond
+// its outer shell (inside).
+TEST(HemisphereCapChecks, FailOnBrokenCaps) {
+  WellParams p;
+  p.trajectory = straight({0, 0, 1});
+  const BuiltBlock b = build(make_case(p), p.sectors);
+  const WellBlock& blk = b.block;
+  const size_t first_cap = static_cast<size_t>((blk.layers - 1) * p.rings * p.sectors);
+  // A polar cell of the start cap (band bands-1, ring 2, sector 0).
+  const int bands = hemisphere_cap_bands(p.sectors);
+  const size_t polar = first_cap + static_cast<size_t>(((bands - 1) * p.rings + 2) * p.sectors);
+  ASSERT_EQ(blk.cell_attrs[polar].radial.band, bands - 1);
+  ASSERT_EQ(blk.cell_attrs[polar].radial.ring, 2);
+
+  double scale = 0;
+  const double closed = norm(block_cell_area_sum(blk, polar, &scale)) / scale;
+  EXPECT_LT(closed, 1e-12);
+  WellBlock reversed = blk;
+  std::reverse(reversed.cell_faces[polar][0].nodes.begin(), reversed.cell_faces[polar][0].nodes.end());
+  const double open = norm(block_cell_area_sum(reversed, polar, &scale)) / scale;
+  EXPECT_GT(open, 1e-3);
+
+  // The first latitude-1 node of the start cap (right after the layers' nodes), pushed 1 % off
+  // its sphere: the faces around it are no longer planar and co-circular.
+  WellBlock bumped = blk;
+  const size_t node = static_cast<size_t>(blk.layers * (p.rings + 1) * p.sectors);
+  const Vec3 e = blk.cell_attrs[first_cap].radial.cap_center;
+  ASSERT_NEAR(norm(blk.nodes[node] - e), p.radius, 1e-12 * 100);
+  bumped.nodes[node] = e + 1.01 * (blk.nodes[node] - e);
+  double worst_circle = 0, worst_plane = 0;
+  for (size_t c = first_cap; c < blk.cell_faces.size(); ++c)
+    for (const CellFace& f : bumped.cell_faces[c]) {
+      double circle = 0, plane = 0;
+      face_misfit(bumped.nodes, f.nodes, &circle, &plane);
+      worst_circle = std::max(worst_circle, circle);
+      worst_plane = std::max(worst_plane, plane);
+    }
+  EXPECT_GT(worst_circle, 1e-6);
+  EXPECT_GT(worst_plane, 1e-6);
+
+  // Centres at their cells' node means instead of sqrt(r_in r_out) at latitude beta_j.
+  BuiltBlock moved = b;
+  for (int c = 0; c < moved.mesh.n_cells(); ++c) {
+    if (moved.mesh.cell_radial[c].band < 0) continue;
+    Vec3 mean;
+    int n = 0;
+    for (const CellFace& f : blk.cell_faces[c])
+      for (int32_t v : f.nodes) mean += blk.nodes[v], ++n;
+    moved.mesh.cell_fv_center[c] = mean / static_cast<double>(n);
+  }
+  const CapFaceAngles a = cap_face_angles(moved.mesh, moved.geo);
+  EXPECT_GT(a.shell, 1e-4);
+  EXPECT_GT(a.cone, 1e-4);
+  EXPECT_LT(a.meridian, 1e-9);  // the node mean stays on the mid-meridian plane: still orthogonal
+
+  // A centre just beyond the cell's outer shell.
+  const Vec3 fv = blk.cell_attrs[polar].fv_center;
+  EXPECT_LT(beyond_faces(blk, polar, fv), 0);
+  const Vec3 out = e + (1.001 * blk.cell_attrs[polar].radial.r_out) * normalized(fv - e);
+  EXPECT_GT(beyond_faces(blk, polar, out), 0);
+}
+
+// The polyhedral half-ball: exact pyramids with one band (3 and 4 sectors), scaling as r^3,
+// and below the half-ball 2/3 pi r^3, approaching it monotonically as the sectors grow.
+TEST(HemisphereCapVolume, PyramidsThenApproachesTheHalfBallFromBelow) {
+  const double r = 1.7;
+  // One band: the pyramid over the end polygon with apex at the pole (height r).
+  EXPECT_NEAR(hemisphere_cap_volume(r, 4), 2.0 * r * r * r / 3.0, 1e-14 * r * r * r);
+  EXPECT_NEAR(hemisphere_cap_volume(r, 3), std::sqrt(3.0) / 4.0 * r * r * r, 1e-14 * r * r * r);
+  const double ball = 2.0 / 3.0 * kPi * r * r * r;
+  double previous = 0;
+  for (int sectors : {6, 12, 24, 48}) {
+    const double v = hemisphere_cap_volume(r, sectors);
+    EXPECT_GT(v, previous) << sectors << " sectors";
+    EXPECT_LT(v, ball) << sectors << " sectors";
+    EXPECT_NEAR(hemisphere_cap_volume(2 * r, sectors), 8 * v, 1e-13 * v) << sectors << " sectors";
+    std::printf("[ cap vol.  ] %2d sectors (%2d bands): polyhedral / ball half = %.6f\n", sectors,
+                hemisphere_cap_bands(sectors), v / ball);
+    previous = v;
+  }
+  EXPECT_GT(previous / ball, 0.98);
+}
+
+// ---------------------------------------------------------------- end_caps in the case file
+
+namespace {
+std::string case_with_end_caps(const std::string& line) {
+  return R"(name: caps
+reservoir: {x: [0, 100], y: [0, 100], z: [0, 60]}
+wells:
+  - name: P1
+    trajectory: [[50, 50, 15], [50, 50, 45]]
+    radius: 0.1
+    drainage_radius: 8.0
+    bhp: 150
+)" + line;
+}
+}  // namespace
+
+TEST(EndCapsKey, FlatAndHemisphereParseOtherValuesFail) {
+  EXPECT_EQ(parse_case(case_with_end_caps("")).wells.at(0).end_caps, EndCaps::Hemisphere);  // the default
+  EXPECT_EQ(parse_case(case_with_end_caps("    end_caps: hemisphere\n")).wells.at(0).end_caps, EndCaps::Hemisphere);
+  EXPECT_EQ(parse_case(case_with_end_caps("    end_caps: flat\n")).wells.at(0).end_caps, EndCaps::Flat);
+  for (const auto& [value, shown] : std::vector<std::pair<std::string, std::string>>{
+           {"round", "'round'"}, {"[flat]", "a list"}, {"Flat", "'Flat'"}}) {
+    try {
+      parse_case(case_with_end_caps("    end_caps: " + value + "\n"));
+      ADD_FAILURE() << "expected InputError for " << value;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), "wells[0].end_caps: expected flat or hemisphere, got " + shown);
+    }
+  }
+}
+
+// ---------------------------------------------------------------- graded end layers
+
+// With hemispherical caps the layers next to each end are as thin as the rings: distances
+// r_k - r_w from the end for every ring radius r_k with r_k - r_w below segment_length,
+// then uniform segments; with flat ends every layer is a segment.
+TEST(WellBlock, HemisphereEndLayersAreGradedLikeTheRings) {
+  WellParams p;
+  p.trajectory = {{0, 0, 0}, {0, 0, 40}};
+  const CaseSpec capped = make_case(p);
+  const WellBlock blk = make_well_block(capped, 0, p.sectors);
+  // r_k = 0.1 x 80^(k/6): r_k - r_w = 0.1075, 0.3309, 0.7944, 1.7566, 3.7545 (< 4) and 7.9 (> 4;
+  // its layer, r_6 - r_5 = 4.15 m, would also be thicker than a segment).
+  std::vector<double> graded;
+  for (int k = 1; k <= p.rings; ++k) {
+    const double d = p.radius * std::pow(p.drainage_radius / p.radius, k / 6.0) - p.radius;
+    if (d < p.segment_length) graded.push_back(d);
+  }
+  ASSERT_EQ(graded.size(), 5u);
+  // Then 40 - 2 x 3.7545 = 32.49 m in round(32.49 / 4) = 8 uniform segments.
+  const int uniform = 8;
+  ASSERT_EQ(blk.layers, 1 + 5 + uniform + 5);
+  std::vector<double> from_start, from_end;
+  for (int l = 0; l < blk.layers; ++l) {
+    from_start.push_back(blk.layer_center[l].z);
+    from_end.push_back(40 - blk.layer_center[blk.layers - 1 - l].z);
+    EXPECT_NEAR(blk.layer_center[l].x, 0, 1e-15);
+    EXPECT_NEAR(blk.layer_center[l].y, 0, 1e-15);
+  }
+  for (const std::vector<double>* d : {&from_start, &from_end}) {
+    EXPECT_NEAR((*d)[0], 0, 1e-12);
+    for (size_t k = 0; k < graded.size(); ++k) EXPECT_NEAR((*d)[k + 1], graded[k], 1e-12) << "layer " << k + 1;
+    const double step = (40 - 2 * graded.back()) / uniform;
+    for (int j = 1; j <= uniform; ++j) EXPECT_NEAR((*d)[graded.size() + j], graded.back() + j * step, 1e-12);
+  }
+  // Symmetric: the same distances from both ends.
+  for (int l = 0; l < blk.layers; ++l) EXPECT_NEAR(from_start[l], from_end[l], 1e-12) << "layer " << l;
+  // The segment lengths in the cells agree (the first cylinder cell is r_1 - r_w long).
+  EXPECT_NEAR(blk.cell_attrs[0].radial.length, graded[0], 1e-12);
+
+  // Flat ends: 10 uniform segments of 4 m.
+  p.end_caps = EndCaps::Flat;
+  const WellBlock flat = make_well_block(make_case(p), 0, p.sectors);
+  ASSERT_EQ(flat.layers, 11);
+  for (int l = 0; l < flat.layers; ++l) EXPECT_NEAR(flat.layer_center[l].z, 4.0 * l, 1e-12) << "layer " << l;
 }
