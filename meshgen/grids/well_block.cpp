@@ -218,14 +218,21 @@ struct Station {
 };
 
 // Distances from a trajectory end of the extra stations of a block with hemispherical caps:
-// r_k - r_w for the rings' radii r_k below segment_length. Near a well's end the field varies
-// along the axis on the scale of the distance to the end, as it does radially: the cap's
-// cells next to the end cross-section are as small as the rings, and so must be the layers
-// of the cylinder behind it (docs/architecture.md, "End caps").
+// r_k - r_w, k = 1, 2, ... (r_k = r_w q^k, q the ring ratio), while the layer they close
+// (r_k - r_{k-1} thick) is thinner than a segment and within 3 segments of the end. Near a well's end the field varies along the axis on the scale of the distance to
+// the end, as it does radially: the cap's cells next to the end cross-section are as small as
+// the rings, and so must be the layers of the cylinder behind it, growing by the ring ratio up
+// to the segment length (docs/architecture.md, "End caps").
 std::vector<double> end_grading(const WellSpec& ws, const std::vector<double>& radii) {
   std::vector<double> g;
   if (ws.end_caps != EndCaps::Hemisphere) return g;
-  for (size_t k = 1; k < radii.size() && radii[k] - radii[0] < ws.segment_length; ++k) g.push_back(radii[k] - radii[0]);
+  const double ratio = radii[1] / radii[0];
+  double r = radii[0];
+  // (the graded part stops within 3 segments of the end whatever the ring ratio)
+  while (r * ratio - r < ws.segment_length && r * ratio - radii[0] <= 3 * ws.segment_length) {
+    r *= ratio;
+    g.push_back(r - radii[0]);
+  }
   return g;
 }
 

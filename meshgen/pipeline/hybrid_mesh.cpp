@@ -77,8 +77,15 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
   std::vector<TransitionCells> transitions;
   const int32_t base = builder.n_nodes();
   constexpr int kMaxRetries = 5;
+  std::string enlarged_for;  // the transition error that made the last enlargement
   for (int attempt = 0;; ++attempt) {
-    out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, extra_deactivated);
+    try {
+      out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, extra_deactivated);
+    } catch (const InputError& e) {
+      if (enlarged_for.empty()) throw;
+      // The cavity was enlarged for the transition (below) and can no longer be built: say why.
+      throw InputError(std::string(e.what()) + " (the cavity was enlarged because " + enlarged_for + ")");
+    }
     for (size_t k = 0; k < out.cavities.cavities.size(); ++k) {
       const auto problems = check_cavity_manifold(out.cavities.cavities[k], coords);
       if (!problems.empty())
@@ -108,6 +115,7 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
       throw std::runtime_error(first_error + (attempt > 0 ? " (after " + std::to_string(attempt) +
                                                                 " cavity enlargements)"
                                                           : std::string()));
+    enlarged_for = first_error;
     extra_deactivated.insert(extra_deactivated.end(), more.begin(), more.end());
     std::sort(extra_deactivated.begin(), extra_deactivated.end());
     extra_deactivated.erase(std::unique(extra_deactivated.begin(), extra_deactivated.end()), extra_deactivated.end());

@@ -295,7 +295,7 @@ TEST(CaseErrors, UnknownKeyAtEveryLevel) {
             "reservoir.poro: unknown key (expected one of: x, y, z, permeability, porosity, initial_pressure)");
   EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "    bhp: 250\n    skin: 0\n")),
             "wells[1].skin: unknown key (expected one of: name, type, trajectory, radius, drainage_radius, rings, "
-            "sectors, segment_length, bhp)");
+            "sectors, segment_length, bhp, end_caps)");
   EXPECT_EQ(error_of(kBase + "fluid: {viscosity: 1, mu: 1}\n"),
             "fluid.mu: unknown key (expected one of: viscosity, density, compressibility)");
 }
@@ -460,9 +460,10 @@ TEST(CaseErrors, WellDiscretisation) {
 }
 
 TEST(CaseErrors, TooManyWellCells) {
-  // 30 m / 1e-5 m = 3,000,000 segments x 6 rings x 12 sectors.
+  // 30 m / 1e-5 m = 3,000,000 segments, + 2 x 3 latitude bands of the hemispherical end caps
+  // (hemisphere_cap_bands(12) = 3), x 6 rings x 12 sectors.
   EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 1e-5")),
-            "wells[0]: too many cells (6 x 12 x 3000000 = 216000000 rings x sectors x segments; at most 20000000 "
+            "wells[0]: too many cells (6 x 12 x 3000006 = 216000432 rings x sectors x segments; at most 20000000 "
             "in the whole case)");
 }
 

@@ -89,19 +89,29 @@ size_t cross_gabriel_violations(const Built& b) {
 }  // namespace
 
 TEST(Cavity, VerticalWellGivesOneClosedManifoldGabrielCavity) {
+  for (const EndCaps ends : {EndCaps::Flat, EndCaps::Hemisphere}) {
+  SCOPED_TRACE(ends == EndCaps::Flat ? "flat ends" : "hemispherical caps");
   CaseSpec cs = base_case(5.0);
   cs.wells.push_back(well("P1", {{60, 60, 1020}, {60, 60, 1070}}));
+  cs.wells.back().end_caps = ends;
   const Built b = build(cs);
   ASSERT_EQ(b.set.cavities.size(), 1u);
   const Cavity& cav = b.set.cavities[0];
   EXPECT_TRUE(check_cavity_manifold(cav, b.coords).empty());
-  int quads = 0, caps = 0;
+  int quads = 0, triangles = 0, caps = 0;
   for (const ConstrainedFace& f : cav.faces) {
     if (f.nodes.size() == 4) ++quads;
+    if (f.nodes.size() == 3) ++triangles;
     if (f.patch != kInteriorFace) ++caps;
   }
-  EXPECT_EQ(caps, 2);                                      // the two wellbore end caps
-  EXPECT_EQ(quads + caps, static_cast<int>(cav.faces.size()));  // everything else is a quad
+  if (ends == EndCaps::Flat) {
+    EXPECT_EQ(caps, 2);                                           // the two wellbore end caps
+    EXPECT_EQ(quads + caps, static_cast<int>(cav.faces.size()));  // everything else is a quad
+  } else {
+    EXPECT_EQ(caps, 0);               // the wellbore is closed inside the block
+    EXPECT_EQ(triangles, 2 * 12);     // the caps' polar shell faces, one per sector
+    EXPECT_EQ(quads + triangles, static_cast<int>(cav.faces.size()));
+  }
   EXPECT_EQ(cross_gabriel_violations(b), 0u);
   // Every cell within dilation x drainage radius of the axis is deactivated.
   for (int c = 0; c < b.grid.n_cells(); ++c) {
@@ -111,6 +121,7 @@ TEST(Cavity, VerticalWellGivesOneClosedManifoldGabrielCavity) {
     if (in_z && std::hypot(dx, dy) < 1.5 * 6 - 1e-9) {
       EXPECT_FALSE(b.set.reservoir_active[c]) << c;
     }
+  }
   }
 }
 

@@ -1,7 +1,7 @@
 // The near-well accuracy study on the four shipped cases (examples/accuracy_*.yaml).
-// Default run: every case at its own resolution (a few seconds each). The issue #7 acceptance
-// criteria and the three-level refinement study are long (minutes, 2+ GB): they run only when
-// the environment has HM_LONG_TESTS=1 (docs/accuracy.md says how to run them).
+// Default run: every case at its own resolution (a few seconds each), with the issue #7
+// acceptance criteria. The three-level refinement study is long (minutes, 2+ GB): it runs only
+// when the environment has HM_LONG_TESTS=1 (docs/accuracy.md says how to run it).
 #include <gtest/gtest.h>
 
 
@@ -34,8 +34,9 @@ bool long_tests_enabled() {
 class AccuracyCase : public ::testing::TestWithParam<const char*> {};
 
 // Every case meshes, both models solve to the tight tolerance, the errors are measured over a
-// non-empty near-well region, and the hybrid rate is within the issue's 0.5 %.
-TEST_P(AccuracyCase, RunsAndTheHybridRateIsWithinHalfAPercent) {
+// non-empty near-well region, and (issue #7) the hybrid rate and near-well pressure errors are
+// within 0.5 % and the near-well error is below Cartesian + Peaceman's on the same grid.
+TEST_P(AccuracyCase, HybridWithinHalfAPercentAndBetterThanPeaceman) {
   const AccuracyStudy st = run_accuracy_study(accuracy_case(GetParam()), 1);
   for (const AccuracyErrors* e : {&st.hybrid, &st.peaceman}) {
     EXPECT_GT(e->near_well_cells, 100);
@@ -45,6 +46,8 @@ TEST_P(AccuracyCase, RunsAndTheHybridRateIsWithinHalfAPercent) {
     EXPECT_GE(e->near_well_pressure_rel_error, e->l2_pressure_rel_error);
   }
   EXPECT_LT(std::fabs(st.hybrid.rate_rel_error), 0.005);
+  EXPECT_LE(st.hybrid.near_well_pressure_rel_error, 0.005);
+  EXPECT_LT(st.hybrid.near_well_pressure_rel_error, st.peaceman.near_well_pressure_rel_error);
   std::printf("%s: hybrid rate %+.3f %%, near-well %.3f %% (lateral %.3f %%, beyond the ends %.3f %%); "
               "Peaceman rate %+.3f %%, near-well %.3f %%\n",
               GetParam(), 100 * st.hybrid.rate_rel_error, 100 * st.hybrid.near_well_pressure_rel_error,
@@ -59,17 +62,18 @@ TEST(AccuracySetup, ExactRateAndSourceFollowTheCase) {
   const CaseSpec cs = accuracy_case("bent");
   const AccuracySetup s = make_accuracy_setup(cs);
   // The source follows the meshed axis: the trajectory with its bend cut along the chords of
-  // the block's fillet (docs/architecture.md): radius rho = 1.5 R, k wedges, tangents
+  // the block's fillet (docs/architecture.md): radius rho = 1.5 R, k wedges (at most 30 degrees,
+  // none longer than a segment on the outside of the bend, at radius rho + R), tangents
   // t = rho tan(beta/2) replaced by k chords 2 rho sin(beta / 2k).
   const WellSpec& w = cs.wells[0];
   const std::vector<Vec3>& t = w.trajectory;
   const Vec3 d1 = normalized(t[1] - t[0]), d2 = normalized(t[2] - t[1]);
   const double beta = std::atan2(norm(cross(d1, d2)), dot(d1, d2)), rho = 1.5 * w.drainage_radius;
   const int k = std::max(static_cast<int>(std::ceil(beta / (M_PI / 6))),
-                         static_cast<int>(std::lround(rho * beta / w.segment_length)));
+                         static_cast<int>(std::ceil((rho + w.drainage_radius) * beta / w.segment_length)));
   const double length = norm(t[1] - t[0]) + norm(t[2] - t[1]) - 2 * rho * std::tan(beta / 2) +
                         k * 2 * rho * std::sin(beta / (2 * k));
-  EXPECT_EQ(k, 2);  // the 40-degree bend of accuracy_bent
+  EXPECT_EQ(k, 4);  // the 40-degree bend of accuracy_bent: 20 m x 0.70 rad / 4 m = 3.5 -> 4
   EXPECT_NEAR(s.field.source_length(), length - 2 * w.radius, 1e-9);
   EXPECT_NEAR(s.drawdown, 50.0, 1e-12);
   EXPECT_NEAR(s.near_radius, 24.0, 1e-12);
@@ -133,15 +137,20 @@ TEST(AccuracyReport, JsonAndSvgAreWritten) {
 
 // ---------------------------------------------------------------- long: issue #7 acceptance
 
-class AccuracyAcceptance : public ::testing::TestWithParam<const char*> {};
-
-TEST_P(AccuracyAcceptance, HybridWithinHalfAPercentAndBetterThanPeaceman) {
-  if (!long_tests_enabled()) GTEST_SKIP() << "long test: set HM_LONG_TESTS=1";
-  const AccuracyStudy st = run_accuracy_study(accuracy_case(GetParam()), 1);
-  EXPECT_LE(std::fabs(st.hybrid.rate_rel_error), 0.005);
-  EXPECT_LE(st.hybrid.near_well_pressure_rel_error, 0.005);
-  EXPECT_LT(st.hybrid.near_well_pressure_rel_error, st.peaceman.near_well_pressure_rel_error);
+// The other half of the pair above: the same vertical case with flat ends (no cap, uniform
+// segments) misses the 0.5 % at the tips (docs/accuracy.md: ~1.1 %), where the flow is 3D.
+TEST(AccuracyEnds, FlatEndsMissHalfAPercentAtTheTips) {
+  CaseSpec cs = accuracy_case("vertical");
+  cs.wells[0].end_caps = EndCaps::Flat;
+  const AccuracyStudy st = run_accuracy_study(cs, 1);
+  EXPECT_GT(st.hybrid.near_well_pressure_rel_error, 0.005);
+  EXPECT_EQ(st.hybrid.near_well_pressure_rel_error, st.hybrid.near_well_max_beyond_ends);
+  std::printf("vertical, flat ends: near-well %.3f %% (beyond the ends %.3f %%, lateral %.3f %%)\n",
+              100 * st.hybrid.near_well_pressure_rel_error, 100 * st.hybrid.near_well_max_beyond_ends,
+              100 * st.hybrid.near_well_max_lateral);
 }
+
+class AccuracyAcceptance : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(AccuracyAcceptance, RefinementLowersTheHybridError) {
   if (!long_tests_enabled()) GTEST_SKIP() << "long test: set HM_LONG_TESTS=1";

@@ -47,6 +47,7 @@ CaseSpec radial_case_spec(const RadialCase& rc) {
   w.rings = rc.rings;
   w.sectors = rc.sectors;
   w.segment_length = rc.segment_length;
+  w.end_caps = EndCaps::Flat;  // a block with flat end faces (no-flow): 2D radial flow
   cs.wells.push_back(w);
   return cs;
 }
