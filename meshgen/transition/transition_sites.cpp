@@ -390,6 +390,12 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
   int corrections = 0;
   int left = 0;
   std::vector<char> stuck;
+  // Iteration at which each site was last moved toward its polygon: a site shrunk for one pair
+  // and grown back for another in alternate iterations would cycle (measured near hemispherical
+  // end caps, where neighbouring cap polygons differ in size); once shrunk it is not grown for a
+  // few iterations, so the other pair's larger site must shrink instead.
+  std::vector<int> shrunk_at(set.sites.size(), -1000);
+  constexpr int kNoGrowAfterShrink = 3;
   for (int it = 1; it <= max_iterations; ++it) {
     *iterations = it;
     // A pair is examined when |Pi Pj|^2 <= max(wi^2, wj^2): each site looks for the others
@@ -427,8 +433,11 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
         // The larger weight moves toward its polygon (5.5.2); once it cannot (a polygon site
         // at its minimal distance), the smaller one moves away from its polygon instead,
         // which raises its weight, within its empty-sphere range.
+        const bool small_may_grow = can_grow(set, small, frames) &&
+                                    (small >= static_cast<int>(shrunk_at.size()) ||
+                                     it - shrunk_at[small] > kNoGrowAfterShrink);
         if (can_shrink(set, large, frames)) fix[large] = 1;
-        else if (can_grow(set, small, frames)) grow[small] = 1;
+        else if (small_may_grow) grow[small] = 1;
         else fix[large] = 1;
       }
     }
@@ -440,8 +449,12 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
       for (size_t s = 0; s < fix.size(); ++s) stuck[s] = fix[s] || grow[s] || involved[s];
       break;
     }
+    shrunk_at.resize(set.sites.size(), -1000);
     for (size_t s = 0; s < fix.size(); ++s)
-      if (fix[s]) shrink_or_split(set, static_cast<int>(s), kShrink, cavity, coords, grid, frames);
+      if (fix[s]) {
+        shrink_or_split(set, static_cast<int>(s), kShrink, cavity, coords, grid, frames);
+        shrunk_at[s] = it;
+      }
     for (size_t s = 0; s < grow.size(); ++s)
       if (grow[s] && !fix[s] && set.sites[s].alive && set.sites[s].kind == SiteKind::InternalPolygon) {
         const Site& site = set.sites[s];

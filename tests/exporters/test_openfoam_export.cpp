@@ -222,8 +222,9 @@ double openfoam_skewness(const hm::PolyMesh& mesh, const hm::MeshGeometry& geo, 
   return hm::norm(sv) / fd;
 }
 
-// The shipped examples through the pipeline: checkMesh accepts the whole hybrid mesh with the
-// right cell count and our total volume; one wellbore patch per well.
+// The shipped examples through the pipeline (accuracy_bent: hemispherical end caps and a bend):
+// checkMesh accepts the whole hybrid mesh with the right cell count and our total volume; one
+// wellbore patch per well.
 class CheckMeshExample : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(CheckMeshExample, HybridMeshPasses) {
@@ -297,10 +298,11 @@ TEST_P(CheckMeshExample, HybridMeshPasses) {
   // OpenFOAM's face centres (triangle fan about the point average) differ from ours on the
   // faces the optimiser leaves non-planar (up to omega_p = 10 deg): 0.11 % measured, 1 % allowed.
   EXPECT_NEAR(std::stod(m[1]), max_skew, 1e-2 * max_skew);
-  EXPECT_NEAR(std::stod(m[1]), optimiser_max, 1e-4 * optimiser_max);  // measured 3e-5 and 8e-5
+  // measured 3e-5 and 8e-5 (flat ends), 1.7e-4 (accuracy_bent: a triangle next to a cap's pole)
+  EXPECT_NEAR(std::stod(m[1]), optimiser_max, 5e-4 * optimiser_max);
 }
 
-INSTANTIATE_TEST_SUITE_P(Examples, CheckMeshExample, ::testing::Values("paper_single_well", "three_wells"),
+INSTANTIATE_TEST_SUITE_P(Examples, CheckMeshExample, ::testing::Values("paper_single_well", "three_wells", "accuracy_bent"),
                          [](const auto& info) { return std::string(info.param); });
 
 // The fail half of the pair: the same gate rejects a mesh with an inverted cell, so passing it
