@@ -42,7 +42,7 @@ struct WellSpec {
   int sectors = 12;               ///< angular cells, >= 3 (raised when Gabriel needs it)
   double segment_length = 4.0;    ///< target cell length along the trajectory (m), > 0
   double bhp = 150;               ///< bottom-hole pressure (bar)
-  EndCaps end_caps = EndCaps::Flat;  ///< closing of the block at both ends (default flat: docs/case-format.md)
+  EndCaps end_caps = EndCaps::Hemisphere;  ///< closing of the block at both ends (docs/case-format.md)
 };
 
 /// Latitude bands of a hemispherical end cap (the polar one, a fan of triangles about the pole,

@@ -78,13 +78,21 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
   const int32_t base = builder.n_nodes();
   constexpr int kMaxRetries = 5;
   std::string enlarged_for;  // the transition error that made the last enlargement
+  // Hemispherical caps reach a drainage radius beyond the end points: next to much coarser
+  // reservoir cells the site correction can fail there (docs/transition.md, known limits).
+  bool any_caps = false;
+  for (const WellSpec& w : cs.wells) any_caps = any_caps || w.end_caps == EndCaps::Hemisphere;
+  const std::string caps_hint =
+      any_caps ? "; with hemispherical end caps next to coarse reservoir cells, refining the reservoir beyond the "
+                 "well ends or wells[i].end_caps: flat may help (docs/case-format.md)"
+               : "";
   for (int attempt = 0;; ++attempt) {
     try {
       out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, extra_deactivated);
     } catch (const InputError& e) {
       if (enlarged_for.empty()) throw;
       // The cavity was enlarged for the transition (below) and can no longer be built: say why.
-      throw InputError(std::string(e.what()) + " (the cavity was enlarged because " + enlarged_for + ")");
+      throw InputError(std::string(e.what()) + " (the cavity was enlarged because " + enlarged_for + ")" + caps_hint);
     }
     for (size_t k = 0; k < out.cavities.cavities.size(); ++k) {
       const auto problems = check_cavity_manifold(out.cavities.cavities[k], coords);
@@ -112,9 +120,10 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
     }
     if (first_error.empty()) break;
     if (more.empty() || attempt == kMaxRetries)
-      throw std::runtime_error(first_error + (attempt > 0 ? " (after " + std::to_string(attempt) +
-                                                                " cavity enlargements)"
-                                                          : std::string()));
+      throw std::runtime_error(first_error +
+                               (attempt > 0 ? " (after " + std::to_string(attempt) + " cavity enlargements)"
+                                            : std::string()) +
+                               caps_hint);
     enlarged_for = first_error;
     extra_deactivated.insert(extra_deactivated.end(), more.begin(), more.end());
     std::sort(extra_deactivated.begin(), extra_deactivated.end());

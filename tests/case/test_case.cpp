@@ -460,13 +460,14 @@ TEST(CaseErrors, WellDiscretisation) {
 }
 
 TEST(CaseErrors, TooManyWellCells) {
-  // 30 m / 1e-5 m = 3,000,000 segments x 6 rings x 12 sectors.
+  // 30 m / 1e-5 m = 3,000,000 segments, + 2 x 4 latitude bands of the hemispherical end caps
+  // (the default; hemisphere_cap_bands(12) = 4), x 6 rings x 12 sectors.
   EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 1e-5")),
-            "wells[0]: too many cells (6 x 12 x 3000000 = 216000000 rings x sectors x segments; at most 20000000 "
-            "in the whole case)");
-  // With hemispherical end caps: + 2 x 4 latitude bands (hemisphere_cap_bands(12) = 4).
-  EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 1e-5\n    end_caps: hemisphere")),
             "wells[0]: too many cells (6 x 12 x 3000008 = 216000576 rings x sectors x segments; at most 20000000 "
+            "in the whole case)");
+  // Flat ends: the segments only.
+  EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 1e-5\n    end_caps: flat")),
+            "wells[0]: too many cells (6 x 12 x 3000000 = 216000000 rings x sectors x segments; at most 20000000 "
             "in the whole case)");
 }
 

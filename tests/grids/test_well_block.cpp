@@ -1191,7 +1191,7 @@ wells:
 }  // namespace
 
 TEST(EndCapsKey, FlatAndHemisphereParseOtherValuesFail) {
-  EXPECT_EQ(parse_case(case_with_end_caps("")).wells.at(0).end_caps, EndCaps::Flat);  // the default
+  EXPECT_EQ(parse_case(case_with_end_caps("")).wells.at(0).end_caps, EndCaps::Hemisphere);  // the default
   EXPECT_EQ(parse_case(case_with_end_caps("    end_caps: hemisphere\n")).wells.at(0).end_caps, EndCaps::Hemisphere);
   EXPECT_EQ(parse_case(case_with_end_caps("    end_caps: flat\n")).wells.at(0).end_caps, EndCaps::Flat);
   for (const auto& [value, shown] : std::vector<std::pair<std::string, std::string>>{

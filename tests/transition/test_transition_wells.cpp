@@ -249,7 +249,8 @@ TEST(TransitionWells, HemisphereCaps) {
 
 // A known limit (docs/transition.md): the horizontal case above with caps puts the caps' poles
 // 4 m from 10 m reservoir cells; the site correction cycles there, the cavity enlargement runs
-// into the reservoir boundary, and the mesher stops with an input error that says both.
+// into the reservoir boundary, and the mesher stops with an input error that says both and
+// suggests the way out.
 TEST(TransitionWells, HemisphereCapsNextToCoarseCellsAreRefusedWithTheReason) {
   const CaseSpec cs = parse_case(case_yaml("hcaps", well("H", "[[33, 50, 25], [67, 50, 25]]", 4.0, "hemisphere")));
   PipelineOptions opts;
@@ -263,6 +264,7 @@ TEST(TransitionWells, HemisphereCapsNextToCoarseCellsAreRefusedWithTheReason) {
     EXPECT_NE(what.find("(the cavity was enlarged because transition: site correction did not converge"),
               std::string::npos)
         << what;
+    EXPECT_NE(what.find("wells[i].end_caps: flat may help"), std::string::npos) << what;
   }
 }
 
