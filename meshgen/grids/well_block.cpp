@@ -482,9 +482,27 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
       for (int s = 0; s < sectors; ++s) block.nodes.push_back(st.p + block.radii[i] * (cos_s[s] * st.u + sin_s[s] * st.v));
   auto node = [&](int l, int i, int s) { return static_cast<int32_t>((l * (rings + 1) + i) * sectors + s % sectors); };
 
+  // Attributes shared by every radial cell, cylinder and caps.
+  const double sector_angle = 2.0 * kPi / sectors;
+  auto radial_cell = [&](int ring, int sector, int segment) {
+    CellAttributes at;
+    at.region = kWell;
+    at.perm = cs.reservoir.permeability;
+    at.porosity = cs.reservoir.porosity;
+    RadialCellInfo& rad = at.radial;
+    rad.well = w;
+    rad.ring = ring;
+    rad.sector = sector;
+    rad.segment = segment;
+    rad.r_in = block.radii[ring];
+    rad.r_out = block.radii[ring + 1];
+    rad.r_center = std::sqrt(rad.r_in * rad.r_out);
+    rad.angle = sector_angle;
+    return at;
+  };
+
   // Cells: id = (segment * rings + ring) * sectors + sector.
   const int32_t wellbore = wellbore_patch(w);
-  const double sector_angle = 2.0 * kPi / sectors;
   const int n_segments = n_layers - 1;
   block.cell_faces.reserve(static_cast<size_t>(n_segments) * rings * sectors);
   block.cell_attrs.reserve(static_cast<size_t>(n_segments) * rings * sectors);
@@ -509,20 +527,9 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
           throw InputError(well_key(w) + ".trajectory: radial cell (ring " + std::to_string(i) + ", sector " +
                            std::to_string(s) + ", segment " + std::to_string(l) + ") is inverted (volume " + num(vol) +
                            " m3)");
-        CellAttributes at;
-        at.region = kWell;
-        at.perm = cs.reservoir.permeability;
-        at.porosity = cs.reservoir.porosity;
-        RadialCellInfo& rad = at.radial;
-        rad.well = w;
-        rad.ring = i;
-        rad.sector = s;
-        rad.segment = l;
-        rad.r_in = block.radii[i];
-        rad.r_out = block.radii[i + 1];
-        rad.r_center = std::sqrt(rad.r_in * rad.r_out);
-        rad.angle = sector_angle;
-        rad.length = length;
+        CellAttributes at = radial_cell(i, s, l);
+        const RadialCellInfo& rad = at.radial;
+        at.radial.length = length;
         const double phi_mid = (s + 0.5) * sector_angle;
         // Midpoint of the point at radius r_center on the mid-angle radial line of both
         // cross-sections: the axis midpoint on straight parts (ring and angular faces exactly
@@ -584,21 +591,10 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
             throw InputError(well_key(w) + ".end_caps: cap cell (ring " + std::to_string(i) + ", band " +
                              std::to_string(j) + ", sector " + std::to_string(s) + ") is degenerate (volume " +
                              num(vol) + " m3)");
-          CellAttributes at;
-          at.region = kWell;
-          at.perm = cs.reservoir.permeability;
-          at.porosity = cs.reservoir.porosity;
+          CellAttributes at = radial_cell(i, s, at_start ? -1 : n_segments);
           RadialCellInfo& rad = at.radial;
-          rad.well = w;
-          rad.ring = i;
-          rad.sector = s;
-          rad.segment = at_start ? -1 : n_segments;
           rad.band = j;
           rad.cap_center = e;
-          rad.r_in = block.radii[i];
-          rad.r_out = block.radii[i + 1];
-          rad.r_center = std::sqrt(rad.r_in * rad.r_out);
-          rad.angle = sector_angle;
           const double phi_mid = (s + 0.5) * sector_angle;
           const Vec3 m = std::cos(phi_mid) * st.u + std::sin(phi_mid) * st.v;
           at.fv_center = e + rad.r_center * (std::cos(lat.beta[j]) * m + std::sin(lat.beta[j]) * a);
