@@ -396,7 +396,8 @@ void check_wells(const CaseSpec& cs) {
     double segments = 0;
     for (size_t i = 0; i + 1 < w.trajectory.size(); ++i)
       segments += std::max(1.0, std::ceil(norm(w.trajectory[i + 1] - w.trajectory[i]) / w.segment_length));
-    if (w.end_caps == EndCaps::Hemisphere) segments += 2.0 * hemisphere_cap_bands(w.sectors);
+    if (w.end_caps == EndCaps::Hemisphere)
+      segments += 2.0 * (hemisphere_cap_bands(w.sectors) + static_cast<double>(hemisphere_end_grading(w).size()));
     const double cells = double(w.rings) * double(w.sectors) * segments;
     total_cells += cells;
     if (total_cells > kMaxCells)
@@ -442,6 +443,19 @@ CaseSpec read_case(const YAML::Node& root) {
 }
 
 }  // namespace
+
+std::vector<double> hemisphere_end_grading(const WellSpec& ws) {
+  std::vector<double> g;
+  if (ws.end_caps != EndCaps::Hemisphere || !(ws.drainage_radius > ws.radius) || ws.rings < 1) return g;
+  const double ratio = std::pow(ws.drainage_radius / ws.radius, 1.0 / ws.rings);
+  double r = ws.radius;
+  while (static_cast<int>(g.size()) < ws.rings && r * ratio - r < ws.segment_length &&
+         r * ratio - ws.radius <= 3 * ws.segment_length) {
+    r *= ratio;
+    g.push_back(r - ws.radius);
+  }
+  return g;
+}
 
 CaseSpec parse_case(const std::string& yaml_text) {
   try {

@@ -48,8 +48,18 @@ struct WellSpec {
 /// Latitude bands of a hemispherical end cap (the polar one, a fan of triangles about the pole,
 /// included): (sectors + 2) / 4 + 1, 4 for 12 sectors, so that the polar triangles are narrow
 /// (3 bands left transition faces of OpenFOAM skewness 4.3 beyond the pole of the bent accuracy
-/// case, docs/accuracy.md); 1 below 6 sectors.
-inline int hemisphere_cap_bands(int sectors) { return sectors < 6 ? 1 : (sectors + 2) / 4 + 1; }
+/// case, docs/accuracy.md); 2 for 3-5 sectors (1 band left the end-plane faces 13-19 degrees
+/// from orthogonal).
+inline int hemisphere_cap_bands(int sectors) { return (sectors + 2) / 4 + 1; }
+
+/// Distances from a trajectory end of the extra stations of a block with hemispherical caps
+/// (empty with flat ends): r_k - r_w, k = 1, 2, ... (r_k = r_w q^k, q the ring ratio), while the
+/// layer they close (r_k - r_{k-1} thick) is thinner than a segment, within 3 segments of the
+/// end, and at most `rings` of them. Near a well's end the field varies along the axis on the
+/// scale of the distance to the end, as it does radially: the cap's cells next to the end
+/// cross-section are as small as the rings, and so must be the layers of the cylinder behind it
+/// (docs/architecture.md, "End caps").
+std::vector<double> hemisphere_end_grading(const WellSpec& ws);
 
 struct TransitionSpec {
   double dilation = 1.5;                       ///< >= 1

@@ -217,30 +217,11 @@ struct Station {
   int bend_point = -1;  // trajectory point of the bend whose wedges it bounds, -1 on straight parts
 };
 
-// Distances from a trajectory end of the extra stations of a block with hemispherical caps:
-// r_k - r_w, k = 1, 2, ... (r_k = r_w q^k, q the ring ratio), while the layer they close
-// (r_k - r_{k-1} thick) is thinner than a segment and within 3 segments of the end. Near a well's end the field varies along the axis on the scale of the distance to
-// the end, as it does radially: the cap's cells next to the end cross-section are as small as
-// the rings, and so must be the layers of the cylinder behind it, growing by the ring ratio up
-// to the segment length (docs/architecture.md, "End caps").
-std::vector<double> end_grading(const WellSpec& ws, const std::vector<double>& radii) {
-  std::vector<double> g;
-  if (ws.end_caps != EndCaps::Hemisphere) return g;
-  const double ratio = radii[1] / radii[0];
-  double r = radii[0];
-  // (the graded part stops within 3 segments of the end whatever the ring ratio)
-  while (r * ratio - r < ws.segment_length && r * ratio - radii[0] <= 3 * ws.segment_length) {
-    r *= ratio;
-    g.push_back(r - radii[0]);
-  }
-  return g;
-}
-
 // Stations along the trajectory: straight parts of each leg split into segments of about
 // segment_length, bends replaced by their wedges; with hemispherical caps, the stations of
-// end_grading at both trajectory ends.
+// hemisphere_end_grading (case.hpp) at both trajectory ends.
 std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& legs,
-                                   const std::vector<BendPlan>& plans, const std::vector<double>& radii) {
+                                   const std::vector<BendPlan>& plans) {
   const int n_legs = static_cast<int>(legs.size());
   std::vector<const BendPlan*> plan_at(n_legs + 1, nullptr);
   for (const BendPlan& p : plans) plan_at[p.point] = &p;
@@ -253,8 +234,8 @@ std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& l
     if (k == 0) st.push_back({s0, g.d, g.u, g.v, -1});
     // (a bend's last station, already pushed, is s0 of this leg)
     // Graded stations at the trajectory's ends, as many as leave half a segment between them.
-    std::vector<double> lo = k == 0 ? end_grading(ws, radii) : std::vector<double>{};
-    std::vector<double> hi = k + 1 == n_legs ? end_grading(ws, radii) : std::vector<double>{};
+    std::vector<double> lo = k == 0 ? hemisphere_end_grading(ws) : std::vector<double>{};
+    std::vector<double> hi = k + 1 == n_legs ? hemisphere_end_grading(ws) : std::vector<double>{};
     const double full = g.length - t0 - t1;
     while (!(lo.empty() && hi.empty()) &&
            (lo.empty() ? 0.0 : lo.back()) + (hi.empty() ? 0.0 : hi.back()) > full - 0.5 * ws.segment_length)
@@ -325,6 +306,7 @@ double hexahedron_volume(const std::vector<Vec3>& x, const std::vector<CellFace>
 //   of 30-120 degrees with 6-24 sectors); a violation there is reported, not repaired.
 struct GabrielDiagnosis {
   int total = 0, end_face = 0, bend = 0, other = 0;
+  int cap = 0;               // violations involving a hemispherical cap's vertex (more sectors do not help)
   int bend_point = -1;       // trajectory point of the first bend with violations
   double bend_degrees = 0;
 };
@@ -337,13 +319,15 @@ GabrielDiagnosis diagnose_gabriel(const WellBlock& block, const std::vector<Vec3
   const std::vector<int32_t>& layer_point = block.layer_bend;
   const int per_layer = (block.rings + 1) * block.sectors;
   const int last = block.layers - 1;
-  // Hemispherical caps' nodes come after the layers' (start cap first): they count as the
-  // end layer of their cap.
+  // Hemispherical caps' nodes come after the layers'. A cap's shells are Gabriel for every sector
+  // count (tests/grids); a violation there means the cap reaches another part of the block.
   const int32_t layer_nodes = block.layers * per_layer;
-  const int32_t per_cap = (static_cast<int32_t>(block.nodes.size()) - layer_nodes) / 2;
-  auto layer_of = [&](int32_t v) { return v < layer_nodes ? v / per_layer : (v - layer_nodes < per_cap ? 0 : last); };
   for (const GabrielViolation& v : violations) {
-    const int la = layer_of(v.a), lb = layer_of(v.b), lp = layer_of(v.p);
+    if (v.a >= layer_nodes || v.b >= layer_nodes || v.p >= layer_nodes) {
+      ++diag.cap;
+      continue;
+    }
+    const int la = v.a / per_layer, lb = v.b / per_layer, lp = v.p / per_layer;
     int point = -1;
     for (int l : {la, lb, lp})
       if (layer_point[l] >= 0) point = layer_point[l];
@@ -370,6 +354,37 @@ int min_end_face_sectors(double ratio) {
   int n = 4;
   while (std::cos(2.0 * kPi / n) < 1.0 / ratio) ++n;
   return n;
+}
+
+// Smallest sector count whose ring cells hold their FV centre (at sqrt(r_in r_out), inside the
+// outer chord at r_out cos(pi / n) iff cos(pi / n) > 1 / sqrt(q)).
+int min_centred_sectors(double ratio) {
+  int n = 3;
+  while (!(std::cos(kPi / n) > 1.0 / std::sqrt(ratio))) ++n;
+  return n;
+}
+
+// Radial cells whose FV centre is not strictly on the inner side of every face plane. With flat
+// ends the end faces' Gabriel rule (cos(2 pi / n) >= 1 / q) raises the sectors beyond
+// min_centred_sectors; hemispherical caps have no end faces, so it is checked directly.
+int count_off_centre_cells(const WellBlock& b) {
+  int off = 0;
+  for (size_t c = 0; c < b.cell_faces.size(); ++c) {
+    const Vec3 x = b.cell_attrs[c].fv_center;
+    for (const CellFace& f : b.cell_faces[c]) {
+      Vec3 area, mean;
+      const size_t k = f.nodes.size();
+      for (size_t i = 0; i < k; ++i) {
+        area += cross(b.nodes[f.nodes[i]], b.nodes[f.nodes[(i + 1) % k]]);
+        mean += b.nodes[f.nodes[i]];
+      }
+      if (!(dot(area, x - mean / static_cast<double>(k)) < 0)) {
+        ++off;
+        break;
+      }
+    }
+  }
+  return off;
 }
 
 double regular_polygon_area(int n, double r) { return 0.5 * n * r * r * std::sin(2.0 * kPi / n); }
@@ -402,8 +417,9 @@ CapLatitudes cap_latitudes(int bands, double sector_angle) {
   auto circumcentre_latitude = [&](double a0, double a1) {
     return std::atan2(ch * (std::cos(a0) - std::cos(a1)), std::sin(a1) - std::sin(a0));
   };
-  // Fixed point (a contraction: converges in ~100-400 steps for 1-12 bands, measured).
-  for (int it = 0; it < 2000; ++it) {
+  // Fixed point (a contraction, slower with more bands: 178 steps for 4 bands, 1855 for 13,
+  // measured; the bound leaves room for ~100 sectors).
+  for (int it = 0; it < 100000; ++it) {
     for (int j = 0; j < bands; ++j) c.beta[j] = circumcentre_latitude(c.alpha[j], c.alpha[j + 1]);
     double change = 0;
     for (int j = 1; j < bands; ++j) {
@@ -459,7 +475,7 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
 
   const std::vector<Leg> legs = make_legs(ws, w);
   const std::vector<BendPlan> plans = plan_bends(ws, w, legs);
-  const std::vector<Station> stations = make_stations(ws, legs, plans, block.radii);
+  const std::vector<Station> stations = make_stations(ws, legs, plans);
   const int n_layers = static_cast<int>(stations.size());
   block.layers = n_layers;
   for (const Station& st : stations) {
@@ -649,13 +665,20 @@ WellBlock make_gabriel_well_block(const CaseSpec& cs, int w) {
   const int requested = ws.sectors;
   int sectors = requested;
   WellBlock block;
-  // Raising sectors only helps the end faces (see diagnose_gabriel): stop as soon as a
-  // violation elsewhere appears.
+  // Raising sectors only helps the end faces and the cells' centring (see diagnose_gabriel):
+  // stop as soon as a violation elsewhere appears.
+  bool for_gabriel = false, for_centres = false;
   for (;;) {
     block = make_well_block(cs, w, sectors);
     const GabrielDiagnosis diag = diagnose_gabriel(block, ws.trajectory);
-    if (diag.total == 0) break;
+    const int off_centre = count_off_centre_cells(block);
+    if (diag.total == 0 && off_centre == 0) break;
     const std::string label = well_label(cs, w);
+    if (diag.cap > 0)
+      throw InputError(label + ": the outer surface of the radial block is not Gabriel next to a hemispherical end cap (" +
+                       std::to_string(diag.cap) + " violations: the cap, which reaches drainage_radius beyond the end "
+                       "point, comes close to another part of the block); use a smaller drainage_radius or "
+                       "end_caps: flat");
     if (diag.bend > 0)
       throw InputError(label + ": the outer surface of the radial block is not Gabriel next to the bend of " +
                        num(diag.bend_degrees) + " degrees at trajectory point " + std::to_string(diag.bend_point) +
@@ -667,21 +690,31 @@ WellBlock make_gabriel_well_block(const CaseSpec& cs, int w) {
     if (diag.other > 0)
       throw InputError(label + ": the outer surface of the radial block is not Gabriel with " +
                        std::to_string(sectors) + " sectors (" + std::to_string(diag.other) + " violations)");
+    for_gabriel = for_gabriel || diag.end_face > 0;
+    for_centres = for_centres || off_centre > 0;
     const int next = sectors % 2 == 0 ? sectors + 2 : sectors + 1;
     if (next > 4 * requested) {
       const double ratio = block.radii[1] / block.radii[0];
-      throw InputError(label + ": the end faces of the radial block are not Gabriel even with " +
-                       std::to_string(sectors) + " sectors (4x the " + std::to_string(requested) + " requested, " +
-                       std::to_string(diag.end_face) + " violations): the ring radius ratio " + num(ratio) +
-                       " needs cos(2 pi / sectors) >= 1 / " + num(ratio) + ", i.e. at least " +
-                       std::to_string(min_end_face_sectors(ratio)) + " sectors; use fewer rings");
+      if (diag.end_face > 0)
+        throw InputError(label + ": the end faces of the radial block are not Gabriel even with " +
+                         std::to_string(sectors) + " sectors (4x the " + std::to_string(requested) + " requested, " +
+                         std::to_string(diag.end_face) + " violations): the ring radius ratio " + num(ratio) +
+                         " needs cos(2 pi / sectors) >= 1 / " + num(ratio) + ", i.e. at least " +
+                         std::to_string(min_end_face_sectors(ratio)) + " sectors; use fewer rings");
+      throw InputError(label + ": " + std::to_string(off_centre) + " radial cells do not contain their FV centre even with " +
+                       std::to_string(sectors) + " sectors (4x the " + std::to_string(requested) +
+                       " requested): the ring radius ratio " + num(ratio) + " needs cos(pi / sectors) > 1 / sqrt(" +
+                       num(ratio) + "), i.e. at least " + std::to_string(min_centred_sectors(ratio)) +
+                       " sectors; use fewer rings");
     }
     sectors = next;
   }
   block.sectors_requested = requested;
   if (sectors != requested)
     block.notes.push_back(well_label(cs, w) + ": sectors raised from " + std::to_string(requested) + " to " +
-                          std::to_string(sectors) + " for the Gabriel condition");
+                          std::to_string(sectors) +
+                          (for_gabriel ? " for the Gabriel condition" : " so that every radial cell holds its FV centre") +
+                          (for_gabriel && for_centres ? " and the cells' centring" : ""));
   return block;
 }
 

@@ -454,6 +454,10 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
       if (fix[s]) {
         shrink_or_split(set, static_cast<int>(s), kShrink, cavity, coords, grid, frames);
         shrunk_at[s] = it;
+        // A reflection shrinks by moving its internal partner: hold that one too.
+        const Site& site = set.sites[s];
+        if (site.kind == SiteKind::ExternalMirror && site.polygon >= 0 && set.internal_of[site.polygon] >= 0)
+          shrunk_at[set.internal_of[site.polygon]] = it;
       }
     for (size_t s = 0; s < grow.size(); ++s)
       if (grow[s] && !fix[s] && set.sites[s].alive && set.sites[s].kind == SiteKind::InternalPolygon) {

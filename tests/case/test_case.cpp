@@ -2,6 +2,8 @@
 // robustness against malformed documents (only InputError, one-line messages).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -469,6 +471,29 @@ TEST(CaseErrors, TooManyWellCells) {
   EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 1e-5\n    end_caps: flat")),
             "wells[0]: too many cells (6 x 12 x 3000000 = 216000000 rings x sectors x segments; at most 20000000 "
             "in the whole case)");
+}
+
+// Hemispherical caps grade the end layers like the rings (hemisphere_end_grading, at most
+// `rings` layers per end): with 2000 rings that is 2 x 2000 layers more, which the budget counts
+// (30 m / 4 m = 8 segments + 2 x (4 bands + 2000 layers) = 4016); with flat ends the same well
+// is 2000 x 12 x 8 cells and passes.
+TEST(CaseErrors, TooManyCellsCountsTheGradedEndLayers) {
+  EXPECT_EQ(error_of(with(kBase, "rings: 6", "rings: 2000")),
+            "wells[0]: too many cells (2000 x 12 x 4016 = 96384000 rings x sectors x segments; at most 20000000 "
+            "in the whole case)");
+  EXPECT_EQ(error_of(with(kBase, "rings: 6", "rings: 2000\n    end_caps: flat")), "");
+  WellSpec w;
+  w.radius = 0.1;
+  w.drainage_radius = 8;
+  w.rings = 2000;
+  EXPECT_EQ(hemisphere_end_grading(w).size(), 2000u);  // capped at `rings`
+  w.rings = 6;  // accuracy_vertical: r_k - r_w while the layer is thinner than a 4 m segment
+  const std::vector<double> g = hemisphere_end_grading(w);
+  ASSERT_EQ(g.size(), 5u);
+  const double q = std::pow(80.0, 1.0 / 6);
+  for (size_t k = 0; k < g.size(); ++k) EXPECT_NEAR(g[k], 0.1 * std::pow(q, k + 1.0) - 0.1, 1e-12);
+  w.end_caps = EndCaps::Flat;
+  EXPECT_TRUE(hemisphere_end_grading(w).empty());
 }
 
 TEST(CaseErrors, TrajectoryShape) {
