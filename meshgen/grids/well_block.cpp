@@ -561,8 +561,8 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   auto cell = [&](int l, int i, int s) { return static_cast<int32_t>((l * rings + i) * sectors + s); };
 
   // Hemispherical caps (cap_latitudes): cells appended after the cylinder's, nodes after its
-  // nodes; the end cross-section's nodes are the caps' latitude-0 nodes. Returns the cells'
-  // outer shell faces (cell id, face index).
+  // nodes; the end cross-section's nodes are the caps' latitude-0 nodes. cap_outer collects
+  // the outermost ring's shell faces (cell id, face index): the caps' part of the outer surface.
   std::vector<std::pair<int32_t, int>> cap_outer;
   auto add_cap = [&](bool at_start) {
     const int bands = hemisphere_cap_bands(sectors);
