@@ -354,9 +354,11 @@ WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_
   require(w.bhp > 0, f.path("bhp"), "must be > 0");
   if (auto e = f.get("end_caps")) {
     const std::string s = e->IsScalar() ? e->Scalar() : std::string();
+    w.end_caps_fallback = false;
     if (e->IsScalar() && s == "flat") w.end_caps = EndCaps::Flat;
     else if (e->IsScalar() && s == "hemisphere") w.end_caps = EndCaps::Hemisphere;
-    else fail(f.path("end_caps"), "expected flat or hemisphere, got " + describe(*e));
+    else if (e->IsScalar() && s == "auto") w.end_caps_fallback = true;
+    else fail(f.path("end_caps"), "expected auto, hemisphere or flat, got " + describe(*e));
   }
   return w;
 }

@@ -43,6 +43,9 @@ struct WellSpec {
   double segment_length = 4.0;    ///< target cell length along the trajectory (m), > 0
   double bhp = 150;               ///< bottom-hole pressure (bar)
   EndCaps end_caps = EndCaps::Hemisphere;  ///< closing of the block at both ends (docs/case-format.md)
+  /// end_caps: auto (the default): hemispherical caps, but flat ends when the caps cannot be
+  /// meshed (build_hybrid_mesh retries with flat ends and says so in its notes).
+  bool end_caps_fallback = true;
 };
 
 /// Latitude bands of a hemispherical end cap (the polar one, a fan of triangles about the pole,

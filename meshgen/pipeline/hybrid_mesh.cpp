@@ -47,7 +47,39 @@ class StageTimer {
 
 }  // namespace
 
+namespace {
+HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions& opts);
+}  // namespace
+
+// end_caps: auto. Hemispherical caps reach a drainage radius beyond the end points; next to much
+// coarser reservoir cells the transition may not be buildable there (docs/transition.md, known
+// limits). Wells that did not ask for caps explicitly are then closed with flat ends, and the
+// notes say so; an error with flat ends too is the case's own and is reported as such.
 HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
+  std::vector<int> fallback;
+  for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w)
+    if (cs.wells[w].end_caps == EndCaps::Hemisphere && cs.wells[w].end_caps_fallback) fallback.push_back(w);
+  if (fallback.empty()) return build_hybrid_mesh_as_given(cs, opts);
+  std::string why;
+  try {
+    return build_hybrid_mesh_as_given(cs, opts);
+  } catch (const std::exception& e) {  // InputError (cavity) or a transition failure
+    why = e.what();
+    why = why.substr(0, why.find("; with hemispherical end caps"));  // the hint is what happens next
+  }
+  CaseSpec flat = cs;
+  for (int w : fallback) flat.wells[w].end_caps = EndCaps::Flat;
+  HybridMesh out = build_hybrid_mesh_as_given(flat, opts);
+  std::string wells;
+  for (int w : fallback) wells += (wells.empty() ? "" : ", ") + ("wells[" + std::to_string(w) + "]");
+  out.notes.insert(out.notes.begin(), wells + ": closed with flat ends (end_caps: auto): the hemispherical end caps "
+                                      "could not be meshed: " + why);
+  return out;
+}
+
+namespace {
+
+HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions& opts) {
   HybridMesh out;
   StageTimer timer(&out.timings_s);
 
@@ -201,5 +233,7 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
   }
   return out;
 }
+
+}  // namespace
 
 }  // namespace hm

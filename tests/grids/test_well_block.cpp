@@ -1194,16 +1194,25 @@ wells:
 }  // namespace
 
 TEST(EndCapsKey, FlatAndHemisphereParseOtherValuesFail) {
-  EXPECT_EQ(parse_case(case_with_end_caps("")).wells.at(0).end_caps, EndCaps::Hemisphere);  // the default
-  EXPECT_EQ(parse_case(case_with_end_caps("    end_caps: hemisphere\n")).wells.at(0).end_caps, EndCaps::Hemisphere);
-  EXPECT_EQ(parse_case(case_with_end_caps("    end_caps: flat\n")).wells.at(0).end_caps, EndCaps::Flat);
+  // The default is auto: hemispherical caps, flat ends where they cannot be meshed.
+  for (const char* line : {"", "    end_caps: auto\n"}) {
+    const WellSpec w = parse_case(case_with_end_caps(line)).wells.at(0);
+    EXPECT_EQ(w.end_caps, EndCaps::Hemisphere);
+    EXPECT_TRUE(w.end_caps_fallback);
+  }
+  const WellSpec strict = parse_case(case_with_end_caps("    end_caps: hemisphere\n")).wells.at(0);
+  EXPECT_EQ(strict.end_caps, EndCaps::Hemisphere);
+  EXPECT_FALSE(strict.end_caps_fallback);
+  const WellSpec flat = parse_case(case_with_end_caps("    end_caps: flat\n")).wells.at(0);
+  EXPECT_EQ(flat.end_caps, EndCaps::Flat);
+  EXPECT_FALSE(flat.end_caps_fallback);
   for (const auto& [value, shown] : std::vector<std::pair<std::string, std::string>>{
            {"round", "'round'"}, {"[flat]", "a list"}, {"Flat", "'Flat'"}}) {
     try {
       parse_case(case_with_end_caps("    end_caps: " + value + "\n"));
       ADD_FAILURE() << "expected InputError for " << value;
     } catch (const InputError& e) {
-      EXPECT_EQ(std::string(e.what()), "wells[0].end_caps: expected flat or hemisphere, got " + shown);
+      EXPECT_EQ(std::string(e.what()), "wells[0].end_caps: expected auto, hemisphere or flat, got " + shown);
     }
   }
 }

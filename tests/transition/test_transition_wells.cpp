@@ -268,6 +268,27 @@ TEST(TransitionWells, HemisphereCapsNextToCoarseCellsAreRefusedWithTheReason) {
   }
 }
 
+// end_caps: auto (the default) on the same case: the caps cannot be meshed, so the pipeline closes
+// the well with flat ends, says so first in its notes, and the mesh has every run_case property.
+TEST(TransitionWells, AutoEndCapsFallBackToFlatEndsWhereCapsCannotBeMeshed) {
+  const CaseSpec cs = parse_case(case_yaml("hauto", well("H", "[[33, 50, 25], [67, 50, 25]]", 4.0, "auto")));
+  run_case("horizontal, auto caps", cs, 1);
+  PipelineOptions opts;
+  opts.optimize = false;
+  const HybridMesh hm = build_hybrid_mesh(cs, opts);
+  ASSERT_EQ(hm.blocks.size(), 1u);
+  EXPECT_FALSE(hm.blocks[0].hemisphere_caps);
+  ASSERT_FALSE(hm.notes.empty());
+  EXPECT_EQ(hm.notes[0].find("wells[0]: closed with flat ends (end_caps: auto): the hemispherical end caps could not "
+                             "be meshed: transition.dilation: the cavity reaches the reservoir boundary"),
+            0u)
+      << hm.notes[0];
+  // Where the caps can be meshed, auto keeps them.
+  const HybridMesh v =
+      build_hybrid_mesh(parse_case(case_yaml("vauto", well("V", "[[50, 50, 14], [50, 50, 36]]", 4.0, "auto"))), opts);
+  EXPECT_TRUE(v.blocks.at(0).hemisphere_caps);
+}
+
 // The paper's running example (examples/paper_single_well.yaml) and the three-well case
 // (two cavities, one of them merged).
 TEST(TransitionWells, PaperExample) {
