@@ -44,7 +44,8 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
                      {"rings", b.rings},
                      {"sectors", b.sectors},
                      {"sectors_requested", b.sectors_requested},
-                     {"segments", b.layers - 1}});
+                     {"segments", b.layers - 1},
+                     {"end_caps", b.hemisphere_caps ? "hemisphere" : "flat"}});
   j["wells"] = wells;
   j["notes"] = h.notes;
   if (!h.transition_reports.empty()) {

@@ -35,6 +35,8 @@ TEST_P(MeshgenExample, MeshesAndReportsConsistently) {
   const auto j = nlohmann::json::parse(hm_test::slurp(out / "summary.json"));
   EXPECT_EQ(j["cavities"].get<int>(), ex.cavities);
   EXPECT_EQ(j["wells"].size(), static_cast<size_t>(ex.wells));
+  // end_caps: auto keeps the hemispherical caps on every shipped example.
+  for (const auto& w : j["wells"]) EXPECT_EQ(w["end_caps"].get<std::string>(), "hemisphere") << w.dump();
   const auto& cells = j["cells"];
   EXPECT_EQ(cells["reservoir"].get<int>() + cells["transition"].get<int>() + cells["well"].get<int>(),
             cells["total"].get<int>());

@@ -62,6 +62,7 @@ TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
     w.sectors = 12;
     w.segment_length = 4;
     w.end_caps = t % 2 ? EndCaps::Hemisphere : EndCaps::Flat;
+    w.end_caps_fallback = false;  // caps must mesh: no fallback to flat ends
     const CaseSpec cs = random_case("random", w);
     SCOPED_TRACE("case " + std::to_string(t) + (t % 2 ? ", caps" : ", flat"));
     try {
@@ -104,6 +105,7 @@ TEST(RandomWells, BentWellsMeshConvexAndExactOrAreRefusedAsInput) {
     w.sectors = 12;
     w.segment_length = 3;
     w.end_caps = t % 2 ? EndCaps::Hemisphere : EndCaps::Flat;
+    w.end_caps_fallback = false;  // caps must mesh: no fallback to flat ends
     const CaseSpec cs = random_case("random_bent", w);
     SCOPED_TRACE("case " + std::to_string(t) + ", bend " + std::to_string(bend * 180 / M_PI) + " deg" + (t % 2 ? ", caps" : ", flat"));
     try {
