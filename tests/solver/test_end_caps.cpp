@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "block_mesh.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/core/geometry.hpp"
 #include "meshgen/core/mesh_builder.hpp"
@@ -49,12 +50,7 @@ PolyMesh block_mesh(const CaseSpec& cs) {
       if (nodes == key) f.patch = kOuterBoundary;
     }
   }
-  MeshBuilder b;
-  add_well_block(block, b);
-  BuildReport rep;
-  PolyMesh m = b.finish(&rep);
-  EXPECT_TRUE(rep.ok) << (rep.problems.empty() ? "" : rep.problems[0]);
-  return m;
+  return hm_test::assemble_block(block);
 }
 
 // Flux of grad(ln |x - E|) = (x - E) / |x - E|^2 through face f along n: 7-point Gauss on a fan

@@ -9,6 +9,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "block_mesh.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "solver_demo/lib/line_source.hpp"
@@ -63,12 +64,7 @@ PolyMesh radial_block_mesh(const RadialCase& rc) {
     if (r.segment == 0) block.cell_faces[c][4].patch = kOuterBoundary;
     if (r.segment == n_seg - 1) block.cell_faces[c][5].patch = kOuterBoundary;
   }
-  MeshBuilder b;
-  add_well_block(block, b);
-  BuildReport rep;
-  PolyMesh m = b.finish(&rep);
-  EXPECT_TRUE(rep.ok) << (rep.problems.empty() ? "" : rep.problems[0]);
-  return m;
+  return hm_test::assemble_block(block);
 }
 
 struct RadialErrors {
