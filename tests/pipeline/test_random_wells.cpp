@@ -43,6 +43,34 @@ double box_minus_hole(const CaseSpec& cs, const HybridMesh& h) {
   return 200.0 * 200.0 * 100.0 -
          0.5 * sectors * r_w * r_w * std::sin(2 * M_PI / sectors) * well_block_prism_length(cs, 0) - caps;
 }
+// Every other case with hemispherical end caps, strictly (they must mesh: no fallback to flat ends).
+void alternate_end_caps(WellSpec& w, int t) {
+  w.end_caps = t % 2 ? EndCaps::Hemisphere : EndCaps::Flat;
+  w.end_caps_fallback = false;
+}
+
+// Meshes the case (no optimisation). Returns true when it meshes, after checking the total volume
+// against the box minus the exact hole (and, with fv_checks, convexity, auto-centering and
+// conformity); false when it is refused as input.
+bool meshes_or_is_refused(const CaseSpec& cs, int t, bool fv_checks) {
+  try {
+    PipelineOptions opts;
+    opts.optimize = false;
+    const HybridMesh h = build_hybrid_mesh(cs, opts);
+    EXPECT_TRUE(h.build_report.ok);
+    const double expected = box_minus_hole(cs, h);
+    EXPECT_NEAR(total_volume(h.geometry), expected, 1e-9 * expected);
+    if (fv_checks) {
+      EXPECT_EQ(check_convexity(h.mesh, h.geometry).violations, 0);
+      EXPECT_EQ(check_auto_centering(h.mesh, h.geometry).violations, 0);
+      EXPECT_EQ(check_conformity(h.mesh, h.geometry).violations, 0);
+    }
+    return true;
+  } catch (const InputError& e) {
+    std::printf("[ refused   ] case %d: %s\n", t, e.what());
+    return false;
+  }
+}
 }  // namespace
 
 TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
@@ -61,22 +89,12 @@ TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
     w.rings = 5;
     w.sectors = 12;
     w.segment_length = 4;
-    w.end_caps = t % 2 ? EndCaps::Hemisphere : EndCaps::Flat;
-    w.end_caps_fallback = false;  // caps must mesh: no fallback to flat ends
-    const CaseSpec cs = random_case("random", w);
+    alternate_end_caps(w, t);
     SCOPED_TRACE("case " + std::to_string(t) + (t % 2 ? ", caps" : ", flat"));
-    try {
-      PipelineOptions opts;
-      opts.optimize = false;
-      const HybridMesh h = build_hybrid_mesh(cs, opts);
-      ASSERT_TRUE(h.build_report.ok);
-      const double expected = box_minus_hole(cs, h);
-      EXPECT_NEAR(total_volume(h.geometry), expected, 1e-9 * expected);
+    if (meshes_or_is_refused(random_case("random", w), t, false))
       ++meshed;
-    } catch (const InputError& e) {
+    else
       ++refused;
-      std::printf("[ refused   ] case %d: %s\n", t, e.what());
-    }
   }
   std::printf("[ random    ] %d meshed, %d refused as input\n", meshed, refused);
   EXPECT_GE(meshed, 8);
@@ -104,25 +122,13 @@ TEST(RandomWells, BentWellsMeshConvexAndExactOrAreRefusedAsInput) {
     w.rings = 4;
     w.sectors = 12;
     w.segment_length = 3;
-    w.end_caps = t % 2 ? EndCaps::Hemisphere : EndCaps::Flat;
-    w.end_caps_fallback = false;  // caps must mesh: no fallback to flat ends
-    const CaseSpec cs = random_case("random_bent", w);
-    SCOPED_TRACE("case " + std::to_string(t) + ", bend " + std::to_string(bend * 180 / M_PI) + " deg" + (t % 2 ? ", caps" : ", flat"));
-    try {
-      PipelineOptions opts;
-      opts.optimize = false;
-      const HybridMesh h = build_hybrid_mesh(cs, opts);
-      ASSERT_TRUE(h.build_report.ok);
-      const double expected = box_minus_hole(cs, h);
-      EXPECT_NEAR(total_volume(h.geometry), expected, 1e-9 * expected);
-      EXPECT_EQ(check_convexity(h.mesh, h.geometry).violations, 0);
-      EXPECT_EQ(check_auto_centering(h.mesh, h.geometry).violations, 0);
-      EXPECT_EQ(check_conformity(h.mesh, h.geometry).violations, 0);
+    alternate_end_caps(w, t);
+    SCOPED_TRACE("case " + std::to_string(t) + ", bend " + std::to_string(bend * 180 / M_PI) + " deg" +
+                 (t % 2 ? ", caps" : ", flat"));
+    if (meshes_or_is_refused(random_case("random_bent", w), t, true))
       ++meshed;
-    } catch (const InputError& e) {
+    else
       ++refused;
-      std::printf("[ refused   ] case %d: %s\n", t, e.what());
-    }
   }
   std::printf("[ random    ] bent: %d meshed, %d refused as input\n", meshed, refused);
   EXPECT_GE(meshed, 10);
