@@ -449,10 +449,11 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
       for (size_t s = 0; s < fix.size(); ++s) stuck[s] = fix[s] || grow[s] || involved[s];
       break;
     }
-    shrunk_at.resize(set.sites.size(), -1000);
     for (size_t s = 0; s < fix.size(); ++s)
       if (fix[s]) {
         shrink_or_split(set, static_cast<int>(s), kShrink, cavity, coords, grid, frames);
+        // A split box appends its per-polygon sites: they are new, and may be held below.
+        shrunk_at.resize(set.sites.size(), -1000);
         shrunk_at[s] = it;
         // A reflection shrinks by moving its internal partner: hold that one too.
         const Site& site = set.sites[s];
