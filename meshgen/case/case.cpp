@@ -19,6 +19,7 @@
 
 #include "meshgen/case/case_limits.hpp"
 #include "meshgen/case/segment_distance.hpp"
+#include "meshgen/case/survey.hpp"
 
 namespace hm {
 namespace {
@@ -324,10 +325,42 @@ std::vector<Vec3> read_trajectory(const YAML::Node& n, const std::string& path, 
   return pts;
 }
 
+// survey: {head: [x, y, z], stations: [[md, inclination, azimuth], ...]} -> the station
+// positions by minimum curvature (meshgen/case/survey.hpp).
+std::vector<Vec3> read_survey(const YAML::Node& n, const std::string& path, size_t& points_budget) {
+  if (!n.IsMap()) fail(path, "expected a map {head: [x, y, z], stations: [[md, inclination, azimuth], ...]}, got " +
+                                 describe(n));
+  const Fields f(n, path, {"head", "stations"});
+  const auto h = read_triple(f.required("head"), f.path("head"), "[x, y, z]");
+  const YAML::Node st = f.required("stations");
+  const std::string sp = f.path("stations");
+  if (!st.IsSequence()) fail(sp, "expected a list of stations [[md, inclination, azimuth], ...], got " + describe(st));
+  if (st.size() < 1) fail(sp, "needs at least 1 station");
+  if (st.size() + 1 > points_budget)
+    fail(sp, "too many stations (at most " + std::to_string(kMaxTrajectoryPoints) + " points over all wells)");
+  points_budget -= st.size() + 1;
+  std::vector<SurveyStation> stations;
+  for (size_t i = 0; i < st.size(); ++i) {
+    const std::string p = index_path(sp, i);
+    if (!st[i].IsSequence()) fail(p, "expected a station [md, inclination, azimuth], got " + describe(st[i]));
+    const auto v = read_triple(st[i], p, "[md, inclination, azimuth]");
+    const SurveyStation s{v[0], v[1], v[2]};
+    const double prev_md = stations.empty() ? 0.0 : stations.back().md;
+    require(s.md > prev_md, p, "md must be greater than the previous station's (" + fmt(prev_md) + " m)");
+    require(s.inclination_deg >= 0 && s.inclination_deg <= 180, p, "inclination must be in [0, 180] degrees");
+    require(s.azimuth_deg >= 0 && s.azimuth_deg < 360, p, "azimuth must be in [0, 360) degrees");
+    if (!stations.empty())
+      require(survey_dogleg(stations.back(), s) <= kMaxSurveyDoglegDeg * kDegreesToRadians, p,
+              "turns by more than " + fmt(kMaxSurveyDoglegDeg) + " degrees from the previous station");
+    stations.push_back(s);
+  }
+  return minimum_curvature_positions({h[0], h[1], h[2]}, stations);
+}
+
 WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_budget) {
   const Fields f(n, path,
-                 {"name", "type", "trajectory", "radius", "drainage_radius", "rings", "sectors", "segment_length", "bhp",
-                  "end_caps"});
+                 {"name", "type", "trajectory", "survey", "radius", "drainage_radius", "rings", "sectors",
+                  "segment_length", "bhp", "end_caps"});
   WellSpec w;
   w.name = read_string(f.required("name"), f.path("name"));
   require(matches_name_charset(w.name), f.path("name"), "must match [A-Za-z0-9_-]+");
@@ -339,7 +372,10 @@ WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_
     else if (t->IsScalar() && s == "injector") w.type = WellType::Injector;
     else fail(f.path("type"), "expected producer or injector, got " + describe(*t));
   }
-  w.trajectory = read_trajectory(f.required("trajectory"), f.path("trajectory"), points_budget);
+  const auto survey = f.get("survey");
+  if (survey && f.get("trajectory")) fail(f.path("survey"), "give either trajectory or survey, not both");
+  w.trajectory = survey ? read_survey(*survey, f.path("survey"), points_budget)
+                        : read_trajectory(f.required("trajectory"), f.path("trajectory"), points_budget);
   w.radius = read_number(f.required("radius"), f.path("radius"));
   require(w.radius > 0, f.path("radius"), "must be > 0");
   w.drainage_radius = read_number(f.required("drainage_radius"), f.path("drainage_radius"));

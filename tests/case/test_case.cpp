@@ -296,7 +296,7 @@ TEST(CaseErrors, UnknownKeyAtEveryLevel) {
   EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  poro: 0.2\n")),
             "reservoir.poro: unknown key (expected one of: x, y, z, permeability, porosity, initial_pressure)");
   EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "    bhp: 250\n    skin: 0\n")),
-            "wells[1].skin: unknown key (expected one of: name, type, trajectory, radius, drainage_radius, rings, "
+            "wells[1].skin: unknown key (expected one of: name, type, trajectory, survey, radius, drainage_radius, rings, "
             "sectors, segment_length, bhp, end_caps)");
   EXPECT_EQ(error_of(kBase + "fluid: {viscosity: 1, mu: 1}\n"),
             "fluid.mu: unknown key (expected one of: viscosity, density, compressibility)");
