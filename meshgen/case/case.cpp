@@ -10,6 +10,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <limits>
@@ -18,6 +19,7 @@
 #include <utility>
 
 #include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/grdecl.hpp"
 #include "meshgen/case/segment_distance.hpp"
 #include "meshgen/case/survey.hpp"
 
@@ -252,12 +254,33 @@ void require(bool ok, const std::string& path, const std::string& reason) {
   if (!ok) fail(path, reason);
 }
 
-ReservoirSpec read_reservoir(const YAML::Node& n) {
-  const Fields f(n, "reservoir", {"x", "y", "z", "permeability", "porosity", "initial_pressure"});
+// reservoir.grdecl: a model file read by OPM instead of the x/y/z axes and the uniform rock.
+ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir) {
+  for (const char* k : {"x", "y", "z", "permeability", "porosity"})
+    if (f.get(k)) fail(f.path(k), "not with reservoir.grdecl (the model gives the grid and its rock)");
+  std::string path = read_string(f.required("grdecl"), f.path("grdecl"));
+  if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
+  const CornerPointModel model = read_corner_point_model(path, f.path("grdecl"));
+  ReservoirSpec r = rectilinear_reservoir(model, f.path("grdecl"));
+  for (size_t c = 0; c < r.cell_poro.size(); ++c) {
+    const std::string cell = f.path("grdecl") + ": cell " + std::to_string(c);
+    require(r.cell_poro[c] > 0 && r.cell_poro[c] <= 1, cell, "porosity x NTG must be in (0, 1], got " + fmt(r.cell_poro[c]));
+    require(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0, cell, "permeability must be > 0");
+  }
+  r.grdecl = path;
+  return r;
+}
+
+ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir) {
+  const Fields f(n, "reservoir", {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure"});
   ReservoirSpec r;
-  r.x = read_axis(f.required("x"), f.path("x"));
-  r.y = read_axis(f.required("y"), f.path("y"));
-  r.z = read_axis(f.required("z"), f.path("z"));
+  if (f.get("grdecl")) {
+    r = read_grdecl_reservoir(f, base_dir);
+  } else {
+    r.x = read_axis(f.required("x"), f.path("x"));
+    r.y = read_axis(f.required("y"), f.path("y"));
+    r.z = read_axis(f.required("z"), f.path("z"));
+  }
   const double cells = double(r.x.size() - 1) * double(r.y.size() - 1) * double(r.z.size() - 1);
   if (cells > kMaxCells)
     fail("reservoir", "too many cells (" + std::to_string(r.x.size() - 1) + " x " + std::to_string(r.y.size() - 1) +
@@ -458,7 +481,7 @@ void check_wells(const CaseSpec& cs) {
   }
 }
 
-CaseSpec read_case(const YAML::Node& root) {
+CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   if (!root.IsMap()) fail("case file", "expected a map with keys name, reservoir, ..., got " + describe(root));
   const Fields f(root, "", {"name", "reservoir", "wells", "transition", "fluid"});
   CaseSpec cs;
@@ -466,7 +489,7 @@ CaseSpec read_case(const YAML::Node& root) {
   require(matches_name_charset(cs.name), "name", "must match [A-Za-z0-9_-]+");
   require(cs.name.size() <= kMaxCaseNameLength, "name",
           "at most " + std::to_string(kMaxCaseNameLength) + " characters");
-  cs.reservoir = read_reservoir(f.required("reservoir"));
+  cs.reservoir = read_reservoir(f.required("reservoir"), base_dir);
   if (auto t = f.get("transition")) cs.transition = read_transition(*t);
   if (auto fl = f.get("fluid")) cs.fluid = read_fluid(*fl);
   if (auto wells = f.get("wells"); wells && !wells->IsNull()) {
@@ -482,6 +505,23 @@ CaseSpec read_case(const YAML::Node& root) {
 
 }  // namespace
 
+int reservoir_cell_at(const ReservoirSpec& r, Vec3 p) {
+  auto slot = [](const std::vector<double>& axis, double v) {
+    const auto it = std::upper_bound(axis.begin(), axis.end(), v);
+    const long k = static_cast<long>(it - axis.begin()) - 1;
+    return static_cast<int>(std::clamp<long>(k, 0, static_cast<long>(axis.size()) - 2));
+  };
+  const int nx = static_cast<int>(r.x.size()) - 1, ny = static_cast<int>(r.y.size()) - 1;
+  return slot(r.x, p.x) + nx * (slot(r.y, p.y) + ny * slot(r.z, p.z));
+}
+
+Vec3 reservoir_permeability(const ReservoirSpec& r, int c) {
+  if (r.cell_permx.empty()) return r.permeability;
+  return {r.cell_permx[c], r.cell_permy[c], r.cell_permz[c]};
+}
+
+double reservoir_porosity(const ReservoirSpec& r, int c) { return r.cell_poro.empty() ? r.porosity : r.cell_poro[c]; }
+
 std::vector<double> hemisphere_end_grading(const WellSpec& ws) {
   std::vector<double> g;
   if (ws.end_caps != EndCaps::Hemisphere || !(ws.drainage_radius > ws.radius) || ws.rings < 1) return g;
@@ -495,12 +535,12 @@ std::vector<double> hemisphere_end_grading(const WellSpec& ws) {
   return g;
 }
 
-CaseSpec parse_case(const std::string& yaml_text) {
+CaseSpec parse_case(const std::string& yaml_text, const std::string& base_dir) {
   try {
     const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
     if (docs.empty() || (docs.size() == 1 && docs[0].IsNull())) fail("case file", "empty document");
     if (docs.size() > 1) fail("case file", "expected one YAML document, got " + std::to_string(docs.size()));
-    return read_case(docs[0]);
+    return read_case(docs[0], base_dir);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp reports its nesting limit as "bad file"; say what happened.
     fail("case file", "YAML error at line " + std::to_string(e.mark.line + 1) + ", column " +
@@ -524,7 +564,8 @@ CaseSpec load_case(const std::string& path) {
       fail("case file", quoted(path, 300) + " is larger than " + std::to_string(kMaxCaseFileBytes >> 20) + " MiB");
   }
   if (in.bad()) fail("case file", "cannot read " + quoted(path, 300));
-  return parse_case(text);
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  return parse_case(text, dir.empty() ? "." : dir);
 }
 
 }  // namespace hm

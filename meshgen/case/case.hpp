@@ -22,7 +22,18 @@ struct ReservoirSpec {
   Vec3 permeability{100, 100, 10};    ///< kx, ky, kz (mD), > 0
   double porosity = 0.2;              ///< in (0, 1]
   double initial_pressure = 200;      ///< bar
+  /// Per-cell rock in natural order (size nx*ny*nz), or empty for the uniform values above:
+  /// a model read from `reservoir.grdecl` (PERMX/PERMY x NTG, PERMZ in mD; PORO x NTG).
+  std::vector<double> cell_permx, cell_permy, cell_permz, cell_poro;
+  std::string grdecl;                 ///< the model file the grid came from, or empty
 };
+
+/// Linear (natural-order) index of the reservoir cell that holds p; points outside the box are
+/// taken to the nearest cell; on a grid plane, the cell on its upper side.
+int reservoir_cell_at(const ReservoirSpec& r, Vec3 p);
+/// Rock of reservoir cell c (uniform or per cell).
+Vec3 reservoir_permeability(const ReservoirSpec& r, int c);
+double reservoir_porosity(const ReservoirSpec& r, int c);
 
 enum class WellType { Producer, Injector };
 
@@ -90,7 +101,8 @@ struct CaseSpec {
 /// Parses and validates a YAML case file. Throws InputError (never anything else for
 /// bad content) with "key.path: reason". A missing or unreadable file is an InputError too.
 CaseSpec load_case(const std::string& path);
-/// Same, from YAML text (tests).
-CaseSpec parse_case(const std::string& yaml_text);
+/// Same, from YAML text; relative file names in it (reservoir.grdecl) are taken from `base_dir`
+/// (load_case: the case file's folder; empty: the working directory).
+CaseSpec parse_case(const std::string& yaml_text, const std::string& base_dir = "");
 
 }  // namespace hm

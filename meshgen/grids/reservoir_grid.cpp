@@ -72,8 +72,8 @@ std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const Reserv
     at.fv_center = grid.cell_center(c);
     const auto ijk = grid.cell_ijk(c);
     at.ijk = {ijk[0], ijk[1], ijk[2]};
-    at.perm = spec.permeability;
-    at.porosity = spec.porosity;
+    at.perm = reservoir_permeability(spec, c);
+    at.porosity = reservoir_porosity(spec, c);
     cell_id[c] = builder.add_cell(faces, at);
   }
   return cell_id;

@@ -185,8 +185,9 @@ HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions&
       CellAttributes at;
       at.region = kTransition;
       at.fv_center = t.sites[c];
-      at.perm = cs.reservoir.permeability;
-      at.porosity = cs.reservoir.porosity;
+      const int rock_cell = reservoir_cell_at(cs.reservoir, at.fv_center);  // the model cell around its site
+      at.perm = reservoir_permeability(cs.reservoir, rock_cell);
+      at.porosity = reservoir_porosity(cs.reservoir, rock_cell);
       builder.add_cell(faces, at);
       cell_cavity_list.push_back(static_cast<int32_t>(k));
       h_ref_list.push_back(t.h_ref[c]);

@@ -67,7 +67,7 @@ TEST_P(MeshgenExample, MeshesAndReportsConsistently) {
 
 INSTANTIATE_TEST_SUITE_P(Examples, MeshgenExample,
                          ::testing::Values(Example{"paper_single_well", 1, 1}, Example{"three_wells", 2, 3},
-                                           Example{"readme_example", 1, 1}),
+                                           Example{"readme_example", 1, 1}, Example{"layered_grdecl", 2, 2}),
                          [](const auto& info) { return info.param.name; });
 
 }  // namespace

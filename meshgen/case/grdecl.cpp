@@ -1,0 +1,166 @@
+#include "meshgen/case/grdecl.hpp"
+
+#include <opm/input/eclipse/Deck/Deck.hpp>
+#include <opm/input/eclipse/EclipseState/EclipseState.hpp>
+#include <opm/input/eclipse/EclipseState/Grid/EclipseGrid.hpp>
+#include <opm/input/eclipse/EclipseState/Grid/FieldPropsManager.hpp>
+#include <opm/input/eclipse/EclipseState/Grid/MapAxes.hpp>
+#include <opm/input/eclipse/Parser/ErrorGuard.hpp>
+#include <opm/input/eclipse/Parser/ParseContext.hpp>
+#include <opm/input/eclipse/Parser/Parser.hpp>
+#include <opm/input/eclipse/Units/Units.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "meshgen/case/case.hpp"
+
+namespace hm {
+
+int CornerPointModel::n_active() const {
+  int n = 0;
+  for (int a : actnum) n += a != 0;
+  return n;
+}
+
+namespace {
+
+std::string cell_name(int c, int nx, int ny) {
+  std::ostringstream os;
+  os << "cell (" << c % nx + 1 << ", " << (c / nx) % ny + 1 << ", " << c / (nx * ny) + 1 << ")";
+  return os.str();
+}
+
+// OPM's EclipseState wants a full deck (RUNSPEC ... GRID); a bare GRDECL (SPECGRID, COORD, ...)
+// is wrapped in a minimal one that INCLUDEs it.
+std::string as_deck(const std::string& path, const std::string& text) {
+  if (text.find("RUNSPEC") != std::string::npos) return text;
+  return "RUNSPEC\nDIMENS\n 1 1 1 /\nOIL\nWATER\nMETRIC\nGRID\nINCLUDE\n '" + path + "' /\n";
+}
+
+}  // namespace
+
+CornerPointModel read_corner_point_model(const std::string& path, const std::string& key) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError(key + ": no such file: " + path);
+  CornerPointModel m;
+  try {
+    Opm::ParseContext context;
+    // A model exported from a geomodeller has keywords our steady single-phase use ignores.
+    context.update(Opm::InputError::WARN);
+    Opm::ErrorGuard errors;
+    Opm::Parser parser;
+    std::string text;
+    {
+      std::ifstream in(path, std::ios::binary);
+      std::ostringstream os;
+      os << in.rdbuf();
+      text = os.str();
+    }
+    const std::string abs = fs::absolute(path).string();
+    Opm::Deck deck = text.find("RUNSPEC") != std::string::npos ? parser.parseFile(abs, context, errors)
+                                                                : parser.parseString(as_deck(abs, text), context, errors);
+    errors.clear();
+    const Opm::EclipseState state(deck);
+    const Opm::EclipseGrid& grid = state.getInputGrid();
+    m.nx = static_cast<int>(grid.getNX());
+    m.ny = static_cast<int>(grid.getNY());
+    m.nz = static_cast<int>(grid.getNZ());
+    const size_t n = grid.getCartesianSize();
+    m.corners.resize(n);
+    m.actnum.resize(n);
+    for (size_t c = 0; c < n; ++c) {
+      const size_t i = c % m.nx, j = (c / m.nx) % m.ny, k = c / (size_t(m.nx) * m.ny);
+      for (int q = 0; q < 8; ++q) {
+        const auto p = grid.getCornerPos(i, j, k, q);
+        m.corners[c][q] = {p[0], p[1], p[2]};
+      }
+      m.actnum[c] = grid.cellActive(c) ? 1 : 0;
+    }
+    const Opm::FieldPropsManager& fp = state.fieldProps();
+    for (const char* kw : {"PERMX", "PORO"})
+      if (!fp.has_double(kw)) throw InputError(key + ": the model has no " + std::string(kw));
+    // Field properties come per active cell in SI units; the case works in mD on every cell.
+    const double md = Opm::prefix::milli * Opm::unit::darcy;
+    auto global = [&](const std::vector<double>& active, double scale, double fill) {
+      std::vector<double> out(n, fill);
+      for (size_t c = 0, a = 0; c < n; ++c)
+        if (m.actnum[c]) out[c] = active[a++] / scale;
+      return out;
+    };
+    m.permx = global(fp.get_double("PERMX"), md, 0.0);
+    m.permy = fp.has_double("PERMY") ? global(fp.get_double("PERMY"), md, 0.0) : m.permx;
+    m.permz = fp.has_double("PERMZ") ? global(fp.get_double("PERMZ"), md, 0.0) : m.permx;
+    m.poro = global(fp.get_double("PORO"), 1.0, 0.0);
+    m.ntg = fp.has_double("NTG") ? global(fp.get_double("NTG"), 1.0, 1.0) : std::vector<double>(n, 1.0);
+    if (deck.hasKeyword("MAPAXES")) {
+      const Opm::MapAxes axes(deck);
+      m.has_mapaxes = true;
+      double x0 = 0, y0 = 0, x1 = 1, y1 = 0, x2 = 0, y2 = 1;
+      axes.transform(x0, y0);
+      axes.transform(x1, y1);
+      axes.transform(x2, y2);
+      m.map_origin = {x0, y0};
+      m.map_unit_x = {x1 - x0, y1 - y0};
+      m.map_unit_y = {x2 - x0, y2 - y0};
+    }
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    std::string why = e.what();
+    for (char& ch : why)
+      if (ch == '\n') ch = ' ';
+    throw InputError(key + ": OPM could not read " + path + ": " + why.substr(0, 300));
+  }
+  if (m.n_active() == 0) throw InputError(key + ": the model has no active cell (ACTNUM, PORO, MINPV, PINCH)");
+  return m;
+}
+
+ReservoirSpec rectilinear_reservoir(const CornerPointModel& m, const std::string& key) {
+  ReservoirSpec r;
+  const int nx = m.nx, ny = m.ny;
+  auto idx = [&](int i, int j, int k) { return i + nx * (j + ny * k); };
+  // Axes from the cells along the grid's three edges, then every corner must sit on them.
+  for (int i = 0; i < nx; ++i) r.x.push_back(m.corners[idx(i, 0, 0)][0].x);
+  r.x.push_back(m.corners[idx(nx - 1, 0, 0)][1].x);
+  for (int j = 0; j < ny; ++j) r.y.push_back(m.corners[idx(0, j, 0)][0].y);
+  r.y.push_back(m.corners[idx(0, ny - 1, 0)][2].y);
+  for (int k = 0; k < m.nz; ++k) r.z.push_back(m.corners[idx(0, 0, k)][0].z);
+  r.z.push_back(m.corners[idx(0, 0, m.nz - 1)][4].z);
+  const size_t n = m.corners.size();
+  for (size_t c = 0; c < n; ++c) {
+    const int i = c % nx, j = (c / nx) % ny, k = c / (size_t(nx) * ny);
+    if (!m.actnum[c])
+      throw InputError(key + ": " + cell_name(c, nx, ny) + " is inactive; inactive cells are not meshed yet");
+    for (int q = 0; q < 8; ++q) {
+      const Vec3 p = m.corners[c][q];
+      const Vec3 want{r.x[i + (q & 1)], r.y[j + ((q >> 1) & 1)], r.z[k + ((q >> 2) & 1)]};
+      if (!(p == want))
+        throw InputError(key + ": " + cell_name(c, nx, ny) +
+                         " is not a rectilinear box (sloping layers, inclined pillars or faults): corner-point "
+                         "geometry is not meshed yet, only models whose cells are axis-aligned boxes");
+    }
+  }
+  for (size_t a = 1; a < r.x.size(); ++a)
+    if (!(r.x[a] > r.x[a - 1])) throw InputError(key + ": grid x not increasing along i (GDORIENT?)");
+  for (size_t a = 1; a < r.y.size(); ++a)
+    if (!(r.y[a] > r.y[a - 1])) throw InputError(key + ": grid y not increasing along j (GDORIENT?)");
+  for (size_t a = 1; a < r.z.size(); ++a)
+    if (!(r.z[a] > r.z[a - 1])) throw InputError(key + ": layer " + std::to_string(a) + " has zero thickness");
+  // NTG scales the pore volume and the horizontal flow areas (OPM's TRANX/TRANY), so it is folded
+  // into the porosity and the horizontal permeabilities the mesh carries.
+  r.cell_permx.resize(n);
+  r.cell_permy.resize(n);
+  r.cell_poro.resize(n);
+  for (size_t c = 0; c < n; ++c) {
+    r.cell_permx[c] = m.permx[c] * m.ntg[c];
+    r.cell_permy[c] = m.permy[c] * m.ntg[c];
+    r.cell_poro[c] = m.poro[c] * m.ntg[c];
+  }
+  r.cell_permz = m.permz;
+  return r;
+}
+
+}  // namespace hm
