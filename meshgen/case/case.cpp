@@ -268,6 +268,14 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
     require(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0, cell, "permeability must be > 0");
   }
   r.grdecl = path;
+  if (model.has_mapaxes) {
+    r.has_map_axes = true;
+    r.map_origin = {model.map_origin[0], model.map_origin[1], 0};
+    r.map_unit_x = {model.map_unit_x[0], model.map_unit_x[1], 0};
+    r.map_unit_y = {model.map_unit_y[0], model.map_unit_y[1], 0};
+    const double det = r.map_unit_x.x * r.map_unit_y.y - r.map_unit_x.y * r.map_unit_y.x;
+    require(std::isfinite(det) && det != 0, f.path("grdecl"), "MAPAXES: the grid axes are parallel");
+  }
   return r;
 }
 
@@ -499,11 +507,22 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
     size_t points_budget = kMaxTrajectoryPoints;
     for (size_t i = 0; i < wells->size(); ++i) cs.wells.push_back(read_well((*wells)[i], index_path("wells", i), points_budget));
   }
+  for (WellSpec& w : cs.wells)
+    for (Vec3& p : w.trajectory) p = map_to_grid(cs.reservoir, p);
   check_wells(cs);
   return cs;
 }
 
 }  // namespace
+
+Vec3 map_to_grid(const ReservoirSpec& r, Vec3 p) {
+  if (!r.has_map_axes) return p;
+  // p = origin + gx unit_x + gy unit_y, solved by Cramer's rule.
+  const Vec3 ux = r.map_unit_x, uy = r.map_unit_y;
+  const double dx = p.x - r.map_origin.x, dy = p.y - r.map_origin.y;
+  const double det = ux.x * uy.y - ux.y * uy.x;
+  return {(dx * uy.y - dy * uy.x) / det, (ux.x * dy - ux.y * dx) / det, p.z};
+}
 
 int reservoir_cell_at(const ReservoirSpec& r, Vec3 p) {
   auto slot = [](const std::vector<double>& axis, double v) {

@@ -26,7 +26,15 @@ struct ReservoirSpec {
   /// a model read from `reservoir.grdecl` (PERMX/PERMY x NTG, PERMZ in mD; PORO x NTG).
   std::vector<double> cell_permx, cell_permy, cell_permz, cell_poro;
   std::string grdecl;                 ///< the model file the grid came from, or empty
+  /// The model's MAPAXES (grdecl): the map position of grid point (0, 0) and of the grid's unit x
+  /// and y directions (z: unused). Well paths in the case file are in map coordinates and are
+  /// brought into the grid frame with it (OPM's convention: COORD is in the grid frame).
+  bool has_map_axes = false;
+  Vec3 map_origin{0, 0, 0}, map_unit_x{1, 0, 0}, map_unit_y{0, 1, 0};
 };
+
+/// The grid-frame point of map point p (MAPAXES inverse; the identity without MAPAXES); z unchanged.
+Vec3 map_to_grid(const ReservoirSpec& r, Vec3 p);
 
 /// Linear (natural-order) index of the reservoir cell that holds p; points outside the box are
 /// taken to the nearest cell; on a grid plane, the cell on its upper side.

@@ -3,6 +3,7 @@
 // with its dimensions, ACTNUM and MAPAXES, and is refused with the reason (not meshed yet).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -113,6 +114,35 @@ TEST(Grdecl, CartesianModelMeshesToTheMeshOfItsBoxForm) {
     ASSERT_EQ(a.mesh.cell_perm[c], b.mesh.cell_perm[c]) << c;
     ASSERT_EQ(a.mesh.cell_porosity[c], b.mesh.cell_porosity[c]) << c;
   }
+}
+
+// MAPAXES (rotated 30 degrees, origin at UTM values): the wells are given in map coordinates and
+// land where they are in the grid frame, where the mesh is built (OPM's convention: COORD is in the
+// grid frame, MAPAXES places it on the map).
+TEST(Grdecl, WellsInMapCoordinatesAreBroughtIntoTheGridFrame) {
+  TempDir tmp;
+  const double th = 30 * M_PI / 180, L = 1000;
+  const Vec3 o{456510.608, 5926880.031, 0}, ux{std::cos(th), std::sin(th), 0}, uy{-std::sin(th), std::cos(th), 0};
+  auto map = [&](double gx, double gy) { return o + gx * ux + gy * uy; };
+  const Vec3 ypt = map(0, L), xpt = map(L, 0);
+  write(tmp.path / "BOX.GRDECL", "MAPUNITS\n 'METRES' /\nMAPAXES\n " + num(ypt.x) + " " + num(ypt.y) + " " + num(o.x) +
+                                     " " + num(o.y) + " " + num(xpt.x) + " " + num(xpt.y) + " /\n" +
+                                     grdecl_of_box(kX, kY, kZ, false));
+  const Vec3 a = map(50, 50), b = map(50, 50);
+  const std::string well = "wells:\n  - {name: P1, trajectory: [[" + num(a.x) + ", " + num(a.y) + ", 1018], [" + num(b.x) +
+                           ", " + num(b.y) + ", 1030]], radius: 0.1, drainage_radius: 4.0, bhp: 150}\n";
+  const CaseSpec cs = load_case(write(tmp.path / "case.yaml", "name: g\nreservoir: {grdecl: BOX.GRDECL}\n" + well));
+  ASSERT_TRUE(cs.reservoir.has_map_axes);
+  EXPECT_NEAR(cs.reservoir.map_origin.x, o.x, 1e-6);
+  EXPECT_NEAR(cs.reservoir.map_origin.y, o.y, 1e-6);
+  for (const Vec3& p : cs.wells[0].trajectory) {
+    EXPECT_NEAR(p.x, 50, 1e-6);
+    EXPECT_NEAR(p.y, 50, 1e-6);
+  }
+  // Without MAPAXES the same map coordinates are far outside the grid: refused as input.
+  write(tmp.path / "PLAIN.GRDECL", grdecl_of_box(kX, kY, kZ, false));
+  EXPECT_THROW(load_case(write(tmp.path / "case2.yaml", "name: g\nreservoir: {grdecl: PLAIN.GRDECL}\n" + well)),
+               InputError);
 }
 
 namespace {
