@@ -188,6 +188,29 @@ std::vector<int> non_empty_sites(SiteSet& set, const Cavity& cavity, const std::
   return bad;
 }
 
+// Short label of a site for the correction's diagnostics: its kind and, for polygon sites, the
+// side and orientation of its polygon (reservoir faces: x/y/z normal).
+std::string site_label(const SiteSet& set, int s, const Cavity& cavity, const std::vector<PolygonFrame>& frames) {
+  const Site& site = set.sites[s];
+  switch (site.kind) {
+    case SiteKind::InternalBox: return "box";
+    case SiteKind::ExternalBox: return "ext-box";
+    case SiteKind::Free: return "free";
+    case SiteKind::Guard: return "guard";
+    default: break;
+  }
+  const int q = site.polygon;
+  std::string side = cavity.faces[q].side == FaceSide::Well ? "well" : "res";
+  if (cavity.faces[q].side == FaceSide::Reservoir) {
+    const Vec3 n = frames[q].normal;
+    side += std::abs(n.z) > 0.5 ? "-z" : std::abs(n.y) > 0.5 ? "-y" : "-x";
+  }
+  int in = site.kind == SiteKind::ExternalMirror ? set.internal_of[q] : s;
+  const bool at_min = set.sites[in].kind == SiteKind::InternalPolygon &&
+                      set.sites[in].t <= 1.0001 * kMinT * frames[q].radius;
+  return (site.kind == SiteKind::ExternalMirror ? "mirror-" : "") + side + (at_min ? "@min" : "");
+}
+
 }  // namespace
 
 PolygonFrame fit_polygon(const std::vector<int32_t>& nodes, const std::vector<Vec3>& coords) {
@@ -394,6 +417,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
   // and grown back for another in alternate iterations would cycle (measured near hemispherical
   // end caps, where neighbouring cap polygons differ in size); once shrunk it is not grown for a
   // few iterations, so the other pair's larger site must shrink instead.
+  std::map<std::string, int> pair_kinds;  // at the last iteration: "large > small" site labels
   std::vector<int> shrunk_at(set.sites.size(), -1000);
   constexpr int kNoGrowAfterShrink = 3;
   for (int it = 1; it <= max_iterations; ++it) {
@@ -429,6 +453,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
         const int large = si.w2 > sj.w2 ? i : j, small = si.w2 > sj.w2 ? j : i;
         if (!set.sites[small].internal()) continue;
         ++n;
+        if (it == max_iterations) ++pair_kinds[site_label(set, large, cavity, frames) + " > " + site_label(set, small, cavity, frames)];
         involved[large] = involved[small] = 1;
         // The larger weight moves toward its polygon (5.5.2); once it cannot (a polygon site
         // at its minimal distance), the smaller one moves away from its polygon instead,
@@ -470,7 +495,14 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
   }
   std::ostringstream os;
   os << "transition: site correction did not converge after " << max_iterations << " iterations (" << left
-     << " pairs left)";
+     << " pairs left";
+  {
+    std::vector<std::pair<int, std::string>> by_count;
+    for (const auto& [k, v] : pair_kinds) by_count.push_back({-v, k});
+    std::sort(by_count.begin(), by_count.end());
+    for (size_t k = 0; k < by_count.size() && k < 4; ++k) os << (k ? ", " : ": ") << -by_count[k].first << " " << by_count[k].second;
+  }
+  os << ")";
   std::vector<int32_t> polygons;
   for (size_t s = 0; s < stuck.size(); ++s)
     if (stuck[s]) polygons.insert(polygons.end(), set.sites[s].polygons.begin(), set.sites[s].polygons.end());

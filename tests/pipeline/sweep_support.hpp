@@ -1,0 +1,128 @@
+// Meshes one realistic case and checks it (the robustness sweep of issue 12), in this process or in a
+// forked child (crashes and hangs become outcomes instead of ending the run).
+#pragma once
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+
+#include "fvcheck/lib/report.hpp"
+#include "meshgen/grids/well_block.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "realistic_cases.hpp"
+
+namespace hm::testing {
+
+enum class Outcome { Meshed, CheckFailed, Refused, Failed, Crash, Hang };
+inline const char* outcome_name(Outcome o) {
+  switch (o) {
+    case Outcome::Meshed: return "meshed";
+    case Outcome::CheckFailed: return "check-failed";
+    case Outcome::Refused: return "refused";
+    case Outcome::Failed: return "failed";
+    case Outcome::Crash: return "crash";
+    case Outcome::Hang: return "hang";
+  }
+  return "?";
+}
+
+struct CaseResult {
+  Outcome outcome = Outcome::Failed;
+  std::string reason;  ///< the error message or the failed checks
+  double seconds = 0;
+};
+
+/// Total volume of the box minus the exact wellbore holes (end caps as requested).
+inline double box_minus_holes(const CaseSpec& cs, const HybridMesh& h) {
+  const ReservoirSpec& r = cs.reservoir;
+  double v = (r.x.back() - r.x.front()) * (r.y.back() - r.y.front()) * (r.z.back() - r.z.front());
+  for (const WellBlock& b : h.blocks) v -= exact_wellbore_hole_volume(cs, b.well, b.sectors);
+  return v;
+}
+
+/// Meshes the case and checks: the builder matched every face, fvcheck passes (convexity,
+/// conformity, closure, volumes, orthogonality, auto-centering, planarity) and the total volume is
+/// the box minus the exact holes (relative 1e-9). Refusals (InputError) and failures are outcomes.
+inline CaseResult mesh_and_check(const RealisticCase& rc) {
+  CaseResult res;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    const HybridMesh h = build_hybrid_mesh(rc.spec);
+    std::string bad;
+    if (!h.build_report.ok) bad += "builder; ";
+    const FvReport fv = run_fvcheck(h.mesh, CheckOptions{}, h.cell_h_ref, &h.build_report);
+    if (!fv.structure.ok) bad += "csr; ";
+    for (const CheckResult& c : fv.checks)
+      if (!c.ok()) bad += c.name + " " + std::to_string(c.violations) + "; ";
+    const double expected = box_minus_holes(rc.spec, h), got = total_volume(h.geometry);
+    if (!(std::abs(got - expected) <= 1e-9 * expected)) bad += "volume " + std::to_string(got / expected - 1) + "; ";
+    res.outcome = bad.empty() ? Outcome::Meshed : Outcome::CheckFailed;
+    res.reason = bad;
+  } catch (const InputError& e) {
+    res.outcome = Outcome::Refused;
+    res.reason = e.what();
+  } catch (const std::exception& e) {
+    res.outcome = Outcome::Failed;
+    res.reason = e.what();
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+/// mesh_and_check in a forked child: a signal is a Crash, more than `timeout_s` a Hang.
+inline CaseResult mesh_and_check_isolated(const RealisticCase& rc, double timeout_s) {
+  int fds[2];
+  if (pipe(fds) != 0) return {Outcome::Failed, "pipe() failed", 0};
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fds[0]);
+    const CaseResult r = mesh_and_check(rc);
+    const std::string msg = std::to_string(static_cast<int>(r.outcome)) + "\n" + r.reason;
+    ssize_t left = static_cast<ssize_t>(msg.size());
+    const char* p = msg.data();
+    while (left > 0) {
+      const ssize_t n = write(fds[1], p, static_cast<size_t>(left));
+      if (n <= 0) break;
+      left -= n, p += n;
+    }
+    _exit(0);
+  }
+  close(fds[1]);
+  CaseResult res;
+  int status = 0;
+  bool done = false;
+  while (!done) {
+    const pid_t w = waitpid(pid, &status, WNOHANG);
+    if (w == pid) done = true;
+    else if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > timeout_s) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      close(fds[0]);
+      return {Outcome::Hang, "no result after " + std::to_string(timeout_s) + " s",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::string msg;
+  char buf[4096];
+  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) msg.append(buf, static_cast<size_t>(n));
+  close(fds[0]);
+  if (!WIFEXITED(status) || msg.empty()) {
+    res.outcome = Outcome::Crash;
+    res.reason = WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) : "no result";
+    return res;
+  }
+  const size_t nl = msg.find('\n');
+  res.outcome = static_cast<Outcome>(std::stoi(msg.substr(0, nl)));
+  res.reason = msg.substr(nl + 1);
+  return res;
+}
+
+}  // namespace hm::testing
