@@ -86,18 +86,24 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
   for (;;) {
     out = TransitionCells{};
     out.base_node_id = base_node_id;
-    const std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out);
+    std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out);
+    bool degenerate = false;
     if (hidden.empty()) {
       // Free sites are optional: one whose cell came out unusable (near-degenerate sites whose
       // power vertices were identified into a duplicate face) is dropped and the diagram rebuilt.
       const std::vector<int> bad_tips = tip_sites_in_bad_cells(set, out);
-      if (bad_tips.empty()) break;
-      for (int s : bad_tips) set.sites[s].alive = false;
-      report.dropped_tip_sites += static_cast<int>(bad_tips.size());
-      if (++tip_rounds > kMaxHiddenRepairs)  // cannot happen twice: no free site is left
-        for (Site& s : set.sites)
-          if (s.kind == SiteKind::Free) s.alive = false;
-      continue;
+      if (!bad_tips.empty()) {
+        for (int s : bad_tips) set.sites[s].alive = false;
+        report.dropped_tip_sites += static_cast<int>(bad_tips.size());
+        if (++tip_rounds > kMaxHiddenRepairs)  // cannot happen twice: no free site is left
+          for (Site& s : set.sites)
+            if (s.kind == SiteKind::Free) s.alive = false;
+        continue;
+      }
+      // Polygon or box sites whose cells collapsed onto a duplicate face: moved like hidden ones.
+      hidden = sites_in_duplicate_faces(set, out);
+      if (hidden.empty()) break;
+      degenerate = true;
     }
     for (int s : hidden) {
       std::ostringstream os;
@@ -105,18 +111,20 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
         os << "tip site " << s << " is hidden: dropped and rebuilt";
       else
         os << "site " << s << (set.sites[s].internal() ? " (internal" : " (external") << ", polygon "
-           << set.sites[s].polygons.front() << ") is hidden: moved toward its polygon and rebuilt";
+           << set.sites[s].polygons.front() << (degenerate ? ") has a duplicate face" : ") is hidden")
+           << ": moved toward its polygon and rebuilt";
       if (report.notes.size() < 50) report.notes.push_back(os.str());
       if (set.sites[s].kind == SiteKind::Free) {
         set.sites[s].alive = false;
         ++report.dropped_tip_sites;
-      } else if (set.sites[s].internal()) {
+      } else if (set.sites[s].internal() && !degenerate) {
         ++report.hidden_sites;
       }
     }
     if (hidden_rounds++ == kMaxHiddenRepairs) {
       std::ostringstream os;
-      os << "transition: " << hidden.size() << " sites stay hidden after " << kMaxHiddenRepairs << " repairs";
+      os << "transition: " << hidden.size() << " sites stay " << (degenerate ? "in duplicate faces" : "hidden")
+         << " after " << kMaxHiddenRepairs << " repairs";
       throw std::runtime_error(os.str());
     }
     ++report.hidden_repairs;

@@ -140,6 +140,11 @@ int drop_blocked_tip_sites(SiteSet& set);
 /// site order.
 std::vector<int> tip_sites_in_bad_cells(const SiteSet& set, const TransitionCells& out);
 
+/// Internal sites whose cells share a face node set with two other faces, or twice within the
+/// cell (after vertex identification, near-degenerate quadruples of sites can collapse two power
+/// faces onto the same nodes). The builder would reject the mesh; the driver moves them instead.
+std::vector<int> sites_in_duplicate_faces(const SiteSet& set, const TransitionCells& out);
+
 /// Stage 5.6-5.7 (CGAL Regular_triangulation_3): power cells of the internal sites,
 /// power vertices identified combinatorially, external faces snapped to the constrained
 /// polygons. Fills `out` (cells, new nodes, report counters). Returns the ids of internal

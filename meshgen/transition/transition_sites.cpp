@@ -135,6 +135,40 @@ bool can_shrink(const SiteSet& set, int s, const std::vector<PolygonFrame>& fram
   return p.t > 1.0001 * kMinT * frames[p.polygon].radius;
 }
 
+// Condition (6) for a pair holds when f = |P_l - P_s|^2 - w_l^2 + w_s^2 >= 0 (l the larger
+// weight, s the smaller). Returns d f / d(-t) for the dual-line parameter t that moves site a
+// (its own, or its internal partner's for a reflection), with w^2 = rho^2 + t^2: positive when
+// moving a toward its polygon raises f. NaN when a has no such parameter (a box: split it).
+//   a larger, internal:   2 h_b         (h_b: height of b above a's polygon, along n)
+//   a larger, reflection: -2 h_b
+//   a smaller, internal:  2 h_b - 4 t_a (f is convex in t_a, least at t_a = h_b / 2)
+double shrink_gain(const SiteSet& set, int a, int b, const std::vector<PolygonFrame>& frames) {
+  const Site& sa = set.sites[a];
+  if (sa.kind != SiteKind::InternalPolygon && sa.kind != SiteKind::ExternalMirror) return std::nan("");
+  if (sa.kind == SiteKind::ExternalMirror && set.sites[set.internal_of[sa.polygon]].kind != SiteKind::InternalPolygon)
+    return std::nan("");
+  const PolygonFrame& f = frames[sa.polygon];
+  const double h = dot(set.sites[b].p - f.center, f.normal);
+  if (sa.w2 < set.sites[b].w2) return 2 * h - 4 * sa.t;
+  return sa.kind == SiteKind::ExternalMirror ? -2 * h : 2 * h;
+}
+
+// Whether growing the smaller site `small` of a violating pair (up to its largest t) can satisfy
+// (6): f(t) = 2 t^2 - 2 h t + c is convex in its t (h: height of the larger site above its
+// polygon), so it must be past the minimum (t > h / 2) and the upper root within reach; below the
+// minimum only moving toward the polygon helps.
+bool grow_satisfies(const SiteSet& set, int small, int large, const std::vector<PolygonFrame>& frames) {
+  const Site& s = set.sites[small];
+  const Site& l = set.sites[large];
+  const PolygonFrame& f = frames[s.polygon];
+  const double h = dot(l.p - f.center, f.normal);
+  if (!(s.t > 0.5 * h)) return false;
+  const double c = norm2(l.p - f.center) - l.w2 + (s.w2 - s.t * s.t);
+  const double disc = h * h - 2 * c;
+  if (disc < 0) return true;
+  return 0.5 * (h + std::sqrt(disc)) <= max_t(set, s.polygon, frames);
+}
+
 bool can_grow(const SiteSet& set, int s, const std::vector<PolygonFrame>& frames) {
   const Site& site = set.sites[s];
   return site.kind == SiteKind::InternalPolygon && site.t < 0.9999 * max_t(set, site.polygon, frames);
@@ -455,15 +489,23 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
         ++n;
         if (it == max_iterations) ++pair_kinds[site_label(set, large, cavity, frames) + " > " + site_label(set, small, cavity, frames)];
         involved[large] = involved[small] = 1;
-        // The larger weight moves toward its polygon (5.5.2); once it cannot (a polygon site
-        // at its minimal distance), the smaller one moves away from its polygon instead,
-        // which raises its weight, within its empty-sphere range.
+        // The larger weight moves toward its polygon (5.5.2) when that helps (the smaller site
+        // in front of its polygon); a box is split. Otherwise the smaller site moves, in the
+        // direction that raises f (shrink_gain), or is split if it is a box.
         const bool small_may_grow = can_grow(set, small, frames) &&
                                     (small >= static_cast<int>(shrunk_at.size()) ||
                                      it - shrunk_at[small] > kNoGrowAfterShrink);
-        if (can_shrink(set, large, frames)) fix[large] = 1;
-        else if (small_may_grow) grow[small] = 1;
-        else fix[large] = 1;
+        const double gain_large = shrink_gain(set, large, small, frames);
+        if (std::isnan(gain_large) || (gain_large > 0 && can_shrink(set, large, frames))) {
+          fix[large] = 1;
+        } else {
+          const double gain_small = shrink_gain(set, small, large, frames);
+          if (std::isnan(gain_small)) fix[small] = 1;
+          else if (small_may_grow && grow_satisfies(set, small, large, frames)) grow[small] = 1;
+          else if (can_shrink(set, small, frames)) fix[small] = 1;
+          else if (small_may_grow) grow[small] = 1;
+          else fix[large] = 1;
+        }
       }
     }
     corrections += n;

@@ -213,4 +213,25 @@ std::vector<int> tip_sites_in_bad_cells(const SiteSet& set, const TransitionCell
   return bad;
 }
 
+std::vector<int> sites_in_duplicate_faces(const SiteSet& set, const TransitionCells& out) {
+  std::vector<int> site_of_cell;
+  for (size_t s = 0; s < set.sites.size(); ++s)
+    if (set.sites[s].alive && set.sites[s].internal()) site_of_cell.push_back(static_cast<int>(s));
+  std::map<std::vector<int32_t>, std::vector<int>> cells_of_face;
+  for (size_t c = 0; c < out.cells.size() && c < site_of_cell.size(); ++c)
+    for (const CellFace& f : out.cells[c]) {
+      std::vector<int32_t> key = f.nodes;
+      std::sort(key.begin(), key.end());
+      cells_of_face[key].push_back(static_cast<int>(c));
+    }
+  std::vector<int> bad;
+  for (const auto& [key, cells] : cells_of_face) {
+    if (cells.size() <= 2 && (cells.size() < 2 || cells[0] != cells[1])) continue;
+    for (int c : cells) bad.push_back(site_of_cell[c]);
+  }
+  std::sort(bad.begin(), bad.end());
+  bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
+  return bad;
+}
+
 }  // namespace hm::transition_detail

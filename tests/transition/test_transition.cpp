@@ -281,7 +281,7 @@ TEST(Transition, SiteCorrection) {
     correct_sites(bad, cav, coords, grid, frames, 1, &iterations);
     FAIL() << "expected no convergence in one iteration";
   } catch (const TransitionError& e) {
-    EXPECT_STREQ(e.what(), "transition: site correction did not converge after 1 iterations (1 pairs left)");
+    EXPECT_STREQ(e.what(), "transition: site correction did not converge after 1 iterations (1 pairs left: 1 well > well)");
     EXPECT_EQ(e.polygons, (std::vector<int32_t>{0, 1}));  // both sites of the pair
     EXPECT_TRUE(e.cells_to_deactivate.empty());           // well polygons, no reservoir behind
   }
