@@ -34,6 +34,7 @@ struct CaseResult {
   Outcome outcome = Outcome::Failed;
   std::string reason;  ///< the error message or the failed checks
   double seconds = 0;
+  std::vector<std::string> notes;  ///< the mesher's notes (in-process runs only)
 };
 
 /// Total volume of the box minus the exact wellbore holes (end caps as requested).
@@ -46,7 +47,8 @@ inline double box_minus_holes(const CaseSpec& cs, const HybridMesh& h) {
 
 /// Meshes the case and checks: the builder matched every face, fvcheck passes (convexity,
 /// conformity, closure, volumes, orthogonality, auto-centering, planarity) and the total volume is
-/// the box minus the exact holes (relative 1e-9). Refusals (InputError) and failures are outcomes.
+/// the box minus the exact holes (relative 1e-9), every block closed as requested (a fallback to
+/// flat ends counts as a failed check). Refusals (InputError) and failures are outcomes.
 inline CaseResult mesh_and_check(const RealisticCase& rc) {
   CaseResult res;
   const auto t0 = std::chrono::steady_clock::now();
@@ -54,6 +56,9 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
     const HybridMesh h = build_hybrid_mesh(rc.spec);
     std::string bad;
     if (!h.build_report.ok) bad += "builder; ";
+    for (const WellBlock& b : h.blocks)
+      if (b.hemisphere_caps != (rc.spec.wells[b.well].end_caps == EndCaps::Hemisphere)) bad += "end caps not as requested; ";
+    res.notes = h.notes;
     const FvReport fv = run_fvcheck(h.mesh, CheckOptions{}, h.cell_h_ref, &h.build_report);
     if (!fv.structure.ok) bad += "csr; ";
     for (const CheckResult& c : fv.checks)
@@ -76,7 +81,7 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
 /// mesh_and_check in a forked child: a signal is a Crash, more than `timeout_s` a Hang.
 inline CaseResult mesh_and_check_isolated(const RealisticCase& rc, double timeout_s) {
   int fds[2];
-  if (pipe(fds) != 0) return {Outcome::Failed, "pipe() failed", 0};
+  if (pipe(fds) != 0) return {Outcome::Failed, "pipe() failed", 0, {}};
   const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid == 0) {
@@ -104,7 +109,7 @@ inline CaseResult mesh_and_check_isolated(const RealisticCase& rc, double timeou
       waitpid(pid, &status, 0);
       close(fds[0]);
       return {Outcome::Hang, "no result after " + std::to_string(timeout_s) + " s",
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()};
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), {}};
     } else {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }

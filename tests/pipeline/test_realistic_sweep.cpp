@@ -118,3 +118,40 @@ TEST(RealisticSweep, FullSweepTable) {
   EXPECT_EQ(all.count[Outcome::Hang], 0);
   EXPECT_EQ(all.count[Outcome::CheckFailed], 0);
 }
+
+// The CI-sized subset (also run under ASan): straight wells (one or two), strict hemispherical caps or
+// flat ends alternately, local coordinates, no optimisation, cavities at most 48 layers thick and
+// cells at most 20 m wide (time). Every case must mesh with its requested end caps and pass
+// mesh_and_check (builder, every fvcheck check, volume = box minus the exact holes).
+TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
+  std::map<std::string, int> shapes;
+  for (uint32_t seed = 1; seed <= 16; ++seed) {
+    RealisticOptions o;
+    o.caps = seed % 2 ? RealisticOptions::Caps::Hemisphere : RealisticOptions::Caps::Flat;
+    o.max_wells = 2;
+    o.bends = false;
+    o.max_cavity_layers = 48;
+    o.max_dx = 20;
+    const RealisticCase rc = make_realistic_case(seed, o);
+    const CaseResult r = mesh_and_check(rc);
+    ++shapes[shape_class(rc)];
+    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+    std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
+                r.seconds);
+  }
+  for (const auto& [k, v] : shapes) std::printf("[ ci sweep  ] %s: %d cases\n", k.c_str(), v);
+}
+
+// Reproducer of issue 12 (1 m layers, 10 m cells, one deviated well with R = 15 m): it crashed
+// (heap overflow in the correction), then failed ("site correction did not converge after 100
+// iterations (14721 pairs left) (after 5 cavity enlargements)"). It must mesh with its caps, on the
+// first attempt (no cavity enlargement), and pass every check. Optimisation off (time).
+TEST(RealisticSweep, ThinLayersReproducerMeshes) {
+  RealisticCase rc;
+  rc.spec = load_case(std::string(HM_SOURCE_DIR) + "/tests/pipeline/data/thin_layers_crash.yaml");
+  rc.spec.transition.optimize = false;
+  rc.spec.wells.at(0).end_caps_fallback = false;
+  const CaseResult r = mesh_and_check(rc);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << r.reason;
+  for (const std::string& n : r.notes) EXPECT_EQ(n.find("so that the transition mesh can be built"), std::string::npos) << n;
+}
