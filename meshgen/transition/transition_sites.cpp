@@ -136,20 +136,17 @@ bool can_shrink(const SiteSet& set, int s, const std::vector<PolygonFrame>& fram
 }
 
 // Condition (6) for a pair holds when f = |P_l - P_s|^2 - w_l^2 + w_s^2 >= 0 (l the larger
-// weight, s the smaller). Returns d f / d(-t) for the dual-line parameter t that moves site a
-// (its own, or its internal partner's for a reflection), with w^2 = rho^2 + t^2: positive when
-// moving a toward its polygon raises f. NaN when a has no such parameter (a box: split it).
-//   a larger, internal:   2 h_b         (h_b: height of b above a's polygon, along n)
-//   a larger, reflection: -2 h_b
-//   a smaller, internal:  2 h_b - 4 t_a (f is convex in t_a, least at t_a = h_b / 2)
-double shrink_gain(const SiteSet& set, int a, int b, const std::vector<PolygonFrame>& frames) {
+// weight, s the smaller). With w^2 = rho^2 + t^2 along the dual lines, f is linear in the larger
+// site's t: returns d f / d(-t) for larger site a against smaller site b (2 h for a polygon site, -2 h
+// for a reflection, which moves with its internal partner; h the height of b above a's polygon):
+// positive when moving a toward its polygon raises f. NaN when a has no such parameter (a box: split it).
+double shrink_gain_of_larger(const SiteSet& set, int a, int b, const std::vector<PolygonFrame>& frames) {
   const Site& sa = set.sites[a];
   if (sa.kind != SiteKind::InternalPolygon && sa.kind != SiteKind::ExternalMirror) return std::nan("");
   if (sa.kind == SiteKind::ExternalMirror && set.sites[set.internal_of[sa.polygon]].kind != SiteKind::InternalPolygon)
     return std::nan("");
   const PolygonFrame& f = frames[sa.polygon];
   const double h = dot(set.sites[b].p - f.center, f.normal);
-  if (sa.w2 < set.sites[b].w2) return 2 * h - 4 * sa.t;
   return sa.kind == SiteKind::ExternalMirror ? -2 * h : 2 * h;
 }
 
@@ -489,18 +486,17 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
         ++n;
         if (it == max_iterations) ++pair_kinds[site_label(set, large, cavity, frames) + " > " + site_label(set, small, cavity, frames)];
         involved[large] = involved[small] = 1;
-        // The larger weight moves toward its polygon (5.5.2) when that helps (the smaller site
-        // in front of its polygon); a box is split. Otherwise the smaller site moves, in the
-        // direction that raises f (shrink_gain), or is split if it is a box.
+        // The larger weight moves toward its polygon (5.5.2) when that helps (the smaller site in
+        // front of its polygon); a box is split. Otherwise the smaller site moves: away from its
+        // polygon only if that can satisfy (6) (grow_satisfies), else toward it; a box is split.
         const bool small_may_grow = can_grow(set, small, frames) &&
                                     (small >= static_cast<int>(shrunk_at.size()) ||
                                      it - shrunk_at[small] > kNoGrowAfterShrink);
-        const double gain_large = shrink_gain(set, large, small, frames);
+        const double gain_large = shrink_gain_of_larger(set, large, small, frames);
         if (std::isnan(gain_large) || (gain_large > 0 && can_shrink(set, large, frames))) {
           fix[large] = 1;
         } else {
-          const double gain_small = shrink_gain(set, small, large, frames);
-          if (std::isnan(gain_small)) fix[small] = 1;
+          if (set.sites[small].kind != SiteKind::InternalPolygon) fix[small] = 1;  // a box: split
           else if (small_may_grow && grow_satisfies(set, small, large, frames)) grow[small] = 1;
           else if (can_shrink(set, small, frames)) fix[small] = 1;
           else if (small_may_grow) grow[small] = 1;
