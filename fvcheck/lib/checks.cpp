@@ -419,7 +419,7 @@ CheckResult check_conformity(const PolyMesh& m, const MeshGeometry& geo, const C
 
   int64_t b_over = 0, b_misor = 0, b_degen = 0;
   if (build) b_over = build->overused_faces, b_misor = build->misoriented_faces, b_degen = build->degenerate_faces;
-  r.violations = unmatched + duplicates + open_cells + misoriented_cells + hanging_nodes + b_over + b_degen;
+  r.violations = unmatched + duplicates + open_cells + misoriented_cells + hanging_nodes + b_over + b_misor + b_degen;
   r.worst = r.values.empty() ? 0.0 : *std::max_element(r.values.begin(), r.values.end());
   r.worst_ids = worst_ids_of(r.values, true, [&](size_t c) { return r.values[c] > 0; });
   r.counts = {{"unmatched_faces", unmatched},

@@ -14,6 +14,7 @@ bool FvReport::ok() const {
   if (!structure.ok) return false;
   for (const CheckResult& c : checks)
     if (!c.ok()) return false;
+  if (!transmissibility.ok()) return false;
   return !checks.empty();
 }
 
@@ -114,6 +115,13 @@ std::string report_summary_text(const FvReport& r) {
                   static_cast<long long>(r.transmissibility.negative_halves));
     os << line;
   }
+  if (r.transmissibility.present && !r.transmissibility.ok())
+    os << "  transmissibility FAILED: negative or non-finite values (first faces:" <<
+        [&] {
+          std::string ids;
+          for (int32_t f : r.transmissibility.negative_faces) ids += " " + std::to_string(f);
+          return ids;
+        }() << ")\n";
   os << "result: " << (r.ok() ? "OK" : "FAILED") << "\n";
   return os.str();
 }

@@ -20,6 +20,8 @@ struct TransmissibilitySummary {
   int64_t negative = 0;  ///< faces with T < 0 or not finite (reported, never silently abs()-ed)
   int64_t negative_halves = 0;          ///< negative or non-finite half-transmissibilities
   std::vector<int32_t> negative_faces;  ///< first faces concerned
+  /// A negative or non-finite transmissibility (face or half) is a failed check.
+  bool ok() const { return !present || (negative == 0 && negative_halves == 0); }
 };
 /// Summary of one value per face (0 = no connection).
 TransmissibilitySummary summarize_transmissibilities(const std::vector<double>& face_values);
@@ -38,7 +40,7 @@ struct FvReport {
   TransmissibilitySummary transmissibility;
   std::vector<std::string> notes;            ///< reader warnings etc., shown in the reports
 
-  /// True when the structure is valid and every check holds (transmissibility is informative).
+  /// True when the structure is valid, every check holds and no transmissibility is negative.
   bool ok() const;
   const CheckResult* find(const std::string& name) const;
 };

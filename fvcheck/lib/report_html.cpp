@@ -193,11 +193,11 @@ std::string report_html(const FvReport& r) {
   if (r.transmissibility.present) {
     h << "<h2>Transmissibilities</h2><table><tr><th class='l'>faces with T &ne; 0</th><th>min</th><th>max</th>"
          "<th>negative faces</th><th>negative halves</th></tr><tr"
-      << (r.transmissibility.negative > 0 ? " class='bad'" : "") << "><td class='l'>" << r.transmissibility.count
+      << (!r.transmissibility.ok() ? " class='bad'" : "") << "><td class='l'>" << r.transmissibility.count
       << "</td><td>" << fmt(r.transmissibility.min) << "</td><td>" << fmt(r.transmissibility.max) << "</td><td>"
       << r.transmissibility.negative << "</td><td>" << r.transmissibility.negative_halves << "</td></tr></table>\n";
     if (!r.transmissibility.negative_faces.empty())
-      h << "<p class='small'>Faces with a negative transmissibility: " << ids_text(r.transmissibility.negative_faces)
+      h << "<p class='small'>Faces with a negative transmissibility (a failed check): " << ids_text(r.transmissibility.negative_faces)
         << "</p>\n";
   }
 
