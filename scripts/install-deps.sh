@@ -3,7 +3,7 @@
 # Usage: scripts/install-deps.sh [--validators]   (--validators adds OPM Flow, OpenFOAM, VTK)
 set -euo pipefail
 build_pkgs=(cmake g++ make libcgal-dev libeigen3-dev libopenmesh-dev libboost-graph-dev libgtest-dev
-            libyaml-cpp-dev nlohmann-json3-dev libtbb-dev libopm-common-dev)
+            libyaml-cpp-dev nlohmann-json3-dev libtbb-dev libopm-common-dev libvtk9-dev clang libclang-rt-14-dev)
 validator_pkgs=(python3-vtk9 libopm-simulators-bin python3-opm-common openfoam xvfb)
 want=("${build_pkgs[@]}")
 if [[ "${1:-}" == "--validators" ]]; then want+=("${validator_pkgs[@]}"); fi

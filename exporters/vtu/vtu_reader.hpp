@@ -1,9 +1,12 @@
 // VTK XML UnstructuredGrid (.vtu) reader -> PolyMesh, rebuilt with the MeshBuilder.
-// Accepts polyhedra (42) and tetra (10), voxel (11), hexahedron (12), wedge (13), pyramid (14);
-// data formats ascii, binary (base64, UInt32 or UInt64 header), appended raw and appended
-// base64, in either byte order. zlib-compressed files are refused with a clear error.
-// Never crashes or hangs on a malformed file: every count, id and offset is bounds-checked
-// and a failure comes back as ok = false with a one-line message. docs/output-formats.md.
+// The file is parsed by VTK's own vtkXMLUnstructuredGridReader, so every variant VTK writes is
+// read: ascii, binary (inline base64), appended (raw or base64), UInt32 or UInt64 headers,
+// 32- or 64-bit ids, either byte order, compressors none / zlib / LZ4 / LZMA, several pieces.
+// Accepts polyhedra (42) and tetra (10), voxel (11), hexahedron (12), wedge (13), pyramid (14).
+// The reader reports what is in the file and repairs nothing: faces are taken with the
+// orientation the file gives them (a reversed face is the checker's finding, not fixed here).
+// Never crashes on a malformed file: every id and face stream is bounds-checked and a failure
+// comes back as ok = false with a one-line message. docs/output-formats.md.
 #pragma once
 #include <string>
 #include <vector>
@@ -21,8 +24,8 @@ struct ReadResult {
   bool has_region = false;     ///< `region` was present (else every cell is kReservoir)
   bool has_fv_center = false;  ///< `fv_center` was present (else the cell centroid is used)
   bool has_face_patch = false; ///< field data `face_patch` was present and used
-  int flipped_faces = 0;       ///< faces re-oriented to point out of their cell
-  int unorientable_cells = 0;  ///< cells whose faces admit no consistent orientation
+  bool has_radial = false;     ///< the radial_* arrays were present (exact radial transmissibilities)
+  std::vector<std::string> missing_mesh_arrays;  ///< mesh_cell_arrays names absent from the file
   /// Every cell data array of the file, as Float64 values (cell order = mesh cell order).
   std::vector<VtuCellArray> cell_arrays;
   std::vector<std::string> warnings;
@@ -36,12 +39,7 @@ struct ReadResult {
 
 /// Reads a .vtu file. Never throws for bad content.
 ReadResult read_vtu(const std::string& path);
-/// Same, from the file's bytes (tests).
+/// Same, from the file's bytes (tests, fuzzing).
 ReadResult read_vtu_buffer(const std::string& bytes);
-
-/// Reorients the faces of one closed cell so that they agree along shared edges and
-/// point outward (positive signed volume). Returns the number of faces reversed; sets
-/// *consistent to false when no consistent orientation exists (non-manifold or Moebius-like).
-int orient_cell_faces(std::vector<std::vector<int32_t>>& faces, const std::vector<Vec3>& points, bool* consistent);
 
 }  // namespace hm

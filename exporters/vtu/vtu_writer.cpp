@@ -5,9 +5,12 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <algorithm>
+#include <array>
 #include <set>
 #include <sstream>
 
+#include "exporters/vtu/vtu_mesh_arrays.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 #include "meshgen/core/text_file.hpp"
 
@@ -47,6 +50,54 @@ void header_line(std::ostringstream& xml, const Block& b, uint64_t offset, const
   xml << " format=\"appended\" offset=\"" << offset << "\"/>\n";
 }
 
+// VTK_HEXAHEDRON's faces as local point indices, outward (vtkHexahedron's face order).
+constexpr int kHexFaces[6][4] = {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}};
+
+// A cell whose six outward quadrilaterals are, cycle for cycle and orientation for orientation,
+// the faces of a VTK_HEXAHEDRON on 8 distinct nodes: returns true with the 8 point ids in VTK
+// order and, for each VTK face k, the cell-local index of the face it is (`which[k]`).
+// Combinatorial only: the geometry (planar or not) is the same whichever type is written.
+bool as_hexahedron(const std::vector<std::vector<int32_t>>& faces, std::array<int32_t, 8>* pts,
+                   std::array<int, 6>* which) {
+  if (faces.size() != 6) return false;
+  for (const auto& f : faces)
+    if (f.size() != 4) return false;
+  // Bottom: the first face, whose outward cycle is VTK's (0, 3, 2, 1).
+  const auto& b = faces[0];
+  std::array<int32_t, 8> p{b[0], b[3], b[2], b[1], -1, -1, -1, -1};
+  for (int i = 0; i < 4; ++i) {
+    // p[i + 4]: the one node joined to p[i] by an edge that is not on the bottom face.
+    for (const auto& f : faces)
+      for (int e = 0; e < 4; ++e) {
+        const int32_t u = f[e], v = f[(e + 1) % 4];
+        const int32_t other = u == p[i] ? v : v == p[i] ? u : -1;
+        if (other < 0 || std::find(p.begin(), p.begin() + 4, other) != p.begin() + 4) continue;
+        if (p[i + 4] >= 0 && p[i + 4] != other) return false;
+        p[i + 4] = other;
+      }
+    if (p[i + 4] < 0) return false;
+  }
+  std::array<int32_t, 8> sorted = p;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;
+  std::vector<std::pair<std::vector<int32_t>, bool>> keys;
+  for (const auto& f : faces) {
+    bool rev = false;
+    std::vector<int32_t> k = canonical_cycle(f, &rev);
+    keys.emplace_back(std::move(k), rev);
+  }
+  for (int k = 0; k < 6; ++k) {
+    bool rev = false;
+    const std::vector<int32_t> key =
+        canonical_cycle({p[kHexFaces[k][0]], p[kHexFaces[k][1]], p[kHexFaces[k][2]], p[kHexFaces[k][3]]}, &rev);
+    const auto it = std::find(keys.begin(), keys.end(), std::make_pair(key, rev));
+    if (it == keys.end()) return false;
+    (*which)[k] = static_cast<int>(it - keys.begin());
+  }
+  *pts = p;
+  return true;
+}
+
 }  // namespace
 
 WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vector<VtuCellArray>& extra) {
@@ -56,9 +107,10 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   if (!csr.ok) return fail("invalid mesh: " + (csr.problems.empty() ? std::string("?") : csr.problems[0]));
   const size_t nc = static_cast<size_t>(m.n_cells());
   if (m.cell_fv_center.size() != nc) return fail("cell_fv_center has the wrong size");
-  std::set<std::string> names{"region", "fv_center"};
+  std::set<std::string> names;
   for (const VtuCellArray& a : extra) {
     if (a.name.empty()) return fail("a cell array has an empty name");
+    if (is_mesh_array_name(a.name)) return fail("cell array name '" + a.name + "' is reserved for the mesh's own data");
     if (!names.insert(a.name).second) return fail("duplicate cell array name '" + a.name + "'");
     if (a.components < 1) return fail("cell array '" + a.name + "' must have >= 1 component");
     if (a.size() != nc * static_cast<size_t>(a.components))
@@ -66,32 +118,54 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
                   std::to_string(nc * static_cast<size_t>(a.components)));
   }
 
-  // Topology: distinct nodes of each cell in first-use order, and outward faces.
+  // Topology: hexahedra as VTK_HEXAHEDRON (12); every other cell as VTK_POLYHEDRON (42) with its
+  // distinct nodes in first-use order and its outward faces. face_patch follows the faces as a
+  // reader sees them: the face stream of a polyhedron, vtkHexahedron's face order for a hexahedron.
   std::vector<int64_t> connectivity, offsets, faces, faceoffsets;
   std::vector<uint8_t> types(nc, 42);
   std::vector<int32_t> face_patch;
   std::vector<int64_t> stamp(m.nodes.size(), -1);
+  std::vector<std::vector<int32_t>> local;
+  std::vector<int32_t> local_patch;
+  bool any_polyhedron = false;
   for (size_t c = 0; c < nc; ++c) {
     const int ci = static_cast<int>(c);
-    faces.push_back(m.cell_face_ptr[c + 1] - m.cell_face_ptr[c]);
+    local.clear();
+    local_patch.clear();
     for (const int32_t* fp = m.cell_begin(ci); fp != m.cell_end(ci); ++fp) {
       const int f = *fp, k = m.face_size(f);
       const int32_t* v = m.face_begin(f);
-      faces.push_back(k);
       const bool own = m.face_owner[f] == ci;
-      for (int i = 0; i < k; ++i) {
-        // The neighbour sees the face reversed: v0, v_{k-1}, ..., v1.
-        const int32_t id = own ? v[i] : v[(k - i) % k];
-        faces.push_back(id);
-        if (stamp[id] != static_cast<int64_t>(c)) {
-          stamp[id] = static_cast<int64_t>(c);
-          connectivity.push_back(id);
+      std::vector<int32_t> cyc(k);
+      // The neighbour sees the face reversed: v0, v_{k-1}, ..., v1.
+      for (int i = 0; i < k; ++i) cyc[i] = own ? v[i] : v[(k - i) % k];
+      local.push_back(std::move(cyc));
+      local_patch.push_back(m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f]);
+    }
+    std::array<int32_t, 8> hex{};
+    std::array<int, 6> which{};
+    if (as_hexahedron(local, &hex, &which)) {
+      types[c] = 12;
+      connectivity.insert(connectivity.end(), hex.begin(), hex.end());
+      for (int k = 0; k < 6; ++k) face_patch.push_back(local_patch[which[k]]);
+    } else {
+      any_polyhedron = true;
+      faces.push_back(static_cast<int64_t>(local.size()));
+      for (size_t q = 0; q < local.size(); ++q) {
+        faces.push_back(static_cast<int64_t>(local[q].size()));
+        for (int32_t id : local[q]) {
+          faces.push_back(id);
+          if (stamp[id] != static_cast<int64_t>(c)) {
+            stamp[id] = static_cast<int64_t>(c);
+            connectivity.push_back(id);
+          }
         }
+        face_patch.push_back(local_patch[q]);
       }
-      face_patch.push_back(m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f]);
     }
     offsets.push_back(static_cast<int64_t>(connectivity.size()));
-    faceoffsets.push_back(static_cast<int64_t>(faces.size()));
+    // VTK's faceoffsets: end of the cell's face stream, -1 for a cell that is not a polyhedron.
+    faceoffsets.push_back(types[c] == 42 ? static_cast<int64_t>(faces.size()) : -1);
   }
   std::vector<double> points(3 * m.nodes.size());
   for (size_t i = 0; i < m.nodes.size(); ++i) {
@@ -99,21 +173,19 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
     points[3 * i + 1] = m.nodes[i].y;
     points[3 * i + 2] = m.nodes[i].z;
   }
-  std::vector<double> center(3 * nc);
-  for (size_t c = 0; c < nc; ++c) {
-    center[3 * c] = m.cell_fv_center[c].x;
-    center[3 * c + 1] = m.cell_fv_center[c].y;
-    center[3 * c + 2] = m.cell_fv_center[c].z;
-  }
-
   Block field = make_block("Int32", "face_patch", 1, face_patch);
   field.tuples = static_cast<int64_t>(face_patch.size());
   std::vector<Block> point_blocks{make_block("Float64", "Points", 3, points)};
   std::vector<Block> cell_blocks{make_block("Int64", "connectivity", 1, connectivity),
-                                 make_block("Int64", "offsets", 1, offsets), make_block("UInt8", "types", 1, types),
-                                 make_block("Int64", "faces", 1, faces),
-                                 make_block("Int64", "faceoffsets", 1, faceoffsets)};
-  std::vector<Block> data_blocks{make_block("Int32", "region", 1, m.cell_region), make_block("Float64", "fv_center", 3, center)};
+                                 make_block("Int64", "offsets", 1, offsets), make_block("UInt8", "types", 1, types)};
+  if (any_polyhedron) {
+    cell_blocks.push_back(make_block("Int64", "faces", 1, faces));
+    cell_blocks.push_back(make_block("Int64", "faceoffsets", 1, faceoffsets));
+  }
+  std::vector<Block> data_blocks;
+  for (const VtuCellArray& a : mesh_cell_arrays(m))
+    data_blocks.push_back(a.integer ? make_block("Int32", a.name, a.components, a.ints)
+                                    : make_block("Float64", a.name, a.components, a.values));
   for (const VtuCellArray& a : extra)
     data_blocks.push_back(a.integer ? make_block("Int32", a.name, a.components, a.ints)
                                     : make_block("Float64", a.name, a.components, a.values));

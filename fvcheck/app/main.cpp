@@ -93,6 +93,10 @@ int main(int argc, char** argv) {
     const hm::Transmissibilities t = hm::compute_transmissibilities(in.mesh, geo);
     report.transmissibility = hm::summarize_transmissibilities(t.face);
     report.transmissibility.negative_halves = t.negative;
+    if (report.transmissibility.negative_faces.empty()) report.transmissibility.negative_faces = t.negative_faces;
+    if (!in.has_radial)
+      report.notes.push_back("no radial_* arrays: well cells get the generic two-point transmissibility "
+                             "(docs/output-formats.md lists the arrays that make a mesh file lossless)");
     if (!in.has_face_patch)
       report.notes.push_back("no face_patch field data: every boundary face treated as outer boundary "
                              "(no wellbore transmissibilities)");

@@ -93,16 +93,14 @@ int main(int argc, char** argv) {
   {
     // mesh.vtu: the hybrid mesh with its FV data and per-cell quality for ParaView.
     const hm::PolyMesh& m = result.mesh;
-    std::vector<double> perm, porosity(m.cell_porosity.begin(), m.cell_porosity.end());
-    for (const hm::Vec3& k : m.cell_perm) perm.insert(perm.end(), {k.x, k.y, k.z});
+    // write_vtu adds the mesh's own per-cell data (region, FV centre, ijk, rock, radial structure).
     const std::vector<hm::VtuCellArray> extra = {
+        hm::VtuCellArray::int32("cavity", 1, result.cell_cavity),
         hm::VtuCellArray::real("volume", 1, result.geometry.cell_volume),
         hm::VtuCellArray::real("h_ref", 1, result.cell_h_ref),
         hm::VtuCellArray::real("Q_S", 1, hm::cell_shape_quality(m, result.cell_h_ref)),
         hm::VtuCellArray::real("Q_O", 1, hm::cell_min_of_faces(m, hm::face_orthogonality(m, result.geometry))),
-        hm::VtuCellArray::real("Q_P", 1, hm::cell_max_of_faces(m, hm::face_planarity(m, result.geometry))),
-        hm::VtuCellArray::real("permeability", 3, perm),
-        hm::VtuCellArray::real("porosity", 1, porosity)};
+        hm::VtuCellArray::real("Q_P", 1, hm::cell_max_of_faces(m, hm::face_planarity(m, result.geometry)))};
     const fs::path p = out / "mesh.vtu";
     const hm::WriteStatus st = hm::write_vtu(p.string(), m, extra);
     if (!st.ok) {

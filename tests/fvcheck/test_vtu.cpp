@@ -1,5 +1,6 @@
-// VTU writer and reader: exact round trip, every supported encoding, outward orientation of
-// faces, and malformed files (which must give an error, never a crash or a hang).
+// VTU writer and reader: exact round trip, every supported encoding, faces read as the file
+// orients them (a reversed face fails the checks), and malformed files (which must give an
+// error, never a crash or a hang).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,6 +14,7 @@
 
 #include "exporters/vtu/vtu_reader.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
+#include "fvcheck/lib/report.hpp"
 #include "fv_test_meshes.hpp"
 
 using namespace hm;
@@ -26,6 +28,13 @@ fs::path temp_dir(const std::string& name) {
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
+}
+
+std::string hm_slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
 }
 
 
@@ -152,8 +161,7 @@ std::string make_vtu(const RawGrid& g, Fmt fmt, bool header64, bool big_endian) 
   return x.str();
 }
 
-// Two unit cubes along x: cell 0 a VTK_HEXAHEDRON, cell 1 a VTK_POLYHEDRON whose faces are
-// given in mixed orientation (two of them inward) to exercise the reorientation.
+// Two unit cubes along x: cell 0 a VTK_HEXAHEDRON, cell 1 a VTK_POLYHEDRON with outward faces.
 RawGrid two_cubes() {
   RawGrid g;
   for (int k = 0; k < 2; ++k)
@@ -166,11 +174,11 @@ RawGrid two_cubes() {
   g.types = {12};
   g.faceoffsets = {-1};
   const std::vector<std::vector<int64_t>> f{
-      {P(1, 0, 0), P(1, 1, 0), P(1, 1, 1), P(1, 0, 1)},  // x = 1, inward (+x)
+      {P(1, 0, 1), P(1, 1, 1), P(1, 1, 0), P(1, 0, 0)},  // x = 1, outward (-x)
       {P(2, 0, 0), P(2, 1, 0), P(2, 1, 1), P(2, 0, 1)},  // x = 2, outward (+x)
       {P(1, 0, 0), P(2, 0, 0), P(2, 0, 1), P(1, 0, 1)},  // y = 0, outward (-y)
       {P(1, 1, 0), P(1, 1, 1), P(2, 1, 1), P(2, 1, 0)},  // y = 1, outward (+y)
-      {P(1, 0, 0), P(2, 0, 0), P(2, 1, 0), P(1, 1, 0)},  // z = 0, inward (+z)
+      {P(1, 1, 0), P(2, 1, 0), P(2, 0, 0), P(1, 0, 0)},  // z = 0, outward (-z)
       {P(1, 0, 1), P(2, 0, 1), P(2, 1, 1), P(1, 1, 1)}}; // z = 1, outward (+z)
   std::vector<int64_t> conn1;
   g.faces.push_back(6);
@@ -204,7 +212,45 @@ void expect_two_cubes(const ReadResult& r, const std::string& what) {
   for (int c = 0; c < 2; ++c) EXPECT_LT(norm(cell_area_sum(m, g, c)), 1e-14) << what;
   EXPECT_EQ(m.cell_region[1], 1) << what;
   EXPECT_TRUE(m.cell_fv_center[1] == (Vec3{1.5, 0.25, 0.5})) << what;
-  EXPECT_EQ(r.flipped_faces, 2) << what;  // the inward faces x = 1 and z = 0 of cell 1
+}
+
+// A cell's faces as seen from it: canonical outward cycle, orientation flag and what lies beyond
+// (neighbour cell or boundary patch), sorted. Equal for two meshes that differ only in face and
+// node-cycle numbering.
+std::vector<std::tuple<std::vector<int32_t>, bool, int32_t, int32_t>> cell_signature(const PolyMesh& m, int c) {
+  std::vector<std::tuple<std::vector<int32_t>, bool, int32_t, int32_t>> out;
+  for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+    const int f = *fp, k = m.face_size(f);
+    std::vector<int32_t> cyc(m.face_begin(f), m.face_end(f));
+    if (m.face_owner[f] != c)
+      for (int i = 0; i < k; ++i) cyc[i] = m.face_begin(f)[(k - i) % k];
+    bool rev = false;
+    std::vector<int32_t> key = canonical_cycle(cyc, &rev);
+    const int32_t beyond = m.face_owner[f] == c ? m.face_neighbour[f] : m.face_owner[f];
+    out.emplace_back(std::move(key), rev, beyond, m.face_patch[f]);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Every per-cell field and every cell's faces are identical (face ids may be renumbered).
+void expect_same_mesh(const PolyMesh& q, const PolyMesh& m) {
+  ASSERT_EQ(q.n_cells(), m.n_cells());
+  EXPECT_EQ(q.n_faces(), m.n_faces());
+  EXPECT_TRUE(std::equal(q.nodes.begin(), q.nodes.end(), m.nodes.begin(), m.nodes.end()));
+  EXPECT_EQ(q.cell_region, m.cell_region);
+  EXPECT_EQ(q.cell_ijk, m.cell_ijk);
+  EXPECT_EQ(q.cell_porosity, m.cell_porosity);
+  for (int c = 0; c < m.n_cells(); ++c) {
+    EXPECT_TRUE(q.cell_fv_center[c] == m.cell_fv_center[c]) << c;
+    EXPECT_TRUE(q.cell_perm[c] == m.cell_perm[c]) << c;
+    const RadialCellInfo &a = q.cell_radial[c], &b = m.cell_radial[c];
+    EXPECT_TRUE(a.well == b.well && a.ring == b.ring && a.sector == b.sector && a.segment == b.segment &&
+                a.band == b.band && a.r_in == b.r_in && a.r_out == b.r_out && a.r_center == b.r_center &&
+                a.angle == b.angle && a.length == b.length && a.cap_center == b.cap_center)
+        << c;
+    EXPECT_EQ(cell_signature(q, c), cell_signature(m, c)) << c;
+  }
 }
 
 }  // namespace
@@ -219,37 +265,80 @@ TEST(VtuRoundTrip, TopologyCoordinatesAndArraysAreIdentical) {
   for (int f = 0; f < m.n_faces() && wb < 0; ++f)
     if (m.face_neighbour[f] < 0) wb = f;
   m.face_patch[wb] = wellbore_patch(0);
+  // Every per-cell field set to something that is not its default.
+  for (int c = 0; c < m.n_cells(); ++c) {
+    m.cell_ijk[c] = {c, 2 * c, 3 * c};
+    m.cell_perm[c] = {100.0 / 3 + c, 0.1 * c, 1e-3};
+    m.cell_porosity[c] = 0.1 + c / 7.0;
+    RadialCellInfo& r = m.cell_radial[c];
+    r = {c % 2, c, c + 1, c + 2, 0.1 * c, 0.2 + c, 1.0 / 3, 2 * M_PI / 7, 0.7, c % 3 - 1, Vec3{1.0 / 3, 2, c + 0.5}};
+  }
   const MeshGeometry g = compute_geometry(m);
-  std::vector<int32_t> ijk;
-  for (int c = 0; c < m.n_cells(); ++c) ijk.insert(ijk.end(), {c, 2 * c, 3 * c});
 
   const fs::path d = temp_dir("roundtrip");
   const std::string path = (d / "mesh.vtu").string();
-  const WriteStatus st = write_vtu(path, m, {VtuCellArray::real("volume", 1, g.cell_volume), VtuCellArray::int32("ijk", 3, ijk)});
+  const WriteStatus st = write_vtu(path, m, {VtuCellArray::real("volume", 1, g.cell_volume)});
   ASSERT_TRUE(st.ok) << st.message;
   EXPECT_FALSE(fs::exists(path + ".tmp"));
+  // Hexahedra go out as VTK_HEXAHEDRON (issue 13), without a polyhedron face stream.
+  const std::string text = hm_slurp(path);
+  EXPECT_EQ(text.find("Name=\"faces\""), std::string::npos);
 
   const ReadResult r = read_vtu(path);
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_TRUE(r.build.ok);
-  EXPECT_TRUE(r.has_region && r.has_fv_center && r.has_face_patch);
-  EXPECT_EQ(r.flipped_faces, 0);
-  const PolyMesh& q = r.mesh;
-  EXPECT_EQ(q.nodes.size(), m.nodes.size());
-  EXPECT_TRUE(std::equal(q.nodes.begin(), q.nodes.end(), m.nodes.begin(), m.nodes.end()));
-  EXPECT_EQ(q.face_node_ptr, m.face_node_ptr);
-  EXPECT_EQ(q.face_nodes, m.face_nodes);
-  EXPECT_EQ(q.face_owner, m.face_owner);
-  EXPECT_EQ(q.face_neighbour, m.face_neighbour);
-  EXPECT_EQ(q.face_patch, m.face_patch);
-  EXPECT_EQ(q.cell_face_ptr, m.cell_face_ptr);
-  EXPECT_EQ(q.cell_faces, m.cell_faces);
-  EXPECT_EQ(q.cell_region, m.cell_region);
-  EXPECT_TRUE(std::equal(q.cell_fv_center.begin(), q.cell_fv_center.end(), m.cell_fv_center.begin()));
+  EXPECT_TRUE(r.has_region && r.has_fv_center && r.has_face_patch && r.has_radial);
+  EXPECT_TRUE(r.missing_mesh_arrays.empty());
+  expect_same_mesh(r.mesh, m);
   const VtuCellArray* vol = r.find("volume");
   ASSERT_NE(vol, nullptr);
   EXPECT_EQ(vol->values, g.cell_volume);
-  for (int c = 0; c < m.n_cells(); ++c) EXPECT_EQ(q.cell_ijk[c], (std::array<int32_t, 3>{c, 2 * c, 3 * c}));
+  fs::remove_all(d);
+}
+
+TEST(VtuRoundTrip, PolyhedraAndHexahedraTogether) {
+  // A box grid whose first cell is split into two prisms: polyhedra beside hexahedra, and
+  // face_patch must follow each type's face order.
+  PolyMesh m = box_grid(2, 2, 1, true);
+  for (int f = 0; f < m.n_faces(); ++f)
+    if (m.face_neighbour[f] < 0 && f % 3 == 0) m.face_patch[f] = wellbore_patch(f % 2);
+  // Turn cell 0 into a polyhedron by rotating one face's cycle: still a hexahedron for VTK. So
+  // instead give it a seventh face by cutting a boundary face in two (a hanging-free split).
+  MeshBuilder mb;
+  for (const Vec3& p : m.nodes) mb.add_node(p);
+  for (int c = 0; c < m.n_cells(); ++c) {
+    std::vector<CellFace> faces;
+    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+      const int f = *fp, k = m.face_size(f);
+      CellFace cf;
+      for (int i = 0; i < k; ++i) cf.nodes.push_back(m.face_owner[f] == c ? m.face_begin(f)[i] : m.face_begin(f)[(k - i) % k]);
+      cf.patch = m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f];
+      if (c == 0 && m.face_neighbour[f] < 0 && k == 4 && faces.size() < 7 && cf.patch == kOuterBoundary &&
+          std::none_of(faces.begin(), faces.end(), [](const CellFace& x) { return x.nodes.size() == 3; })) {
+        faces.push_back({{cf.nodes[0], cf.nodes[1], cf.nodes[2]}, wellbore_patch(1)});
+        faces.push_back({{cf.nodes[0], cf.nodes[2], cf.nodes[3]}, kOuterBoundary});
+        continue;
+      }
+      faces.push_back(cf);
+    }
+    CellAttributes at;
+    at.region = m.cell_region[c];
+    at.fv_center = m.cell_fv_center[c];
+    at.radial.well = c;
+    mb.add_cell(faces, at);
+  }
+  BuildReport br;
+  const PolyMesh q = mb.finish(&br);
+  ASSERT_TRUE(br.ok);
+  const fs::path d = temp_dir("mixed");
+  const std::string path = (d / "mesh.vtu").string();
+  ASSERT_TRUE(write_vtu(path, q).ok);
+  const std::string text = hm_slurp(path);
+  EXPECT_NE(text.find("Name=\"faces\""), std::string::npos);
+  const ReadResult r = read_vtu(path);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_TRUE(r.build.ok);
+  expect_same_mesh(r.mesh, q);
   fs::remove_all(d);
 }
 
@@ -310,20 +399,28 @@ TEST(VtuReader, MissingRegionAndCentreGetDefaults) {
   EXPECT_NEAR(r.mesh.cell_fv_center[1].y, 0.5, 1e-14);
 }
 
-TEST(VtuReader, InsideOutPolyhedronIsTurnedOutward) {
-  RawGrid g = two_cubes();
-  // Reverse every face of the polyhedron: all six now point inward.
-  size_t p = 1;
-  for (int k = 0; k < 6; ++k) {
+// fvcheck reports, never repairs: the same file with one face's cycle reversed fails the checks.
+TEST(VtuReader, OneReversedFaceFailsTheChecksTheOriginalPasses) {
+  const RawGrid good = two_cubes();
+  const ReadResult ok = read_vtu_buffer(make_vtu(good, Fmt::Ascii, false, false));
+  ASSERT_TRUE(ok.ok) << ok.error;
+  const FvReport pass = run_fvcheck(ok.mesh, {}, {}, &ok.build);
+  EXPECT_TRUE(pass.ok()) << report_summary_text(pass);
+  // Face k of the polyhedron (cell 1) reversed: k = 0 is the face shared with the hexahedron,
+  // k = 1 a boundary face.
+  for (int k : {0, 1}) {
+    RawGrid g = good;
+    size_t p = 1;
+    for (int i = 0; i < k; ++i) p += 1 + static_cast<size_t>(g.faces[p]);
     const int64_t n = g.faces[p];
-    std::reverse(g.faces.begin() + p + 1, g.faces.begin() + p + 1 + n);
-    p += 1 + n;
+    std::reverse(g.faces.begin() + static_cast<long>(p) + 1, g.faces.begin() + static_cast<long>(p) + 1 + n);
+    const ReadResult r = read_vtu_buffer(make_vtu(g, Fmt::Ascii, false, false));
+    ASSERT_TRUE(r.ok) << r.error;
+    const FvReport fail = run_fvcheck(r.mesh, {}, {}, &r.build);
+    EXPECT_FALSE(fail.ok()) << "face " << k << "\n" << report_summary_text(fail);
+    ASSERT_NE(fail.find("conformity"), nullptr);
+    EXPECT_GT(fail.find("conformity")->violations, 0) << k;
   }
-  const ReadResult r = read_vtu_buffer(make_vtu(g, Fmt::Ascii, false, false));
-  ASSERT_TRUE(r.ok) << r.error;
-  EXPECT_EQ(r.flipped_faces, 4);  // all but the two that were inward before
-  EXPECT_NEAR(compute_geometry(r.mesh).cell_volume[1], 1.0, 1e-14);
-  EXPECT_TRUE(r.build.ok);
 }
 
 TEST(VtuReader, StandardCellTypesHaveExactVolumes) {
@@ -336,7 +433,9 @@ TEST(VtuReader, StandardCellTypesHaveExactVolumes) {
       {10, {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}, 1.0 / 6.0},
       {11, {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1}, 1.0},
       {12, {0, 0, 0, 2, 0, 0, 2, 1, 0, 0, 1, 0, 0, 0, 3, 2, 0, 3, 2, 1, 3, 0, 1, 3}, 6.0},
-      {13, {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 2, 1, 0, 2, 0, 1, 2}, 1.0},
+      // VTK's wedge: (0, 1, 2) has its right-hand normal away from (3, 4, 5) (vtkCellSizeFilter
+      // gives -1 and vtkCellValidator 'faces oriented incorrectly' for the mirrored order).
+      {13, {0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 2, 0, 1, 2, 1, 0, 2}, 1.0},
       {14, {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 1}, 1.0 / 3.0}};
   for (const Case& c : cases) {
     RawGrid g;
@@ -355,18 +454,19 @@ TEST(VtuReader, StandardCellTypesHaveExactVolumes) {
 
 // ------------------------------------------------------------ reader: malformed input
 TEST(VtuReaderMalformed, ClearErrorsForBrokenFiles) {
+  // Every case must fail with a one-line message; the messages of VTK's XML layer are VTK's,
+  // the ones about ids and face streams are ours.
   auto err = [](const std::string& text) {
     const ReadResult r = read_vtu_buffer(text);
     EXPECT_FALSE(r.ok);
+    EXPECT_FALSE(r.error.empty());
+    EXPECT_EQ(r.error.find('\n'), std::string::npos) << r.error;
     return r.error;
   };
   EXPECT_EQ(err(""), "empty file");
-  EXPECT_NE(err("hello").find("not a VTK XML file"), std::string::npos);
-  EXPECT_NE(err("<VTKFile type=\"PolyData\"></VTKFile>").find("not an UnstructuredGrid"), std::string::npos);
-  EXPECT_NE(err("<VTKFile type=\"UnstructuredGrid\" compressor=\"vtkZLibDataCompressor\"><UnstructuredGrid/></VTKFile>")
-                .find("not supported"),
-            std::string::npos);
-  EXPECT_NE(err("<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid>").find("not closed"), std::string::npos);
+  err("hello");
+  err("<VTKFile type=\"PolyData\"></VTKFile>");
+  err("<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid>");
 
   const RawGrid good = two_cubes();
   {  // a point id out of range in the faces stream
@@ -383,43 +483,37 @@ TEST(VtuReaderMalformed, ClearErrorsForBrokenFiles) {
   {  // faceoffsets beyond the faces array
     RawGrid g = good;
     g.faceoffsets[1] = 1000;
-    EXPECT_NE(err(make_vtu(g, Fmt::Ascii, false, false)).find("bad faceoffsets"), std::string::npos);
+    err(make_vtu(g, Fmt::Ascii, false, false));
   }
   {  // a face claiming more nodes than the stream holds
     RawGrid g = good;
     g.faces[1] = 40;
-    EXPECT_NE(err(make_vtu(g, Fmt::Ascii, false, false)).find("bad face size"), std::string::npos);
+    err(make_vtu(g, Fmt::Ascii, false, false));
   }
   {  // decreasing offsets
     RawGrid g = good;
     g.offsets[1] = 3;
-    EXPECT_NE(err(make_vtu(g, Fmt::Ascii, false, false)).find("bad offsets"), std::string::npos);
+    err(make_vtu(g, Fmt::Ascii, false, false));
   }
   {  // wrong counts: NumberOfCells far larger than the arrays (must not allocate for it)
     std::string t = make_vtu(good, Fmt::AppendedRaw, true, false);
     const size_t p = t.find("NumberOfCells=\"2\"");
     ASSERT_NE(p, std::string::npos);
     t.replace(p, 17, "NumberOfCells=\"2000000000\"");
-    EXPECT_NE(err(t).find("expected 2000000000"), std::string::npos);
+    err(t);
   }
   {  // an appended offset past the end
     std::string t = make_vtu(good, Fmt::AppendedRaw, false, false);
     const size_t p = t.find("offset=\"0\"");
     ASSERT_NE(p, std::string::npos);
     t.replace(p, 10, "offset=\"999999\"");
-    EXPECT_NE(err(t).find("beyond the end"), std::string::npos);
+    err(t);
   }
   {  // missing faceoffsets for polyhedra
     std::string t = make_vtu(good, Fmt::Ascii, false, false);
     const size_t p = t.find("Name=\"faceoffsets\"");
     t.replace(p, 18, "Name=\"faceoffsetz\"");
-    EXPECT_NE(err(t).find("faceoffsets"), std::string::npos);
-  }
-  {  // garbage number in ascii
-    std::string t = make_vtu(good, Fmt::Ascii, false, false);
-    const size_t p = t.find("0.5 0.5 0.5");
-    t.replace(p, 3, "0.x");
-    EXPECT_NE(err(t).find("bad ascii number"), std::string::npos);
+    err(t);
   }
   {  // unsupported cell type
     RawGrid g = good;
@@ -475,24 +569,4 @@ TEST(VtuReader, MissingFileAndDirectoryGiveErrors) {
   const ReadResult b = read_vtu(fs::temp_directory_path().string());
   EXPECT_FALSE(b.ok);
   EXPECT_NE(b.error.find("directory"), std::string::npos);
-}
-
-TEST(VtuReader, OrientCellFacesMakesAClosedOutwardSurface) {
-  std::vector<Vec3> pts;
-  for (int c = 0; c < 8; ++c) pts.push_back({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
-  const int32_t n[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-  std::vector<std::vector<int32_t>> faces;
-  for (const CellFace& f : box_faces(n)) faces.push_back(f.nodes);
-  std::reverse(faces[2].begin(), faces[2].end());
-  std::reverse(faces[5].begin(), faces[5].end());
-  bool consistent = false;
-  EXPECT_EQ(orient_cell_faces(faces, pts, &consistent), 2);
-  EXPECT_TRUE(consistent);
-  std::vector<std::vector<int32_t>> ref;
-  for (const CellFace& f : box_faces(n)) ref.push_back(f.nodes);
-  for (int k = 0; k < 6; ++k) {
-    bool r1 = false, r2 = false;
-    EXPECT_EQ(canonical_cycle(faces[k], &r1), canonical_cycle(ref[k], &r2));
-    EXPECT_EQ(r1, r2) << k;  // same orientation as the outward reference
-  }
 }

@@ -1,0 +1,128 @@
+#include "vtu_mesh_arrays.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+namespace hm {
+
+namespace {
+
+// One per-cell field of PolyMesh: its array name, components, and how to get / set component d.
+struct Field {
+  const char* name;
+  int components;
+  bool integer;
+  std::function<double(const PolyMesh&, size_t c, int d)> get;
+  std::function<void(PolyMesh&, size_t c, int d, double v)> set;
+};
+
+double at(const Vec3& v, int d) { return d == 0 ? v.x : d == 1 ? v.y : v.z; }
+void put(Vec3& v, int d, double x) { (d == 0 ? v.x : d == 1 ? v.y : v.z) = x; }
+
+#define HM_RADIAL_INT(NAME, MEMBER)                                                                          \
+  Field{NAME, 1, true, [](const PolyMesh& m, size_t c, int) { return double(m.cell_radial[c].MEMBER); }, \
+        [](PolyMesh& m, size_t c, int, double v) { m.cell_radial[c].MEMBER = static_cast<int32_t>(v); }}
+#define HM_RADIAL_REAL(NAME, MEMBER)                                                               \
+  Field{NAME, 1, false, [](const PolyMesh& m, size_t c, int) { return m.cell_radial[c].MEMBER; }, \
+        [](PolyMesh& m, size_t c, int, double v) { m.cell_radial[c].MEMBER = v; }}
+
+const std::vector<Field>& fields() {
+  static const std::vector<Field> f = {
+      {"region", 1, true, [](const PolyMesh& m, size_t c, int) { return double(m.cell_region[c]); },
+       [](PolyMesh& m, size_t c, int, double v) { m.cell_region[c] = static_cast<int32_t>(v); }},
+      {"fv_center", 3, false, [](const PolyMesh& m, size_t c, int d) { return at(m.cell_fv_center[c], d); },
+       [](PolyMesh& m, size_t c, int d, double v) { put(m.cell_fv_center[c], d, v); }},
+      {"ijk", 3, true, [](const PolyMesh& m, size_t c, int d) { return double(m.cell_ijk[c][d]); },
+       [](PolyMesh& m, size_t c, int d, double v) { m.cell_ijk[c][d] = static_cast<int32_t>(v); }},
+      {"permeability", 3, false, [](const PolyMesh& m, size_t c, int d) { return at(m.cell_perm[c], d); },
+       [](PolyMesh& m, size_t c, int d, double v) { put(m.cell_perm[c], d, v); }},
+      {"porosity", 1, false, [](const PolyMesh& m, size_t c, int) { return m.cell_porosity[c]; },
+       [](PolyMesh& m, size_t c, int, double v) { m.cell_porosity[c] = v; }},
+      HM_RADIAL_INT("radial_well", well),
+      HM_RADIAL_INT("radial_ring", ring),
+      HM_RADIAL_INT("radial_sector", sector),
+      HM_RADIAL_INT("radial_segment", segment),
+      HM_RADIAL_INT("radial_band", band),
+      HM_RADIAL_REAL("radial_r_in", r_in),
+      HM_RADIAL_REAL("radial_r_out", r_out),
+      HM_RADIAL_REAL("radial_r_center", r_center),
+      HM_RADIAL_REAL("radial_angle", angle),
+      HM_RADIAL_REAL("radial_length", length),
+      {"radial_cap_center", 3, false,
+       [](const PolyMesh& m, size_t c, int d) { return at(m.cell_radial[c].cap_center, d); },
+       [](PolyMesh& m, size_t c, int d, double v) { put(m.cell_radial[c].cap_center, d, v); }},
+  };
+  return f;
+}
+
+#undef HM_RADIAL_INT
+#undef HM_RADIAL_REAL
+
+}  // namespace
+
+std::vector<VtuCellArray> mesh_cell_arrays(const PolyMesh& m) {
+  const size_t nc = static_cast<size_t>(m.n_cells());
+  std::vector<VtuCellArray> out;
+  for (const Field& f : fields()) {
+    VtuCellArray a;
+    a.name = f.name;
+    a.components = f.components;
+    a.integer = f.integer;
+    for (size_t c = 0; c < nc; ++c)
+      for (int d = 0; d < f.components; ++d) {
+        const double v = f.get(m, c, d);
+        if (f.integer) a.ints.push_back(static_cast<int32_t>(v));
+        else a.values.push_back(v);
+      }
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+bool is_mesh_array_name(const std::string& name) {
+  for (const Field& f : fields())
+    if (name == f.name) return true;
+  return false;
+}
+
+bool RestoredArrays::has(const std::string& name) const {
+  return is_mesh_array_name(name) && std::find(missing.begin(), missing.end(), name) == missing.end();
+}
+
+RestoredArrays restore_mesh_cell_arrays(const std::vector<VtuCellArray>& arrays, PolyMesh& m) {
+  RestoredArrays r;
+  const size_t nc = static_cast<size_t>(m.n_cells());
+  for (const Field& f : fields()) {
+    const auto it = std::find_if(arrays.begin(), arrays.end(), [&](const VtuCellArray& a) { return a.name == f.name; });
+    if (it == arrays.end()) {
+      r.missing.push_back(f.name);
+      continue;
+    }
+    const VtuCellArray& a = *it;
+    // 1-component permeability (isotropic) is accepted for files written by other tools.
+    const bool isotropic = std::string(f.name) == "permeability" && a.components == 1;
+    if (a.components != f.components && !isotropic) {
+      r.error = a.name + ": " + std::to_string(a.components) + " components, expected " + std::to_string(f.components);
+      return r;
+    }
+    if (a.values.size() != nc * static_cast<size_t>(a.components)) {
+      r.error = a.name + ": " + std::to_string(a.values.size()) + " values for " + std::to_string(nc) + " cells";
+      return r;
+    }
+    for (size_t c = 0; c < nc; ++c)
+      for (int d = 0; d < f.components; ++d) {
+        const double v = a.values[c * a.components + (isotropic ? 0 : d)];
+        const bool ok = std::isfinite(v) && (!f.integer || (v == std::floor(v) && std::fabs(v) < 2147483647.0));
+        if (!ok) {
+          r.error = a.name + ": cell " + std::to_string(c) + ": " +
+                    (f.integer ? "not a 32-bit integer" : "not a finite number");
+          return r;
+        }
+        f.set(m, c, d, v);
+      }
+  }
+  return r;
+}
+
+}  // namespace hm
