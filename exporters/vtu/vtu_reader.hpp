@@ -1,7 +1,9 @@
 // VTK XML UnstructuredGrid (.vtu) reader -> PolyMesh, rebuilt with the MeshBuilder.
-// The file is parsed by VTK's own vtkXMLUnstructuredGridReader, so every variant VTK writes is
-// read: ascii, binary (inline base64), appended (raw or base64), UInt32 or UInt64 headers,
-// 32- or 64-bit ids, either byte order, compressors none / zlib / LZ4 / LZMA, several pieces.
+// The XML and the data arrays are decoded by VTK's own vtkXMLDataParser, so every variant VTK
+// writes is read: ascii, binary (inline base64), appended (raw or base64), UInt32 or UInt64
+// headers, 32- or 64-bit ids, either byte order, compressors none / zlib / LZ4 / LZMA, several
+// pieces. The cells are assembled here (VTK's vtkXMLUnstructuredGridReader crashes on a
+// malformed polyhedron face stream).
 // Accepts polyhedra (42) and tetra (10), voxel (11), hexahedron (12), wedge (13), pyramid (14).
 // The reader reports what is in the file and repairs nothing: faces are taken with the
 // orientation the file gives them (a reversed face is the checker's finding, not fixed here).
