@@ -1,5 +1,5 @@
-// solver_demo CASE.yaml -o OUTDIR
-//   Builds the hybrid mesh, solves the steady single-phase problem the exported deck poses (wells
+// solver_demo CASE.yaml -o OUTDIR [--mesh MESH.vtu]
+//   Builds the hybrid mesh (or reads it from MESH.vtu, as meshgen wrote it: no re-meshing), solves the steady single-phase problem the exported deck poses (wells
 //   at their BHP, no-flow outer boundary, gravity) and writes solution.json and pressure.vtu.
 // solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N]
 //   The near-well accuracy study (docs/accuracy.md): accuracy.json and accuracy.svg.
@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "exporters/vtu/vtu_reader.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/core/cli.hpp"
@@ -25,7 +26,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: solver_demo CASE.yaml -o OUTDIR\n"
+    "usage: solver_demo CASE.yaml -o OUTDIR [--mesh MESH.vtu]\n"
+    "         (--mesh: solve on the mesh file meshgen wrote for CASE.yaml instead of meshing again)\n"
     "       solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N] [--source-to-tips]\n"
     "         (N refinement levels, default 3; --source-to-tips: the line source runs to the well's end\n"
     "          points, singular on the end caps, instead of stopping r_w short of them)\n";
@@ -50,11 +52,42 @@ int guarded(Work work) {
   return 0;
 }
 
-int run_flow(const hm::CaseSpec& cs, const fs::path& out) {
+// The mesh of a case read from a file meshgen wrote: the file must carry the finite-volume data
+// (radial structure, wellbore patches) and its wells must be the case's.
+std::string load_mesh_file(const hm::CaseSpec& cs, const std::string& path, hm::PolyMesh* mesh) {
+  hm::ReadResult r = hm::read_vtu(path);
+  if (!r.ok) return r.error;
+  if (!r.build.ok) return path + ": the cells do not form a conforming mesh";
+  if (!r.missing_mesh_arrays.empty())
+    return path + ": no '" + r.missing_mesh_arrays.front() + "' cell array (not a mesh file meshgen wrote)";
+  if (!r.has_face_patch) return path + ": no face_patch field data (the wellbores are unknown)";
+  std::vector<int> faces_of_well(cs.wells.size(), 0);
+  for (int f = 0; f < r.mesh.n_faces(); ++f)
+    if (r.mesh.face_neighbour[f] < 0 && hm::is_wellbore_patch(r.mesh.face_patch[f])) {
+      const int w = hm::well_of_patch(r.mesh.face_patch[f]);
+      if (w >= static_cast<int>(cs.wells.size()))
+        return path + ": wellbore faces of well " + std::to_string(w) + ", the case has " +
+               std::to_string(cs.wells.size()) + " wells";
+      ++faces_of_well[w];
+    }
+  for (size_t w = 0; w < cs.wells.size(); ++w)
+    if (faces_of_well[w] == 0) return path + ": no wellbore face of well '" + cs.wells[w].name + "'";
+  *mesh = std::move(r.mesh);
+  return {};
+}
+
+int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mesh_file) {
   hm::HybridMesh mesh;
   hm::FlowSolution sol;
+  if (!mesh_file.empty()) {
+    if (const std::string why = load_mesh_file(cs, mesh_file, &mesh.mesh); !why.empty()) {
+      std::cerr << "solver_demo: " << why << "\n";
+      return 2;
+    }
+    mesh.geometry = hm::compute_geometry(mesh.mesh);
+  }
   if (const int rc = guarded([&] {
-        mesh = hm::build_hybrid_mesh(cs);
+        if (mesh_file.empty()) mesh = hm::build_hybrid_mesh(cs);
         hm::FlowProblem pb;
         pb.mesh = &mesh.mesh;
         pb.geo = &mesh.geometry;
@@ -145,7 +178,7 @@ int run_accuracy(const hm::CaseSpec& cs, const fs::path& out, int levels, const 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string case_path, out_dir;
+  std::string case_path, out_dir, mesh_file;
   bool accuracy = false;
   int levels = 3;
   hm::AccuracyOptions acc_opt;
@@ -154,6 +187,9 @@ int main(int argc, char** argv) {
     if (a == "-o" || a == "--output") {
       if (++i >= argc) return usage("-o needs a directory");
       out_dir = argv[i];
+    } else if (a == "--mesh") {
+      if (++i >= argc) return usage("--mesh needs a .vtu file");
+      mesh_file = argv[i];
     } else if (a == "--accuracy") {
       accuracy = true;
     } else if (a == "--source-to-tips") {
@@ -188,5 +224,6 @@ int main(int argc, char** argv) {
     std::cerr << "solver_demo: " << why << "\n";
     return 2;
   }
-  return accuracy ? run_accuracy(cs, out_dir, levels, acc_opt) : run_flow(cs, out_dir);
+  if (accuracy && !mesh_file.empty()) return usage("--mesh and --accuracy exclude each other (the study meshes each level)");
+  return accuracy ? run_accuracy(cs, out_dir, levels, acc_opt) : run_flow(cs, out_dir, mesh_file);
 }
