@@ -175,3 +175,27 @@ TEST(FvcheckCli, UnreadableInputAndBadArgumentsExitTwoWithOneLine) {
   }
   EXPECT_FALSE(fs::exists(d / "no_such_dir"));
 }
+
+// fvcheck reports what the file holds: VTK's own file of a hexahedron and a polyhedron passes;
+// the same file with the cycle of the polyhedron's first face reversed fails conformity (exit
+// 1), with no re-orientation note.
+TEST(FvcheckCli, OneReversedFaceFailsTheSameFileUnreversedPasses) {
+  const fs::path d = hm_test::fresh_dir("fvcheck_reversed");
+  const std::string good = hm_test::slurp(std::string(HM_SOURCE_DIR) + "/tests/fuzz/corpus_vtu/ascii.vtu");
+  const std::string stream = "6 4 7 10 4 1";
+  const size_t p = good.find(stream);
+  ASSERT_NE(p, std::string::npos);
+  std::string bad = good;
+  bad.replace(p, stream.size(), "6 4 1 4 10 7");
+  const std::string fvcheck = std::string(HM_BIN_DIR) + "/fvcheck ";
+  const auto ok = hm_test::run_command(fvcheck + hm_test::q(write(d, "good.vtu", good)));
+  EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
+  EXPECT_NE(ok.out.find("result: OK"), std::string::npos);
+  const auto r = hm_test::run_command(fvcheck + hm_test::q(write(d, "bad.vtu", bad)) + " --html " +
+                                      hm_test::q(d / "bad.html"));
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("conformity      FAILED"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("result: FAILED"), std::string::npos);
+  EXPECT_EQ(r.out.find("re-oriented"), std::string::npos) << r.out;
+  EXPECT_NE(hm_test::slurp(d / "bad.html").find("CHECKS FAILED"), std::string::npos);
+}
