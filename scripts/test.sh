@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README command 2: install what is missing, build, run all tests (ctest), then the tests of our
-# own code again in an AddressSanitizer + UndefinedBehaviorSanitizer build.
+# own code again in an AddressSanitizer + UndefinedBehaviorSanitizer build, then a short libFuzzer
+# run of the VTU reader (clang, ASan+UBSan; HM_FUZZ_SECONDS, default 25).
 # HM_SKIP_SANITIZE=1 skips the sanitizer build (local iteration only; CI runs it).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -22,4 +23,16 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   (cd build-asan && ctest --output-on-failure -j"$jobs" -E '^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation)')
+fi
+
+if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
+  echo "== libFuzzer: fuzz_vtu (clang, ASan+UBSan) for ${HM_FUZZ_SECONDS:-25} s"
+  cmake -S "$root" -B "$root/build-fuzz" -DHM_FUZZ=ON -DHM_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE=TRUE >/dev/null
+  cmake --build "$root/build-fuzz" -j"$jobs" --target fuzz_vtu
+  corpus=$(mktemp -d)
+  cp "$root"/tests/fuzz/corpus_vtu/* "$corpus"/
+  ASAN_OPTIONS=detect_leaks=1 "$root/build-fuzz/bin/fuzz_vtu" -max_total_time="${HM_FUZZ_SECONDS:-25}" \
+    -max_len=65536 -rss_limit_mb=2048 "$corpus"
+  rm -rf "$corpus"
 fi

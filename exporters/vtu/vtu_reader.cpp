@@ -1,5 +1,6 @@
 #include "vtu_reader.hpp"
 
+#include <vtkBase64Utilities.h>
 #include <vtkCommand.h>
 #include <vtkLZ4DataCompressor.h>
 #include <vtkLZMADataCompressor.h>
@@ -14,6 +15,7 @@
 #include <vtkZLibDataCompressor.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -115,12 +117,99 @@ struct Source {
   vtkXMLDataParser* parser = nullptr;
   std::istream* stream = nullptr;  // the parser's; a read that hits its end means truncated data
   uint64_t max_words = 0;  // no array can hold more values than this (from the file size)
+  uint64_t file_bytes = 0;
+  bool compressed = false;
+  int header_bytes = 8;        // header_type UInt64 (8) or UInt32 (4)
+  bool swap = false;           // the file's byte order is not the host's
+  bool appended_base64 = false;
 };
 
 std::string attr(vtkXMLDataElement* e, const char* name) {
   const char* v = e->GetAttribute(name);
   return v ? v : "";
 }
+
+// vtkXMLDataParser sizes its block tables and its decompression buffer from a compressed
+// array's header (number of blocks, uncompressed block size, last block size, compressed sizes)
+// before reading anything else: a forged header would allocate without limit inside VTK. So the header is read
+// here (raw or base64, as the array is stored) and bounded before VTK sees them.
+std::vector<uint64_t> header_words(const Source& src, std::streamoff pos, bool base64, size_t count) {
+  std::istream& in = *src.stream;
+  in.clear();
+  in.seekg(pos);
+  const size_t hb = static_cast<size_t>(src.header_bytes), bytes = count * hb;
+  std::vector<unsigned char> raw(bytes + 3, 0);
+  if (base64) {
+    const size_t chars = (bytes + 2) / 3 * 4;
+    std::vector<unsigned char> text;
+    text.reserve(chars);
+    while (text.size() < chars) {
+      const int ch = in.get();
+      if (ch == EOF) break;
+      if (ch == ' ' || ch == '\n' || ch == '\r' || ch == '\t') continue;
+      text.push_back(static_cast<unsigned char>(ch));
+    }
+    if (text.size() < chars || vtkBase64Utilities::DecodeSafely(text.data(), chars, raw.data(), raw.size()) < bytes)
+      fail("compressed array header ends early");
+  } else {
+    in.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(bytes));
+    if (in.gcount() != static_cast<std::streamsize>(bytes)) fail("compressed array header ends early");
+  }
+  in.clear();
+  std::vector<uint64_t> w(count);
+  for (size_t k = 0; k < count; ++k) {
+    unsigned char* p = raw.data() + k * hb;
+    if (src.swap) std::reverse(p, p + hb);
+    if (hb == 4) {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      w[k] = v;
+    } else {
+      std::memcpy(&w[k], p, 8);
+    }
+  }
+  return w;
+}
+
+// Largest uncompressed block accepted (VTK writes 32 KiB blocks; ParaView too).
+constexpr uint64_t kMaxCompressedBlockBytes = uint64_t(256) << 20;
+
+void check_compressed_header(const Source& src, vtkXMLDataElement* e, const std::string& format, int64_t offset) {
+  std::streamoff pos = 0;
+  bool base64 = true;
+  if (format == "appended") {
+    pos = static_cast<std::streamoff>(src.parser->GetAppendedDataPosition()) + static_cast<std::streamoff>(offset);
+    base64 = src.appended_base64;
+  } else {
+    // Inline binary: the base64 text after the element's start tag.
+    std::istream& in = *src.stream;
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(e->GetXMLByteIndex()));
+    int ch = 0;
+    while ((ch = in.get()) != EOF && ch != '>') {
+    }
+    if (ch == EOF) fail("array " + attr(e, "Name") + ": no data");
+    pos = in.tellg();
+  }
+  const std::vector<uint64_t> w = header_words(src, pos, base64, 3);
+  if (w[0] > src.file_bytes / static_cast<uint64_t>(src.header_bytes))
+    fail("array " + attr(e, "Name") + ": " + std::to_string(w[0]) + " compressed blocks cannot be in a file of this size");
+  if (w[1] > kMaxCompressedBlockBytes)
+    fail("array " + attr(e, "Name") + ": compressed block size " + std::to_string(w[1]) + " bytes is too large");
+  // VTK divides by the block size and trusts the last block's size (VTK 9.1 crashes otherwise).
+  if (w[0] > 0 && (w[1] == 0 || w[2] > w[1]))
+    fail("array " + attr(e, "Name") + ": inconsistent compressed block sizes " + std::to_string(w[1]) + " / " +
+         std::to_string(w[2]));
+  // VTK allocates each block's compressed size as stated: they must fit in the file.
+  const std::vector<uint64_t> all = header_words(src, pos, base64, 3 + static_cast<size_t>(w[0]));
+  uint64_t total = 0;
+  for (size_t k = 3; k < all.size(); ++k) {
+    if (all[k] > src.file_bytes) fail("array " + attr(e, "Name") + ": a compressed block is larger than the file");
+    total += all[k];
+  }
+  if (total > src.file_bytes) fail("array " + attr(e, "Name") + ": the compressed blocks are larger than the file");
+}
+
 
 int64_t count_attr(vtkXMLDataElement* e, const char* name, int64_t max_value) {
   const std::string v = attr(e, name);
@@ -178,8 +267,10 @@ Array read_array(const Source& src, vtkXMLDataElement* e, int64_t values) {
   size_t got = 0;
   if (format == "appended") {
     const int64_t offset = count_attr(e, "offset", std::numeric_limits<int64_t>::max() / 2);
+    if (src.compressed) check_compressed_header(src, e, format, offset);
     got = src.parser->ReadAppendedData(offset, buf.data(), 0, static_cast<size_t>(values), type);
   } else if (format == "ascii" || format == "binary") {
+    if (src.compressed && format == "binary") check_compressed_header(src, e, format, 0);
     got = src.parser->ReadInlineData(e, format == "ascii", buf.data(), 0, static_cast<size_t>(values), type);
   } else {
     fail(what + "unknown format '" + format + "'");
@@ -344,7 +435,7 @@ void read_piece(const Source& src, vtkXMLDataElement* piece, Parsed& out) {
   out.cell_data = std::move(merged);
 }
 
-Parsed parse_document(const Source& src) {
+Parsed parse_document(Source& src) {
   vtkXMLDataElement* root = src.parser->GetRootElement();
   if (!root || !root->GetName() || std::strcmp(root->GetName(), "VTKFile") != 0)
     fail("not a VTK XML file (no <VTKFile> root)");
@@ -355,6 +446,13 @@ Parsed parse_document(const Source& src) {
   else if (comp == "vtkLZ4DataCompressor") src.parser->SetCompressor(vtkSmartPointer<vtkLZ4DataCompressor>::New());
   else if (comp == "vtkLZMADataCompressor") src.parser->SetCompressor(vtkSmartPointer<vtkLZMADataCompressor>::New());
   else if (!comp.empty()) fail("unknown compressor '" + comp + "'");
+  src.compressed = !comp.empty();
+  src.header_bytes = attr(root, "header_type") == "UInt64" ? 8 : 4;
+  const uint16_t one = 1;
+  unsigned char first;
+  std::memcpy(&first, &one, 1);
+  src.swap = (attr(root, "byte_order") == "BigEndian") == (first == 1);
+  if (vtkXMLDataElement* ad = child(root, "AppendedData")) src.appended_base64 = attr(ad, "encoding") == "base64";
   vtkXMLDataElement* grid = child(root, "UnstructuredGrid");
   if (!grid) fail("no <UnstructuredGrid> element");
   Parsed out;
@@ -456,6 +554,7 @@ ReadResult read_stream(std::istream& in, uint64_t file_bytes) {
     // every array by what a file of this size could possibly hold, so that a forged count
     // cannot allocate without limit.
     src.max_words = std::min<uint64_t>(4096 * (file_bytes + 64), uint64_t(1) << 34);
+    src.file_bytes = file_bytes;
     Parsed doc = parse_document(src);
     if (!catcher->errors.empty()) fail(catcher->errors.front());
     r = convert(std::move(doc));
