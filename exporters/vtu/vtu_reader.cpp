@@ -2,6 +2,7 @@
 
 #include <vtkBase64Utilities.h>
 #include <vtkCommand.h>
+#include <vtkDataCompressor.h>
 #include <vtkLZ4DataCompressor.h>
 #include <vtkLZMADataCompressor.h>
 #include <vtkLogger.h>
@@ -133,83 +134,120 @@ std::string attr(vtkXMLDataElement* e, const char* name) {
 // array's header (number of blocks, uncompressed block size, last block size, compressed sizes)
 // before reading anything else: a forged header would allocate without limit inside VTK. So the header is read
 // here (raw or base64, as the array is stored) and bounded before VTK sees them.
-std::vector<uint64_t> header_words(const Source& src, std::streamoff pos, bool base64, size_t count) {
+// `n` bytes stored at `pos` (raw) or base64-encoded from `pos` after `skip_chars` characters of
+// an earlier base64 unit (whitespace ignored). Fails when the file ends first.
+std::vector<unsigned char> read_bytes(const Source& src, std::streamoff pos, bool base64, size_t skip, size_t n) {
   std::istream& in = *src.stream;
   in.clear();
-  in.seekg(pos);
-  const size_t hb = static_cast<size_t>(src.header_bytes), bytes = count * hb;
-  std::vector<unsigned char> raw(bytes + 3, 0);
-  if (base64) {
-    const size_t chars = (bytes + 2) / 3 * 4;
+  std::vector<unsigned char> out(n + 3, 0);
+  if (!base64) {
+    in.seekg(pos + static_cast<std::streamoff>(skip));
+    in.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(n));
+    if (in.gcount() != static_cast<std::streamsize>(n)) fail("the file ends inside the data (truncated?)");
+  } else {
+    in.seekg(pos);
+    const size_t chars = (n + 2) / 3 * 4;
     std::vector<unsigned char> text;
     text.reserve(chars);
+    size_t skipped = 0;
     while (text.size() < chars) {
       const int ch = in.get();
       if (ch == EOF) break;
       if (ch == ' ' || ch == '\n' || ch == '\r' || ch == '\t') continue;
+      if (skipped < skip) {
+        ++skipped;
+        continue;
+      }
       text.push_back(static_cast<unsigned char>(ch));
     }
-    if (text.size() < chars || vtkBase64Utilities::DecodeSafely(text.data(), chars, raw.data(), raw.size()) < bytes)
-      fail("compressed array header ends early");
-  } else {
-    in.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(bytes));
-    if (in.gcount() != static_cast<std::streamsize>(bytes)) fail("compressed array header ends early");
+    if (text.size() < chars || vtkBase64Utilities::DecodeSafely(text.data(), chars, out.data(), out.size()) < n)
+      fail("the file ends inside the data (truncated or bad base64)");
   }
   in.clear();
-  std::vector<uint64_t> w(count);
-  for (size_t k = 0; k < count; ++k) {
-    unsigned char* p = raw.data() + k * hb;
-    if (src.swap) std::reverse(p, p + hb);
-    if (hb == 4) {
-      uint32_t v;
-      std::memcpy(&v, p, 4);
-      w[k] = v;
-    } else {
-      std::memcpy(&w[k], p, 8);
-    }
+  out.resize(n);
+  return out;
+}
+
+uint64_t header_word(const Source& src, unsigned char* p) {
+  if (src.swap) std::reverse(p, p + src.header_bytes);
+  if (src.header_bytes == 4) {
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v;
   }
-  return w;
+  uint64_t v;
+  std::memcpy(&v, p, 8);
+  return v;
 }
 
 // Largest uncompressed block accepted (VTK writes 32 KiB blocks; ParaView too).
-constexpr uint64_t kMaxCompressedBlockBytes = uint64_t(256) << 20;
+constexpr uint64_t kMaxCompressedBlockBytes = uint64_t(64) << 20;
 
-void check_compressed_header(const Source& src, vtkXMLDataElement* e, const std::string& format, int64_t offset) {
+// A compressed array, decompressed here with VTK's compressor classes (zlib, LZ4, LZMA) rather
+// than by vtkXMLDataParser, which crashes on forged or corrupt compressed data (VTK 9.1: a
+// 2^62-byte block table, a division by a zero block size, a null block after a failed
+// decompression). Layout (VTK): header words [blocks, block size, last block size, compressed
+// size of each block], then the compressed blocks; in base64 form the header and the blocks
+// are two separately encoded units. Returns the first `needed` bytes, in host byte order for
+// words of `word` bytes.
+std::vector<unsigned char> read_compressed(const Source& src, vtkXMLDataElement* e, const std::string& format,
+                                           int64_t offset, size_t needed, size_t word) {
+  const std::string what = "array " + attr(e, "Name") + ": ";
   std::streamoff pos = 0;
   bool base64 = true;
   if (format == "appended") {
     pos = static_cast<std::streamoff>(src.parser->GetAppendedDataPosition()) + static_cast<std::streamoff>(offset);
     base64 = src.appended_base64;
   } else {
-    // Inline binary: the base64 text after the element's start tag.
-    std::istream& in = *src.stream;
+    std::istream& in = *src.stream;  // inline binary: the base64 text after the start tag
     in.clear();
     in.seekg(static_cast<std::streamoff>(e->GetXMLByteIndex()));
     int ch = 0;
     while ((ch = in.get()) != EOF && ch != '>') {
     }
-    if (ch == EOF) fail("array " + attr(e, "Name") + ": no data");
+    if (ch == EOF) fail(what + "no data");
     pos = in.tellg();
   }
-  const std::vector<uint64_t> w = header_words(src, pos, base64, 3);
-  if (w[0] > src.file_bytes / static_cast<uint64_t>(src.header_bytes))
-    fail("array " + attr(e, "Name") + ": " + std::to_string(w[0]) + " compressed blocks cannot be in a file of this size");
-  if (w[1] > kMaxCompressedBlockBytes)
-    fail("array " + attr(e, "Name") + ": compressed block size " + std::to_string(w[1]) + " bytes is too large");
-  // VTK divides by the block size and trusts the last block's size (VTK 9.1 crashes otherwise).
-  if (w[0] > 0 && (w[1] == 0 || w[2] > w[1]))
-    fail("array " + attr(e, "Name") + ": inconsistent compressed block sizes " + std::to_string(w[1]) + " / " +
-         std::to_string(w[2]));
-  // VTK allocates each block's compressed size as stated: they must fit in the file.
-  const std::vector<uint64_t> all = header_words(src, pos, base64, 3 + static_cast<size_t>(w[0]));
+  const size_t hb = static_cast<size_t>(src.header_bytes);
+  std::vector<unsigned char> h = read_bytes(src, pos, base64, 0, 3 * hb);
+  const uint64_t blocks = header_word(src, &h[0]), block = header_word(src, &h[hb]), last = header_word(src, &h[2 * hb]);
+  if (blocks > src.file_bytes / hb) fail(what + std::to_string(blocks) + " compressed blocks cannot be in a file of this size");
+  if (blocks > 0 && (block == 0 || block > kMaxCompressedBlockBytes || last > block))
+    fail(what + "bad compressed block sizes " + std::to_string(block) + " / " + std::to_string(last));
+  const size_t header_size = (3 + static_cast<size_t>(blocks)) * hb;
+  h = read_bytes(src, pos, base64, 0, header_size);
+  std::vector<uint64_t> csize(blocks);
   uint64_t total = 0;
-  for (size_t k = 3; k < all.size(); ++k) {
-    if (all[k] > src.file_bytes) fail("array " + attr(e, "Name") + ": a compressed block is larger than the file");
-    total += all[k];
+  for (size_t k = 0; k < blocks; ++k) {
+    csize[k] = header_word(src, &h[(3 + k) * hb]);
+    if (csize[k] > src.file_bytes) fail(what + "a compressed block is larger than the file");
+    total += csize[k];
   }
-  if (total > src.file_bytes) fail("array " + attr(e, "Name") + ": the compressed blocks are larger than the file");
+  if (total > src.file_bytes) fail(what + "the compressed blocks are larger than the file");
+  auto usize = [&](size_t k) { return k + 1 == blocks && last > 0 ? last : block; };
+  const uint64_t available = blocks == 0 ? 0 : (blocks - 1) * block + usize(blocks - 1);
+  if (available < needed) fail(what + "the compressed data holds fewer values than expected");
+  const std::vector<unsigned char> packed =
+      read_bytes(src, pos, base64, base64 ? (header_size + 2) / 3 * 4 : header_size, static_cast<size_t>(total));
+  vtkDataCompressor* z = src.parser->GetCompressor();
+  if (!z) fail(what + "no decompressor");
+  std::vector<unsigned char> out(needed);
+  size_t done = 0, at = 0;
+  std::vector<unsigned char> tmp;
+  for (size_t k = 0; k < blocks && done < needed; ++k) {
+    const size_t u = static_cast<size_t>(usize(k));
+    tmp.assign(u, 0);
+    if (z->Uncompress(packed.data() + at, static_cast<size_t>(csize[k]), tmp.data(), u) != u)
+      fail(what + "corrupt compressed block " + std::to_string(k));
+    const size_t take = std::min(u, needed - done);
+    std::memcpy(out.data() + done, tmp.data(), take);
+    done += take;
+    at += static_cast<size_t>(csize[k]);
+  }
+  if (src.swap && word > 1)
+    for (size_t k = 0; k + word <= out.size(); k += word) std::reverse(out.begin() + k, out.begin() + k + word);
+  return out;
 }
-
 
 int64_t count_attr(vtkXMLDataElement* e, const char* name, int64_t max_value) {
   const std::string v = attr(e, name);
@@ -265,12 +303,15 @@ Array read_array(const Source& src, vtkXMLDataElement* e, int64_t values) {
   std::vector<unsigned char> buf(static_cast<size_t>(values) * word);
   const std::string format = attr(e, "format");
   size_t got = 0;
-  if (format == "appended") {
+  if (src.compressed && (format == "appended" || format == "binary")) {
+    const int64_t offset =
+        format == "appended" ? count_attr(e, "offset", std::numeric_limits<int64_t>::max() / 2) : 0;
+    buf = read_compressed(src, e, format, offset, buf.size(), word);
+    got = static_cast<size_t>(values);
+  } else if (format == "appended") {
     const int64_t offset = count_attr(e, "offset", std::numeric_limits<int64_t>::max() / 2);
-    if (src.compressed) check_compressed_header(src, e, format, offset);
     got = src.parser->ReadAppendedData(offset, buf.data(), 0, static_cast<size_t>(values), type);
   } else if (format == "ascii" || format == "binary") {
-    if (src.compressed && format == "binary") check_compressed_header(src, e, format, 0);
     got = src.parser->ReadInlineData(e, format == "ascii", buf.data(), 0, static_cast<size_t>(values), type);
   } else {
     fail(what + "unknown format '" + format + "'");
