@@ -98,32 +98,9 @@ std::string upper(std::string s) {
 
 std::string eclipse_deck_name(const CaseSpec& cs) { return upper(cs.name); }
 
-double slowest_diffusion_days(const CaseSpec& cs, const PolyMesh& mesh, double cw_per_bar) {
-  constexpr double kM2PerMilliDarcy = 9.869233e-16, kPaSPerCp = 1e-3, kPaPerBar = 1e5, kSecondsPerDay = 86400;
-  const ReservoirSpec& r = cs.reservoir;
-  const double extent[3] = {r.x.back() - r.x.front(), r.y.back() - r.y.front(), r.z.back() - r.z.front()};
-  double kmin[3] = {r.permeability.x, r.permeability.y, r.permeability.z}, phi = r.porosity;
-  for (int c = 0; c < mesh.n_cells(); ++c) {
-    kmin[0] = std::min(kmin[0], mesh.cell_perm[c].x);
-    kmin[1] = std::min(kmin[1], mesh.cell_perm[c].y);
-    kmin[2] = std::min(kmin[2], mesh.cell_perm[c].z);
-    phi = std::max(phi, mesh.cell_porosity[c]);
-  }
-  double tau = 0;
-  for (int a = 0; a < 3; ++a)
-    if (kmin[a] > 0)
-      tau = std::max(tau, phi * cs.fluid.viscosity * kPaSPerCp * cw_per_bar / kPaPerBar * extent[a] * extent[a] /
-                              (kmin[a] * kM2PerMilliDarcy));
-  return tau / kSecondsPerDay;
-}
-
-double steady_state_days(double tau_days, double max_total_days) {
-  // flow's default adaptive stepping starts at 1 day and grows the step about threefold while
-  // Newton converges quickly, up to 365 days: ~364 days in its first six steps. Two more steps
-  // of 365 days each take one more Newton update from an already steady state, which brings
-  // flow's default tolerances (CNV 1e-2, MB 1e-6) down to our solve's accuracy; 40 tau leaves
-  // e^-40 of the slowest transient.
-  return std::min(max_total_days, std::max(364.0 + 2 * 365.0, 40 * tau_days));
+std::vector<std::string> flow_steady_state_options() {
+  return {"--enable-adaptive-time-stepping=false", "--time-step-control=newtoniterationcount",
+          "--max-residual-allowed=1e30", "--linear-solver-reduction=1e-6", "--tolerance-mb=1e-9"};
 }
 
 WriteStatus write_reservoir_grdecl(const std::string& path, const ReservoirSpec& reservoir, const PolyMesh& mesh) {
@@ -303,10 +280,10 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     if (fl.compressibility < 1e-8)
       warnings.push_back("fluid compressibility raised to 1e-8 /bar in PVTW (flow needs Cw > 0)");
     TextOut o;
-    const double tau = slowest_diffusion_days(cs, mesh, cw);
-    const double run_days = steady_state_days(tau, options.tstep_days);
     o << "-- " << name << ": single-phase steady-state deck written by HybridMesh (docs/export-eclipse.md).\n"
-      << "-- Run: flow " << name << ".DATA (no options needed)\n\n"
+      << "-- Run: flow";
+    for (const std::string& a : flow_steady_state_options()) o << ' ' << a;
+    o << ' ' << name << ".DATA\n\n"
       << "RUNSPEC\n\nTITLE\n" << name << "\n\n"
       << "DIMENS\n" << L.deck_nx << ' ' << L.ny << ' ' << L.nz << " /\n\n"
       << "WATER\n\nMETRIC\n\n"
@@ -335,10 +312,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       << "SCHEDULE\n\n"
       << "RPTRST\n'BASIC=2' /\n\n"
       << "INCLUDE\n" << quoted(sched_inc) << " /\n\n"
-      << "-- Steady state: one report step of max(1094 days, 40 x the slowest diffusion time\n"
-      << "-- phi mu c L^2 / k = " << tau << " days), which flow's default adaptive stepping\n"
-      << "-- takes in steps growing from 1 day; what is left of the transient is e^-40 at most.\n"
-      << "TSTEP\n" << run_days << " /\n\nEND\n";
+      << "-- One long step: backward Euler then gives the steady state.\n"
+      << "TSTEP\n" << options.tstep_days << " /\n\nEND\n";
     data_text = std::move(o.text);
   }
 

@@ -22,9 +22,9 @@
 namespace hm {
 
 struct EclipseDeckOptions {
-  /// Upper bound of the simulated time (days) of the steady-state schedule
-  /// (steady_state_days). The run starts on 1 Jan 1900 and flow's dates end in 2262:
-  /// at most ~131,000 days.
+  /// Length of the single report step (days). Long enough that the compressible accumulation
+  /// left after one backward-Euler step is negligible: the run is a steady-state solve. The run
+  /// starts on 1 Jan 1900 and flow's dates end in 2262: at most ~131,000 days.
   double tstep_days = 1.0e5;
   /// Thickness (m) of the thin boxes that carry the non-reservoir cells. Their depth (centre)
   /// is exact; the thickness only decides how many fit in one column.
@@ -111,16 +111,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
 /// ACTNUM 1 where the mesh has the reservoir cell, 0 where the cavity replaced it.
 WriteStatus write_reservoir_grdecl(const std::string& path, const ReservoirSpec& reservoir, const PolyMesh& mesh);
 
-/// The slowest pressure-diffusion time of the reservoir (days): phi mu c L^2 / k along each axis
-/// (L the reservoir's extent, k the smallest permeability of any cell along that axis, phi the
-/// largest porosity, c = the deck's Cw), the largest over the axes.
-double slowest_diffusion_days(const CaseSpec& cs, const PolyMesh& mesh, double cw_per_bar);
-
-/// The deck's single TSTEP (days): max(1094, 40 x tau_days), capped at max_total_days. flow's
-/// default adaptive stepping takes it in steps growing from 1 day (about threefold per step, to
-/// its default largest step of 365 days), so `flow NAME.DATA` with no options reaches the steady
-/// state: the slowest mode has decayed by e^-40, and the last time step's accumulation term is
-/// what is left of the transient (docs/export-eclipse.md).
-double steady_state_days(double tau_days, double max_total_days);
+/// Command-line options for `flow` that make the one-step deck a steady-state solve and make it
+/// converge to the accuracy of its float32 output (docs/export-eclipse.md explains each).
+std::vector<std::string> flow_steady_state_options();
 
 }  // namespace hm

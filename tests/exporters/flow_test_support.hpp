@@ -19,11 +19,12 @@ struct FlowRun {
   double seconds = 0;      ///< wall time of the flow run
 };
 
-/// Runs flow on dir/NAME.DATA as a user types it (no solver options; output in dir/out), then
-/// reads the results back with scripts/validate_flow.py.
+/// Runs flow with the exporter's steady-state options on dir/NAME.DATA (output in dir/out),
+/// then reads the results back with scripts/validate_flow.py.
 inline FlowRun run_flow(const fs::path& dir, const std::string& name, int timeout_s = 900) {
   FlowRun r;
   std::string cmd = "cd " + shell_quote(dir.string()) + " && flow";
+  for (const std::string& a : hm::flow_steady_state_options()) cmd += " " + a;
   cmd += " --output-dir=out " + shell_quote(name + ".DATA");
   const auto t0 = std::chrono::steady_clock::now();
   r.flow = run_command(cmd, timeout_s);
