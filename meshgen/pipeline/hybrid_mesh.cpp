@@ -31,6 +31,30 @@ TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& g
 
 namespace {
 
+Stats merged(const Stats& a, const Stats& b) {
+  if (a.count == 0) return b;
+  if (b.count == 0) return a;
+  Stats s;
+  s.count = a.count + b.count;
+  s.min = std::min(a.min, b.min);
+  s.max = std::max(a.max, b.max);
+  s.mean = (a.mean * static_cast<double>(a.count) + b.mean * static_cast<double>(b.count)) / static_cast<double>(s.count);
+  return s;
+}
+
+}  // namespace
+
+void add_quality(TransitionQuality& total, const TransitionQuality& q) {
+  total.vertices += q.vertices;
+  total.faces += q.faces;
+  total.cells += q.cells;
+  total.q_s = merged(total.q_s, q.q_s);
+  total.q_o = merged(total.q_o, q.q_o);
+  total.q_p = merged(total.q_p, q.q_p);
+}
+
+namespace {
+
 class StageTimer {
  public:
   explicit StageTimer(std::vector<std::pair<std::string, double>>* out) : out_(out) {}
@@ -134,10 +158,14 @@ HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions&
     if (!opts.build_transition) break;
     // Cavities are independent, so they are built concurrently; results are used in
     // cavity order, so the output does not depend on scheduling.
+    TransitionOptions topts;
+    topts.optimize = opts.optimize && cs.transition.optimize;
+    topts.g_remove = cs.transition.gamma[1];
+    topts.g_expand = cs.transition.gamma[2];
     std::vector<std::future<TransitionCells>> jobs;
     for (const Cavity& cav : out.cavities.cavities)
       jobs.push_back(std::async(std::launch::async, [&, cavp = &cav] {
-        return build_transition(*cavp, coords, out.grid, out.blocks, base);
+        return build_transition(*cavp, coords, out.grid, out.blocks, base, topts);
       }));
     transitions.clear();
     std::vector<int32_t> more;
@@ -219,19 +247,22 @@ HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions&
                              std::to_string(out.build_report.overused_faces) + " overused faces)");
   if (!opts.build_transition) return out;
 
-  out.transition_before = transition_quality(out.mesh, out.geometry, out.cell_h_ref);
-  if (opts.optimize && cs.transition.optimize && out.transition_before.cells > 0) {
-    OptimizeParams params;
-    params.gamma = cs.transition.gamma;
-    params.omega_o = cs.transition.omega_o;
-    params.omega_p = cs.transition.omega_p;
-    params.expansion = cs.transition.expansion;
-    out.mesh = optimize_transition(out.mesh, out.cell_h_ref, params, &out.optimize_report);
-    out.geometry = compute_geometry(out.mesh);
-    out.optimized = true;
-    out.transition_after = transition_quality(out.mesh, out.geometry, out.cell_h_ref);
-    timer.mark("optimization");
+  // Before/after figures of the transition cells, each cavity's cells on their own (the
+  // cavity's polygons are their boundary faces): only the transition cells are measured.
+  auto quality_of = [&](const TransitionCells& t) {
+    const PolyMesh sub = transition_submesh(t, coords);
+    return transition_quality(sub, compute_geometry(sub), t.h_ref);
+  };
+  for (const TransitionCells& t : transitions) {
+    out.optimized = out.optimized || t.unoptimized != nullptr;
+    add_quality(out.transition_before, quality_of(t.unoptimized ? *t.unoptimized : t));
+    if (t.unoptimized) add_quality(out.transition_after, quality_of(t));
+    const SiteOptimizeReport& o = t.report.optimization;
+    SiteOptimizeReport& a = out.optimize_report;
+    a.rounds = std::max(a.rounds, o.rounds);
+    a.proposed += o.proposed, a.kept += o.kept, a.refused += o.refused, a.invalid += o.invalid;
   }
+  timer.mark("transition_quality");
   return out;
 }
 

@@ -12,7 +12,6 @@
 #include "meshgen/grids/reservoir_grid.hpp"
 #include "fvcheck/lib/quality.hpp"
 #include "meshgen/grids/well_block.hpp"
-#include "meshgen/optimize/optimize.hpp"
 #include "meshgen/transition/transition.hpp"
 
 namespace hm {
@@ -30,6 +29,8 @@ struct TransitionQuality {
   Stats q_s, q_o, q_p;  ///< Q_S (h = cell_h_ref), Q_O(V), Q_P(V) over the transition cells
 };
 TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& geo, const std::vector<double>& h_ref);
+/// Adds the figures of disjoint sets of transition cells (other cavities) into `total`.
+void add_quality(TransitionQuality& total, const TransitionQuality& q);
 
 struct HybridMesh {
   PolyMesh mesh;
@@ -43,10 +44,12 @@ struct HybridMesh {
   std::vector<double> cell_h_ref;    ///< n_cells: Q_S reference length (transition: mean constrained edge)
   std::vector<int32_t> reservoir_cell_of;  ///< n_cells: linear reservoir index of reservoir cells, -1 otherwise
   BuildReport build_report;
-  TransitionQuality transition_before;  ///< before optimisation
+  /// The transition cells before and after the site optimiser, each cavity's cells measured on
+  /// their own (transition_submesh: the cavity polygons are boundary faces).
+  TransitionQuality transition_before;
   TransitionQuality transition_after;   ///< after optimisation (when optimized)
   bool optimized = false;
-  OptimizeReport optimize_report;
+  SiteOptimizeReport optimize_report;   ///< summed over the cavities (rounds: the largest)
   std::vector<std::string> notes;    ///< every automatic change made to the input (sectors, dilation, ...)
   std::vector<std::pair<std::string, double>> timings_s;  ///< stage name -> seconds, in stage order
 };

@@ -53,23 +53,16 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
     t["before"] = to_json(h.transition_before);
     if (h.optimized) {
       t["after"] = to_json(h.transition_after);
-      t["optimization"] = {{"removed_below_g1", h.optimize_report.removed_below_g1},
-                           {"removed_below_g2", h.optimize_report.removed_below_g2},
-                           {"expanded", h.optimize_report.expanded},
-                           {"collapsed_faces", h.optimize_report.collapsed_faces},
-                           {"rejected", h.optimize_report.rejected},
-                           {"rejected_by",
-                            {{"invalid", h.optimize_report.rejected_invalid},
-                             {"convexity", h.optimize_report.rejected_convexity},
-                             {"orthogonality", h.optimize_report.rejected_orthogonality},
-                             {"planarity", h.optimize_report.rejected_planarity},
-                             {"centering", h.optimize_report.rejected_centering},
-                             {"shape", h.optimize_report.rejected_shape},
-                             {"skewness", h.optimize_report.rejected_skewness}}},
-                           {"skewness_removed", h.optimize_report.skewness_removed},
-                           {"skewed_faces", h.optimize_report.skewed_faces},
-                           {"max_skewness", h.optimize_report.max_skewness},
-                           {"passes", h.optimize_report.passes}};
+      double transition_s = 0, optimize_s = 0;
+      for (const TransitionReport& r : h.transition_reports)
+        transition_s += r.seconds_delaunay + r.seconds_sites + r.seconds_power, optimize_s += r.seconds_optimize;
+      t["optimization"] = {{"rounds", h.optimize_report.rounds},
+                           {"moves_proposed", h.optimize_report.proposed},
+                           {"moves_kept", h.optimize_report.kept},
+                           {"moves_refused", h.optimize_report.refused},
+                           {"moves_invalid", h.optimize_report.invalid},
+                           {"seconds_transition", transition_s},
+                           {"seconds_optimize", optimize_s}};
     }
     int corrections = 0, hidden = 0, snapped = 0, removed = 0, internal = 0, external = 0, free = 0, dropped = 0;
     for (const TransitionReport& r : h.transition_reports) {

@@ -2,6 +2,7 @@
 // stages are in transition_delaunay.cpp and transition_power.cpp.
 #include "transition.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 #include <stdexcept>
@@ -54,7 +55,7 @@ std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector
 
 TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
                                  const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
-                                 int32_t base_node_id) {
+                                 int32_t base_node_id, const TransitionOptions& options) {
   TransitionReport report;
   using Clock = std::chrono::steady_clock;
   auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
@@ -139,11 +140,20 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     report.correction_iterations += iterations;
     report.dropped_tip_sites += drop_blocked_tip_sites(set);
   }
+  const Clock::time_point t3 = Clock::now();
+  SiteOptimizeReport optimization;
+  if (options.optimize) {
+    auto raw = std::make_shared<const TransitionCells>(out);
+    optimization = optimize_sites(set, cavity, node_coords, frames, options, out);
+    out.unoptimized = std::move(raw);
+  }
   // Merge the stage reports.
   TransitionReport& r = out.report;
+  r.optimization = optimization;
+  r.seconds_optimize = options.optimize ? seconds(t3, Clock::now()) : 0.0;
   r.seconds_delaunay = seconds(t0, t1);
   r.seconds_sites = seconds(t1, t2);
-  r.seconds_power = seconds(t2, Clock::now());
+  r.seconds_power = seconds(t2, t3);
   r.site_corrections = report.site_corrections;
   r.correction_iterations = report.correction_iterations;
   r.hidden_sites = report.hidden_sites;
@@ -163,6 +173,33 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     r.notes.push_back(std::to_string(r.free_sites) + " tip sites (weight 0) grade the cells beyond the well ends" +
                       (r.dropped_tip_sites > 0 ? " (" + std::to_string(r.dropped_tip_sites) + " dropped)" : ""));
   return out;
+}
+
+PolyMesh transition_submesh(const TransitionCells& t, const std::vector<Vec3>& node_coords,
+                            std::vector<int32_t>* global_node) {
+  std::vector<int32_t> used;
+  for (const auto& cell : t.cells)
+    for (const CellFace& f : cell) used.insert(used.end(), f.nodes.begin(), f.nodes.end());
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  MeshBuilder builder;
+  for (int32_t v : used) builder.add_node(v >= t.base_node_id ? t.new_nodes[v - t.base_node_id] : node_coords[v]);
+  auto local = [&](int32_t v) { return static_cast<int32_t>(std::lower_bound(used.begin(), used.end(), v) - used.begin()); };
+  for (size_t c = 0; c < t.cells.size(); ++c) {
+    std::vector<CellFace> faces = t.cells[c];
+    for (CellFace& f : faces) {
+      for (int32_t& v : f.nodes) v = local(v);
+      f.patch = kOuterBoundary;  // the cavity's polygons: the boundary of this mesh
+    }
+    CellAttributes at;
+    at.region = kTransition;
+    at.fv_center = t.sites[c];
+    builder.add_cell(faces, at);
+  }
+  BuildReport report;  // every node is used, so none is renumbered
+  PolyMesh mesh = builder.finish(&report);
+  if (global_node) *global_node = std::move(used);
+  return mesh;
 }
 
 }  // namespace hm

@@ -2,7 +2,9 @@
 // conforming with the constrained polygons. This header is CGAL-free; CGAL lives in
 // the .cpp files of this folder only.
 #pragma once
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,6 +13,23 @@
 #include "meshgen/core/mesh_builder.hpp"
 
 namespace hm {
+
+/// Options of the site optimiser (docs/optimization.md), the transition's last stage.
+struct TransitionOptions {
+  bool optimize = false;    ///< move sites to remove and expand short edges, rebuilding the diagram
+  double g_remove = 0.30;   ///< gamma G2: edges between free vertices below G2 h are removed
+  double g_expand = 0.40;   ///< gamma G3: other edges with a free end below G3 h are expanded to it
+  double max_shift = 0.5;   ///< a site moves at most this fraction of the edge's h per step
+  int max_rounds = 8;       ///< rounds of simultaneous independent moves (each: one or two rebuilds)
+};
+
+struct SiteOptimizeReport {
+  int rounds = 0;    ///< rounds run
+  int proposed = 0;  ///< independent site moves tried
+  int kept = 0;      ///< moves kept (the Q_S of the cells they touch improved)
+  int refused = 0;   ///< moves undone: no Q_S improvement
+  int invalid = 0;   ///< moves undone: the rebuilt diagram was not a valid conforming mesh
+};
 
 struct TransitionReport {
   int internal_sites = 0, external_sites = 0;
@@ -40,6 +59,8 @@ struct TransitionReport {
   double max_identification_shift = 0;  ///< max distance power vertex -> identified constrained node (m)
   double max_snap_shift = 0;    ///< max distance power vertex -> snapped constrained node (m)
   double seconds_delaunay = 0, seconds_sites = 0, seconds_power = 0;  ///< wall time of the stages
+  double seconds_optimize = 0;  ///< wall time of the site optimiser (0 when not run)
+  SiteOptimizeReport optimization;
 };
 
 /// Transition cells of one cavity, ready for the builder.
@@ -57,6 +78,13 @@ struct TransitionCells {
   std::vector<double> h_ref;
   /// Per cell: the cavity face indices (constrained polygons) that are faces of this cell.
   std::vector<std::vector<int32_t>> cell_polygons;
+  /// Per cell: its site's index in the cavity's site set (for the site optimiser).
+  std::vector<int32_t> cell_site;
+  /// Per new node: four of the sites whose power sphere it is the centre of (sorted; ids
+  /// >= the site count are the far guard points).
+  std::vector<std::array<int, 4>> new_node_sites;
+  /// When optimised: the raw power diagram before the site optimiser (for before/after figures).
+  std::shared_ptr<const TransitionCells> unoptimized;
   TransitionReport report;
 };
 
@@ -80,7 +108,13 @@ class TransitionError : public std::runtime_error {
 /// correction does not converge, std::runtime_error if the cavity leaks (not closed).
 TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
                                  const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
-                                 int32_t base_node_id);
+                                 int32_t base_node_id, const TransitionOptions& options = {});
+
+/// The transition cells of one cavity as a PolyMesh of their own (cells in order; the cavity's
+/// constrained polygons are its boundary faces). Node i of the result is global node
+/// (*global_node)[i] (constrained ids, or base_node_id + k for new node k).
+PolyMesh transition_submesh(const TransitionCells& cells, const std::vector<Vec3>& node_coords,
+                            std::vector<int32_t>* global_node = nullptr);
 
 /// Dual (Voronoi) edge parameters of each constrained polygon, found from the Delaunay
 /// tetrahedra attached to it (paper 5.3): the internal Voronoi vertex is O + t_in n, the

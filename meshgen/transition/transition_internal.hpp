@@ -76,6 +76,16 @@ struct SiteSet {
   int emptiness_fixes = 0;       ///< sites moved because their sphere held a cavity vertex
 };
 
+/// Places the internal polygon site s at O + t n with the weight of its constrained vertices
+/// (and re-derives its reflection, if its polygon has one).
+void place_polygon_site(SiteSet& set, int s, double t, const Cavity& cavity, const std::vector<Vec3>& coords,
+                        const std::vector<PolygonFrame>& frames);
+/// Admissible range of polygon q's internal site parameter t: above min_t the site stays apart
+/// from its reflection; below max_t its sphere (and its reflection's) stays empty of other
+/// cavity vertices and within the site's own cap.
+double min_t(const std::vector<PolygonFrame>& frames, int q);
+double max_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames);
+
 /// Stage 5.4: one site per deactivated cell (box) or per polygon, plus external sites.
 SiteSet make_sites(const Cavity& cavity, const std::vector<Vec3>& coords, const ReservoirGrid& grid,
                    const std::vector<PolygonFrame>& frames, std::vector<std::string>& notes);
@@ -151,5 +161,12 @@ std::vector<int> sites_in_duplicate_faces(const SiteSet& set, const TransitionCe
 /// sites that are hidden (no cell); nothing is emitted then.
 std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                    const std::vector<PolygonFrame>& frames, TransitionCells& out);
+
+/// The site optimiser (transition_optimize.cpp): rounds of independent site moves that
+/// remove or expand short edges, each followed by a rebuild of the exact diagram; `out` is a
+/// valid diagram of `set` on entry and on exit. Q_S's h is the entry diagram's h_ref.
+SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                  const std::vector<PolygonFrame>& frames, const TransitionOptions& options,
+                                  TransitionCells& out);
 
 }  // namespace hm::transition_detail

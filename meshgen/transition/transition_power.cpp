@@ -424,9 +424,11 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
   }
   std::sort(free_classes.begin(), free_classes.end());
   out.new_nodes.clear();
+  out.new_node_sites.clear();
   for (const auto& [key, cls] : free_classes) {
     free_id[cls] = out.base_node_id + static_cast<int32_t>(out.new_nodes.size());
     out.new_nodes.push_back(class_info(cls).point);
+    out.new_node_sites.push_back(key);
   }
   rep.identified_vertices = identified;
   rep.free_vertices = static_cast<int>(out.new_nodes.size());
@@ -443,6 +445,7 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
       internal_sites.push_back(s);
     }
   const size_t ncell = internal_sites.size();
+  out.cell_site.assign(internal_sites.begin(), internal_sites.end());
   out.cells.assign(ncell, {});
   out.cell_polygons.assign(ncell, {});
   out.sites.resize(ncell);

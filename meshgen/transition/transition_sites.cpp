@@ -67,6 +67,8 @@ void update_mirror(SiteSet& set, int q, const std::vector<PolygonFrame>& frames)
   set.sites[e].unchecked = true;
 }
 
+}  // namespace
+
 // Places the internal polygon site s at O + t n with the weight of its constrained vertices.
 void place_polygon_site(SiteSet& set, int s, double t, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames) {
@@ -78,6 +80,8 @@ void place_polygon_site(SiteSet& set, int s, double t, const Cavity& cavity, con
   site.w2 = mean_w2(site.p, cavity.faces[q].nodes, coords);
   update_mirror(set, q, frames);
 }
+
+namespace {
 
 // Paper 5.4.1 (n = 1): midpoint of [O V]. When the external site is a mirror, its sphere
 // must stay empty too, which bounds t by the external Voronoi vertex: t <= -t_out.
@@ -116,6 +120,8 @@ int add_mirror_site(SiteSet& set, int q, const Cavity& cavity, const std::vector
   return id;
 }
 
+}  // namespace
+
 // Largest t of polygon q's internal site that keeps its sphere (and its reflection's) clearly
 // empty, within the site's own cap (end faces, place_end_face_sites).
 double max_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames) {
@@ -123,6 +129,10 @@ double max_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames)
   const double cap = in >= 0 ? set.sites[in].t_cap : kInf;
   return std::min(0.95 * 2.0 * initial_t(set, q, frames), cap);
 }
+
+double min_t(const std::vector<PolygonFrame>& frames, int q) { return 1.0001 * kMinT * frames[q].radius; }
+
+namespace {
 
 // Whether shrink_or_split can still change site s: boxes can be split, polygon sites (or
 // the partner of a reflection) can move while above their minimal distance.

@@ -3,7 +3,7 @@
 
 #include "exporter_test_support.hpp"
 #include "exporters/openfoam/openfoam_case.hpp"
-#include "meshgen/optimize/optimize.hpp"
+#include "meshgen/core/fv_quality.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 
 namespace {

@@ -1,0 +1,239 @@
+#include "fv_quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hm {
+
+namespace {
+constexpr double kDeg = 180.0 / M_PI;
+
+double clamp_unit(double x) { return std::min(1.0, std::max(-1.0, x)); }
+
+// OpenFOAM's face centre and area vector (primitiveMesh face centres): a triangle
+// directly; otherwise a fan around the point average whose triangle centroids are weighted
+// by their area projected on the face's normal. The area points as the cycle turns.
+void foam_face(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* e, Vec3* centre, Vec3* area) {
+  const size_t n = static_cast<size_t>(e - b);
+  if (n == 3) {
+    *centre = (nodes[b[0]] + nodes[b[1]] + nodes[b[2]]) / 3.0;
+    *area = 0.5 * cross(nodes[b[1]] - nodes[b[0]], nodes[b[2]] - nodes[b[0]]);
+    return;
+  }
+  Vec3 mean;
+  for (const int32_t* v = b; v != e; ++v) mean += nodes[*v];
+  mean = mean / static_cast<double>(n);
+  Vec3 sum_n;
+  for (size_t i = 0; i < n; ++i) sum_n += cross(nodes[b[(i + 1) % n]] - nodes[b[i]], mean - nodes[b[i]]);
+  Vec3 sum_c;
+  double sum_a = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = nodes[b[i]], q = nodes[b[(i + 1) % n]];
+    const double a = dot(cross(q - p, mean - p), sum_n);
+    sum_a += a;
+    sum_c += a * (p + q + mean);
+  }
+  *centre = sum_a > 1e-300 ? sum_c / (3.0 * sum_a) : mean;
+  *area = 0.5 * sum_n;
+}
+
+// OpenFOAM's cell centre (primitiveMesh cell centres): the volume-weighted centroid of the
+// pyramids from the average of the face centres. Faces are given as outward cycles.
+Vec3 foam_cell_centre(const std::vector<Vec3>& nodes, const std::vector<std::vector<int32_t>>& outward) {
+  std::vector<Vec3> fc(outward.size()), fa(outward.size());
+  Vec3 est;
+  for (size_t i = 0; i < outward.size(); ++i) {
+    foam_face(nodes, outward[i].data(), outward[i].data() + outward[i].size(), &fc[i], &fa[i]);
+    est += fc[i];
+  }
+  if (outward.empty()) return est;
+  est = est / static_cast<double>(outward.size());
+  Vec3 sum;
+  double vol = 0;
+  for (size_t i = 0; i < outward.size(); ++i) {
+    const double pv = std::max(dot(fa[i], fc[i] - est), 1e-300);
+    sum += pv * (0.75 * fc[i] + 0.25 * est);
+    vol += pv;
+  }
+  return vol > 0 ? sum / vol : est;
+}
+
+// OpenFOAM's face skewness (primitiveMeshTools::faceSkewness / boundaryFaceSkewness): the
+// distance from the face centre to where the line between the cell centres crosses the face
+// plane, over the face's extent in that direction (at least 0.2 |d|; 0.4 |d| on the boundary).
+double foam_skewness(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* e, Vec3 fc, Vec3 fa, Vec3 own_cc,
+                     const Vec3* nei_cc) {
+  const Vec3 cpf = fc - own_cc;
+  Vec3 d;
+  double fd;
+  if (nei_cc) {
+    d = *nei_cc - own_cc;
+    fd = 0.2 * norm(d);
+  } else {
+    const Vec3 nrm = fa / (norm(fa) + 1e-300);
+    d = dot(nrm, cpf) * nrm;
+    fd = 0.4 * norm(d);
+  }
+  const Vec3 sv = cpf - (dot(fa, cpf) / (dot(fa, d) + 1e-300)) * d;
+  const Vec3 sv_hat = sv / (norm(sv) + 1e-300);
+  fd += 1e-300;
+  for (const int32_t* v = b; v != e; ++v) fd = std::max(fd, std::abs(dot(sv_hat, nodes[*v] - fc)));
+  return norm(sv) / fd;
+}
+
+
+// Distinct undirected edges (a < b) of cell c.
+void cell_edges(const PolyMesh& m, int c, std::vector<std::pair<int32_t, int32_t>>& edges) {
+  edges.clear();
+  for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+    const int f = *fp, n = m.face_size(f);
+    const int32_t* v = m.face_begin(f);
+    for (int i = 0; i < n; ++i) {
+      int32_t a = v[i], b = v[(i + 1) % n];
+      if (a > b) std::swap(a, b);
+      edges.emplace_back(a, b);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+}
+}  // namespace
+
+std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& geo) {
+  std::vector<double> q(m.n_faces(), 0.0);
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const double a = norm(geo.face_area[f]);
+    const Vec3 p1 = m.cell_fv_center[m.face_owner[f]];
+    const Vec3 p2 = m.face_neighbour[f] >= 0 ? m.cell_fv_center[m.face_neighbour[f]] : geo.face_centroid[f];
+    const Vec3 d = p2 - p1;
+    const double l = norm(d);
+    if (!(a > 0) || !(l > 0)) continue;  // degenerate: Q_O = 0
+    q[f] = std::asin(clamp_unit(std::fabs(dot(d, geo.face_area[f])) / (l * a))) * kDeg;
+  }
+  return q;
+}
+
+std::vector<double> face_planarity(const PolyMesh& m, const MeshGeometry& geo) {
+  std::vector<double> q(m.n_faces(), 0.0);
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const double a = norm(geo.face_area[f]);
+    if (!(a > 0)) {
+      q[f] = 90.0;
+      continue;
+    }
+    const Vec3 n = geo.face_area[f] / a;
+    const int k = m.face_size(f);
+    const int32_t* v = m.face_begin(f);
+    Vec3 g;
+    for (int i = 0; i < k; ++i) g += m.nodes[v[i]];
+    g = g / k;
+    double worst = 0;
+    for (int i = 0; i < k; ++i) {
+      const Vec3 t = cross(m.nodes[v[i]] - g, m.nodes[v[(i + 1) % k]] - g);  // 2 * triangle area vector
+      const double ta = norm(t);
+      if (!(ta > 2e-12 * a)) continue;
+      worst = std::max(worst, std::acos(clamp_unit(std::fabs(dot(n, t)) / ta)) * kDeg);
+    }
+    q[f] = worst;
+  }
+  return q;
+}
+
+std::vector<double> cell_min_of_faces(const PolyMesh& m, const std::vector<double>& fv) {
+  std::vector<double> out(m.n_cells(), 0.0);
+  for (int c = 0; c < m.n_cells(); ++c) {
+    double v = std::numeric_limits<double>::infinity();
+    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) v = std::min(v, fv[*f]);
+    out[c] = std::isfinite(v) ? v : 0.0;
+  }
+  return out;
+}
+
+std::vector<double> cell_max_of_faces(const PolyMesh& m, const std::vector<double>& fv) {
+  std::vector<double> out(m.n_cells(), 0.0);
+  for (int c = 0; c < m.n_cells(); ++c) {
+    double v = 0;
+    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) v = std::max(v, fv[*f]);
+    out[c] = v;
+  }
+  return out;
+}
+
+std::vector<double> cell_mean_edge_length(const PolyMesh& m) {
+  std::vector<double> out(m.n_cells(), 0.0);
+  std::vector<std::pair<int32_t, int32_t>> edges;
+  for (int c = 0; c < m.n_cells(); ++c) {
+    cell_edges(m, c, edges);
+    double s = 0;
+    for (auto [a, b] : edges) s += norm(m.nodes[b] - m.nodes[a]);
+    out[c] = edges.empty() ? 0.0 : s / static_cast<double>(edges.size());
+  }
+  return out;
+}
+
+std::vector<double> cell_shape_quality(const PolyMesh& m, const std::vector<double>& h_ref) {
+  std::vector<double> out(m.n_cells(), 0.0);
+  const bool use_ref = h_ref.size() == static_cast<size_t>(m.n_cells());
+  std::vector<std::pair<int32_t, int32_t>> edges;
+  for (int c = 0; c < m.n_cells(); ++c) {
+    cell_edges(m, c, edges);
+    if (edges.empty()) continue;
+    double h = use_ref ? h_ref[c] : 0.0;
+    if (!(h > 0) || !std::isfinite(h)) {
+      h = 0;
+      for (auto [a, b] : edges) h += norm(m.nodes[b] - m.nodes[a]);
+      h /= static_cast<double>(edges.size());
+    }
+    if (!(h > 0)) continue;  // every edge has zero length
+    double q = 1.0;
+    for (auto [a, b] : edges) {
+      const double l = norm(m.nodes[b] - m.nodes[a]);
+      q = std::min(q, l > 0 ? std::min(l / h, h / l) : 0.0);
+    }
+    out[c] = q;
+  }
+  return out;
+}
+
+Stats stats_of(const std::vector<double>& values, const std::vector<bool>& mask) {
+  Stats s;
+  double sum = 0;
+  s.min = std::numeric_limits<double>::infinity();
+  s.max = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!mask.empty() && (i >= mask.size() || !mask[i])) continue;
+    const double v = values[i];
+    if (std::isnan(v)) continue;
+    ++s.count;
+    sum += v;
+    s.min = std::min(s.min, v);
+    s.max = std::max(s.max, v);
+  }
+  if (s.count == 0) return Stats{};
+  s.mean = sum / static_cast<double>(s.count);
+  return s;
+}
+
+std::vector<double> openfoam_face_skewness(const PolyMesh& mesh) {
+  std::vector<Vec3> centre(mesh.n_cells());
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    std::vector<std::vector<int32_t>> outward;
+    for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f) {
+      outward.emplace_back(mesh.face_begin(*f), mesh.face_end(*f));
+      if (mesh.face_owner[*f] != c) std::reverse(outward.back().begin(), outward.back().end());
+    }
+    centre[c] = foam_cell_centre(mesh.nodes, outward);
+  }
+  std::vector<double> skew(mesh.n_faces());
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    Vec3 fc, fa;
+    foam_face(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), &fc, &fa);
+    const int32_t n = mesh.face_neighbour[f];
+    skew[f] = foam_skewness(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), fc, fa, centre[mesh.face_owner[f]],
+                            n >= 0 ? &centre[n] : nullptr);
+  }
+  return skew;
+}
+
+}  // namespace hm

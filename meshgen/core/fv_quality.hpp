@@ -1,0 +1,54 @@
+// The finite-volume quality kernel of HybridMesh (paper section 6.1): orthogonality Q_O
+// (eq. 8-9), planarity Q_P (eq. 10-11), shape Q_S (eq. 7) and their statistics. One
+// implementation used by the mesher (transition optimiser, summary), fvcheck and the writers;
+// face areas and centroids come from MeshGeometry (geometry.hpp).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "geometry.hpp"
+#include "polymesh.hpp"
+
+namespace hm {
+
+/// Q_O(F) in degrees for every face (eq. 8): arcsin |u . n| with u the unit vector between
+/// the FV centres of owner and neighbour (boundary face: owner's FV centre -> face centroid)
+/// and n the unit face normal. 0 for a degenerate face or coincident points.
+std::vector<double> face_orthogonality(const PolyMesh& mesh, const MeshGeometry& geo);
+
+/// Q_P(F) in degrees for every face (eq. 10): the largest angle between the face normal and
+/// the normals of the fan triangles (G, A_i, A_{i+1}), G the mean of the face's nodes.
+/// Fan triangles of area <= 1e-12 * face area have no normal and are skipped; a face of zero
+/// area gets 90.
+std::vector<double> face_planarity(const PolyMesh& mesh, const MeshGeometry& geo);
+
+/// Q_O(V) = min of Q_O(F) over the cell's faces (eq. 9).
+std::vector<double> cell_min_of_faces(const PolyMesh& mesh, const std::vector<double>& face_values);
+/// Q_P(V) = max of Q_P(F) over the cell's faces (eq. 11).
+std::vector<double> cell_max_of_faces(const PolyMesh& mesh, const std::vector<double>& face_values);
+
+/// Mean length of the distinct edges of each cell.
+std::vector<double> cell_mean_edge_length(const PolyMesh& mesh);
+
+/// Q_S(V) = min over the cell's distinct edges of min(l/h, h/l) (eq. 7). h_ref[c] is the
+/// reference length of cell c; when h_ref is empty, or h_ref[c] is not a positive finite
+/// number, the cell's mean edge length is used. A zero-length edge gives 0.
+std::vector<double> cell_shape_quality(const PolyMesh& mesh, const std::vector<double>& h_ref);
+
+struct Stats {
+  int64_t count = 0;
+  double min = 0, max = 0, mean = 0;  ///< 0 when count == 0
+};
+/// Statistics of the values whose mask entry is true (all values when mask is empty).
+Stats stats_of(const std::vector<double>& values, const std::vector<bool>& mask = {});
+
+/// OpenFOAM's face skewness (checkMesh flags faces above 4), per face: cell centres are
+/// geometric centroids and face centres area-weighted, computed as OpenFOAM does
+/// (primitiveMeshTools::faceSkewness), so that it reproduces checkMesh's figures.
+std::vector<double> openfoam_face_skewness(const PolyMesh& mesh);
+
+/// Skewness above which a face counts as skewed: OpenFOAM's 4, less a margin for the
+/// precision of the written points.
+inline constexpr double kOpenFoamSkewnessLimit = 3.95;
+
+}  // namespace hm

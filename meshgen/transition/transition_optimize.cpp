@@ -1,0 +1,340 @@
+// Optimisation of one cavity's transition mesh by moving its sites (docs/optimization.md).
+// CGAL-free: every trial is a rebuild of the exact power diagram (build_power_cells), so the
+// output stays a power diagram: planar faces, internal faces orthogonal to their site
+// segments, the constrained polygons untouched.
+//
+// A short edge (u, v) of a power diagram joins the power centres of two tetrahedra of the
+// regular triangulation that share a triangle ABC: u of ABCE, v of ABCD. Both lie on the line
+// of equal power to A, B and C, and v moves along it when D moves. Placing v at a chosen point
+// x of that line needs pow(x, D) = pow(x, A), one equation in D's parameter:
+//  - a polygon site O + t n whose weight passes through its polygon's nodes X_i has
+//    pow(x) = |x - O|^2 - R2 - 2 t n.(x - Xbar) (R2 = mean |O - X_i|^2): linear in t;
+//  - its reflection O - t n: pow(x) = |x - O|^2 - R2 + 2 t n.(x - 2 O + Xbar);
+//  - a free site of weight 0: moved radially about x to distance sqrt(pow(x, A)).
+// x = u makes the five sites co-spherical: the edge vanishes (removal); x beyond v lengthens it
+// (expansion). Boxes (reservoir cell centres) never move.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "meshgen/core/fv_quality.hpp"
+#include "transition_internal.hpp"
+
+namespace hm::transition_detail {
+
+namespace {
+
+struct SiteState {
+  Vec3 p;
+  double w2 = 0, t = 0;
+};
+
+// One proposed site move: the site that moves (for a reflection, its internal partner) and
+// the cells whose geometry it changes (its own and those sharing a node with it).
+struct Move {
+  int site = -1;
+  SiteState before, after;
+  std::vector<int> region;  // cells
+  bool removal = false;
+  // The edge (power-sphere site quadruples of its ends; a constrained node as {-1,-1,-1,id})
+  // and the site tried on it: a move refused once is not tried again.
+  std::array<int, 9> tag{};
+};
+
+double power_of(const Site& s, Vec3 x) { return norm2(x - s.p) - s.w2; }
+
+Vec3 mean_of(const std::vector<int32_t>& nodes, const std::vector<Vec3>& coords) {
+  Vec3 m;
+  for (int32_t v : nodes) m += coords[v];
+  return m / static_cast<double>(nodes.size());
+}
+
+double mean_sq_distance(Vec3 p, const std::vector<int32_t>& nodes, const std::vector<Vec3>& coords) {
+  double s = 0;
+  for (int32_t v : nodes) s += norm2(coords[v] - p);
+  return s / static_cast<double>(nodes.size());
+}
+
+// Condition (6) of paper 5.5.1 for site s against every other live site: where two spheres
+// overlap, the radical plane must not pass beyond the smaller-weight (internal) site. A free
+// site also keeps its clearance from every other sphere, and every sphere from it.
+bool centred(const SiteSet& set, int s) {
+  const Site& a = set.sites[s];
+  for (size_t j = 0; j < set.sites.size(); ++j) {
+    const Site& b = set.sites[j];
+    if (static_cast<int>(j) == s || !b.alive || b.kind == SiteKind::Guard) continue;
+    const double d2 = norm2(a.p - b.p);
+    if (a.kind == SiteKind::Free && b.kind != SiteKind::Free && std::sqrt(d2) < std::sqrt(b.w2) + a.clearance)
+      return false;
+    if (b.kind == SiteKind::Free && a.kind != SiteKind::Free && std::sqrt(d2) < std::sqrt(a.w2) + b.clearance)
+      return false;
+    if (d2 > std::max(a.w2, b.w2)) continue;
+    const Site& small = a.w2 > b.w2 ? b : a;
+    if (small.internal() && std::abs(a.w2 - b.w2) > d2) return false;
+  }
+  return true;
+}
+
+class SiteOptimizer {
+ public:
+  SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                const std::vector<PolygonFrame>& frames, const std::vector<double>& h_ref,
+                const TransitionOptions& opt)
+      : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt) {}
+
+  // One round on `out` (a valid diagram of set_): true if some move was kept.
+  bool round(TransitionCells& out, SiteOptimizeReport& rep);
+
+ private:
+  Vec3 node(const TransitionCells& t, int32_t v) const {
+    return v >= t.base_node_id ? t.new_nodes[v - t.base_node_id] : coords_[v];
+  }
+  bool rebuild(TransitionCells& fresh, int32_t base) const;
+  static std::array<int, 4> key_of(const TransitionCells& t, int32_t v) {
+    return v >= t.base_node_id ? t.new_node_sites[v - t.base_node_id] : std::array<int, 4>{-1, -1, -1, v};
+  }
+  SiteState state(int s) const { return {set_.sites[s].p, set_.sites[s].w2, set_.sites[s].t}; }
+  void restore(int s, const SiteState& st) {
+    Site& site = set_.sites[s];
+    if (site.kind == SiteKind::InternalPolygon) place_polygon_site(set_, s, st.t, cavity_, coords_, frames_);
+    else site.p = st.p, site.w2 = st.w2;
+  }
+  // The move of site d (or of its partner) that puts the power vertex it shares with
+  // reference site a at x; false if it leaves the admissible range. Changes nothing.
+  bool trial_move(int d, int a, Vec3 x, double max_shift, Move* m);
+
+  SiteSet& set_;
+  const Cavity& cavity_;
+  const std::vector<Vec3>& coords_;
+  const std::vector<PolygonFrame>& frames_;
+  const std::vector<double>& h_ref_;
+  const TransitionOptions& opt_;
+  std::set<std::array<int, 9>> refused_;
+};
+
+bool SiteOptimizer::rebuild(TransitionCells& fresh, int32_t base) const {
+  fresh = TransitionCells{};
+  fresh.base_node_id = base;
+  if (!build_power_cells(set_, cavity_, coords_, frames_, fresh).empty()) return false;
+  const TransitionReport& r = fresh.report;
+  if (r.unmatched_external_faces > 0 || r.missing_polygons > 0) return false;
+  for (const auto& cell : fresh.cells)
+    if (cell.size() < 4) return false;
+  return tip_sites_in_bad_cells(set_, fresh).empty();
+}
+
+bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, Move* m) {
+  const Site& ds = set_.sites[d];
+  const double target = power_of(set_.sites[a], x);
+  int mover = d;
+  if (ds.kind == SiteKind::InternalPolygon || ds.kind == SiteKind::ExternalMirror) {
+    const int q = ds.polygon;
+    mover = set_.internal_of[q];
+    if (mover < 0 || set_.sites[mover].kind != SiteKind::InternalPolygon) return false;
+    const Vec3 o = frames_[q].center, n = frames_[q].normal;
+    const Vec3 xbar = mean_of(cavity_.faces[q].nodes, coords_);
+    const double r2 = mean_sq_distance(o, cavity_.faces[q].nodes, coords_);
+    const double slope = ds.kind == SiteKind::InternalPolygon ? -2.0 * dot(n, x - xbar) : 2.0 * dot(n, x - 2.0 * o + xbar);
+    if (!(std::abs(slope) > 0)) return false;
+    const double t = (target - norm2(x - o) + r2) / slope;
+    if (!(t >= min_t(frames_, q) && t <= max_t(set_, q, frames_))) return false;
+    if (std::abs(t - set_.sites[mover].t) > max_shift) return false;
+    m->site = mover;
+    m->before = state(mover);
+    place_polygon_site(set_, mover, t, cavity_, coords_, frames_);
+  } else if (ds.kind == SiteKind::Free) {
+    if (!(target > 0)) return false;
+    const Vec3 away = ds.p - x;
+    const double len = norm(away);
+    if (!(len > 0)) return false;
+    const Vec3 p = x + (std::sqrt(target) / len) * away;
+    if (norm(p - ds.p) > max_shift) return false;
+    m->site = d;
+    m->before = state(d);
+    set_.sites[d].p = p;
+  } else {
+    return false;
+  }
+  const bool ok = centred(set_, mover);
+  m->after = state(mover);
+  restore(mover, m->before);
+  return ok;
+}
+
+bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep) {
+  std::vector<int32_t> global;
+  const PolyMesh sub = transition_submesh(out, coords_, &global);
+  const std::vector<double> qs = cell_shape_quality(sub, h_ref_);
+  const int nc = sub.n_cells();
+  // node -> cells and edge -> cells over local node ids (sorted incidence lists)
+  std::vector<std::pair<int32_t, int32_t>> node_cell;
+  std::vector<std::array<int32_t, 3>> edge_cell;
+  for (int c = 0; c < nc; ++c)
+    for (const int32_t* f = sub.cell_begin(c); f != sub.cell_end(c); ++f) {
+      const int k = sub.face_size(*f);
+      const int32_t* v = sub.face_begin(*f);
+      for (int i = 0; i < k; ++i) {
+        node_cell.push_back({v[i], c});
+        const int32_t a = std::min(v[i], v[(i + 1) % k]), b = std::max(v[i], v[(i + 1) % k]);
+        edge_cell.push_back({a, b, c});
+      }
+    }
+  std::sort(node_cell.begin(), node_cell.end());
+  node_cell.erase(std::unique(node_cell.begin(), node_cell.end()), node_cell.end());
+  std::sort(edge_cell.begin(), edge_cell.end());
+  edge_cell.erase(std::unique(edge_cell.begin(), edge_cell.end()), edge_cell.end());
+  std::vector<int> node_ptr(sub.n_nodes() + 1, 0);
+  for (const auto& [v, c] : node_cell) ++node_ptr[v + 1];
+  for (int v = 0; v < sub.n_nodes(); ++v) node_ptr[v + 1] += node_ptr[v];
+  auto cells_of_node = [&](int32_t v) {
+    std::vector<int> cs;
+    for (int i = node_ptr[v]; i < node_ptr[v + 1]; ++i) cs.push_back(node_cell[i].second);
+    return cs;
+  };
+  const int ns = static_cast<int>(set_.sites.size());
+  std::vector<int> cell_of_site(ns, -1);
+  for (int c = 0; c < nc; ++c) cell_of_site[out.cell_site[c]] = c;
+  // The cells whose geometry a move of `site` changes: its own and its face neighbours.
+  auto region_of = [&](int site) {
+    std::vector<int> r;
+    const int c = cell_of_site[site];
+    if (c < 0) return r;
+    r.push_back(c);
+    for (const int32_t* f = sub.cell_begin(c); f != sub.cell_end(c); ++f) {
+      const int o = sub.face_owner[*f], n = sub.face_neighbour[*f];
+      if (n >= 0) r.push_back(o == c ? n : o);
+    }
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+    return r;
+  };
+
+  // Candidate edges: shorter than G3 h (h: the largest reference length of the cells around),
+  // with a free end; shortest relative length first, ties by node ids.
+  struct Candidate {
+    double rel, len, h;
+    int32_t a, b;
+    size_t first, last;  // range in edge_cell
+  };
+  std::vector<Candidate> cand;
+  for (size_t i = 0; i < edge_cell.size();) {
+    size_t j = i;
+    double h = 0;
+    while (j < edge_cell.size() && edge_cell[j][0] == edge_cell[i][0] && edge_cell[j][1] == edge_cell[i][1])
+      h = std::max(h, h_ref_[edge_cell[j][2]]), ++j;
+    const int32_t a = edge_cell[i][0], b = edge_cell[i][1];
+    const bool free_end = global[a] >= out.base_node_id || global[b] >= out.base_node_id;
+    const double len = norm(sub.nodes[a] - sub.nodes[b]);
+    if (free_end && h > 0 && len < opt_.g_expand * h) cand.push_back({len / h, len, h, a, b, i, j});
+    i = j;
+  }
+  std::sort(cand.begin(), cand.end(), [&](const Candidate& x, const Candidate& y) {
+    return x.rel != y.rel ? x.rel < y.rel : std::make_pair(global[x.a], global[x.b]) < std::make_pair(global[y.a], global[y.b]);
+  });
+
+  std::vector<char> locked(ns, 0), moved(ns, 0);
+  std::vector<Move> moves;
+  for (const Candidate& e : cand) {
+    std::vector<int> around;  // sites of the cells around the edge
+    for (size_t k = e.first; k < e.last; ++k) around.push_back(out.cell_site[edge_cell[k][2]]);
+    bool busy = false;
+    for (int s : around) busy = busy || moved[s];
+    if (busy) continue;
+    Move best;
+    double best_shift = std::numeric_limits<double>::infinity();
+    for (int end = 0; end < 2; ++end) {
+      const int32_t v = end ? e.a : e.b, u = end ? e.b : e.a;
+      if (global[v] < out.base_node_id) continue;
+      const bool removal = e.rel < opt_.g_remove && global[u] >= out.base_node_id;
+      const Vec3 pv = sub.nodes[v], pu = sub.nodes[u];
+      const Vec3 x = removal ? pu : pv + ((opt_.g_expand * e.h - e.len) / e.len) * (pv - pu);
+      // Sites of v not around the edge: those of its cells and of its power sphere.
+      std::vector<int> ds;
+      for (int c : cells_of_node(v)) ds.push_back(out.cell_site[c]);
+      for (int s : out.new_node_sites[global[v] - out.base_node_id])
+        if (s < ns) ds.push_back(s);
+      std::sort(ds.begin(), ds.end());
+      ds.erase(std::unique(ds.begin(), ds.end()), ds.end());
+      for (int d : ds) {
+        if (std::find(around.begin(), around.end(), d) != around.end()) continue;
+        Move m;
+        const std::array<int, 4> ku = key_of(out, global[u]), kv = key_of(out, global[v]);
+        m.tag = {ku[0], ku[1], ku[2], ku[3], kv[0], kv[1], kv[2], kv[3], d};
+        if (refused_.count(m.tag)) continue;
+        if (!trial_move(d, around.front(), x, opt_.max_shift * e.h, &m) || locked[m.site]) continue;
+        const double shift = norm(m.after.p - m.before.p);
+        m.removal = removal;
+        if (shift < best_shift) best = m, best_shift = shift;
+      }
+    }
+    if (best.site < 0) continue;
+    best.region = region_of(best.site);
+    bool clash = false;
+    for (int c : best.region) clash = clash || moved[out.cell_site[c]];
+    if (clash) continue;
+    restore(best.site, best.after);
+    moved[best.site] = 1;
+    for (int c : best.region) locked[out.cell_site[c]] = 1;
+    locked[best.site] = 1;
+    moves.push_back(best);
+  }
+  rep.proposed += static_cast<int>(moves.size());
+  if (moves.empty()) return false;
+
+  // Rebuild with the moves; an invalid diagram keeps the first half of them, down to none.
+  TransitionCells fresh;
+  size_t keep = moves.size();
+  while (!rebuild(fresh, out.base_node_id)) {
+    const size_t half = keep / 2;
+    for (size_t i = half; i < keep; ++i) restore(moves[i].site, moves[i].before);
+    if (keep == 1) refused_.insert(moves[0].tag);
+    rep.invalid += static_cast<int>(keep - half);
+    keep = half;
+    if (keep == 0) {
+      moves.clear();
+      return false;
+    }
+  }
+  moves.resize(keep);
+  // Keep a move only if the Q_S of the cells it touches improves (sum over its region).
+  std::vector<int32_t> g2;
+  const std::vector<double> qs2 = cell_shape_quality(transition_submesh(fresh, coords_, &g2), h_ref_);
+  std::vector<Move> kept;
+  for (const Move& m : moves) {
+    double before = 0, after = 0;
+    for (int c : m.region) before += qs[c], after += qs2[c];
+    if (after > before + 1e-12) kept.push_back(m);
+    else restore(m.site, m.before), refused_.insert(m.tag);
+  }
+  rep.refused += static_cast<int>(moves.size() - kept.size());
+  if (kept.empty()) {
+    return false;
+  }
+  if (kept.size() < moves.size() && !rebuild(fresh, out.base_node_id)) {
+    for (const Move& m : kept) restore(m.site, m.before);
+    rep.invalid += static_cast<int>(kept.size());
+    return false;
+  }
+  rep.kept += static_cast<int>(kept.size());
+  out = std::move(fresh);
+  return true;
+}
+
+}  // namespace
+
+SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                  const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+                                  TransitionCells& out) {
+  SiteOptimizeReport rep;
+  const std::vector<double> h_ref = out.h_ref;  // the raw diagram's: the same reference before and after
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt);
+  while (rep.rounds < opt.max_rounds) {
+    ++rep.rounds;
+    if (!optimizer.round(out, rep)) break;
+  }
+  out.h_ref = h_ref;
+  return rep;
+}
+
+}  // namespace hm::transition_detail

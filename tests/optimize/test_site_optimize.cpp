@@ -1,0 +1,165 @@
+// Properties of the site optimiser (docs/optimization.md): its output is a power diagram
+// again, so every face stays planar, every face between two transition cells stays
+// orthogonal to the segment of their sites, the cavity polygons and the structured grids are
+// untouched, and the result is deterministic; and it does improve Q_S.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "fvcheck/lib/checks.hpp"
+#include "meshgen/core/fv_quality.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+
+using namespace hm;
+
+namespace {
+
+std::vector<double> lattice(double lo, double hi, double h) {
+  std::vector<double> v;
+  const int n = static_cast<int>(std::round((hi - lo) / h));
+  for (int i = 0; i <= n; ++i) v.push_back(lo + (hi - lo) * i / n);
+  return v;
+}
+
+// A small deviated well in 4 m cells (a few hundred transition cells: seconds, not minutes).
+CaseSpec small_case() {
+  CaseSpec cs;
+  cs.name = "site_opt";
+  cs.reservoir.x = lattice(0, 60, 4);
+  cs.reservoir.y = lattice(0, 60, 4);
+  cs.reservoir.z = lattice(1000, 1040, 4);
+  WellSpec w;
+  w.name = "P1";
+  w.trajectory = {{25, 27, 1015}, {35, 33, 1025}};
+  w.radius = 0.1;
+  w.drainage_radius = 4;
+  w.rings = 3;
+  w.sectors = 8;
+  w.segment_length = 4;
+  cs.wells.push_back(w);
+  return cs;
+}
+
+HybridMesh build(const CaseSpec& cs, bool optimize) {
+  PipelineOptions o;
+  o.optimize = optimize;
+  return build_hybrid_mesh(cs, o);
+}
+
+struct Figures {
+  double max_q_p = 0;            // over faces of transition cells (deg)
+  double min_q_o_internal = 90;  // over faces between two transition cells (deg)
+  double mean_q_s = 0;
+  int transition_cells = 0;
+  int skewed_faces = 0;  // OpenFOAM skewness above checkMesh's 4 (faces of transition cells)
+  double max_skewness = 0;
+};
+
+Figures figures(const HybridMesh& h) {
+  const PolyMesh& m = h.mesh;
+  const std::vector<double> q_p = face_planarity(m, h.geometry), q_o = face_orthogonality(m, h.geometry);
+  const std::vector<double> q_s = cell_shape_quality(m, h.cell_h_ref);
+  Figures f;
+  for (int face = 0; face < m.n_faces(); ++face) {
+    const int o = m.face_owner[face], n = m.face_neighbour[face];
+    const bool t_o = m.cell_region[o] == kTransition, t_n = n >= 0 && m.cell_region[n] == kTransition;
+    if (t_o || t_n) f.max_q_p = std::max(f.max_q_p, q_p[face]);
+    if (t_o && t_n) f.min_q_o_internal = std::min(f.min_q_o_internal, q_o[face]);
+  }
+  const std::vector<double> skew = openfoam_face_skewness(m);
+  for (int face = 0; face < m.n_faces(); ++face) {
+    const int o = m.face_owner[face], n = m.face_neighbour[face];
+    if (n < 0 || (m.cell_region[o] != kTransition && m.cell_region[n] != kTransition)) continue;
+    f.max_skewness = std::max(f.max_skewness, skew[face]);
+    f.skewed_faces += skew[face] > 4 ? 1 : 0;
+  }
+  for (int c = 0; c < m.n_cells(); ++c)
+    if (m.cell_region[c] == kTransition) f.mean_q_s += q_s[c], ++f.transition_cells;
+  f.mean_q_s /= std::max(1, f.transition_cells);
+  return f;
+}
+
+TEST(SiteOptimizer, KeepsAPowerDiagramAndImprovesShape) {
+  const CaseSpec cs = small_case();
+  const HybridMesh raw = build(cs, false), opt = build(cs, true);
+  ASSERT_TRUE(opt.optimized);
+  ASSERT_TRUE(opt.build_report.ok);
+  const Figures fr = figures(raw), fo = figures(opt);
+  std::printf("[ figures  ] %d transition cells: mean Q_S %.4f -> %.4f, max Q_P %.3g -> %.3g deg, min internal Q_O "
+              "%.6f -> %.6f deg; skewed faces %d -> %d (max %.3g -> %.3g); %d moves kept of %d\n",
+              fo.transition_cells, fr.mean_q_s, fo.mean_q_s, fr.max_q_p, fo.max_q_p, fr.min_q_o_internal,
+              fo.min_q_o_internal, fr.skewed_faces, fo.skewed_faces, fr.max_skewness, fo.max_skewness, opt.optimize_report.kept, opt.optimize_report.proposed);
+  EXPECT_EQ(fo.transition_cells, fr.transition_cells);  // sites are moved, never removed
+  EXPECT_GT(opt.optimize_report.kept, 0);
+  EXPECT_GT(fo.mean_q_s, fr.mean_q_s);
+  EXPECT_GT(opt.transition_after.q_s.mean, opt.transition_before.q_s.mean);
+  EXPECT_LT(opt.transition_after.vertices, opt.transition_before.vertices);  // removals merge vertices
+  // A power diagram: planar faces (the raw diagram is planar to ~1e-6 deg) and faces between
+  // two transition cells normal to their site segment.
+  EXPECT_LE(fo.max_q_p, 1e-3);
+  EXPECT_GE(fo.min_q_o_internal, 90 - 1e-5);  // asin near 90 deg: ~1e-6 of rounding
+  // Closed, conforming, the domain's volume, every check of fvcheck.
+  const double domain = 60.0 * 60 * 40;  // less the wellbore
+  EXPECT_NEAR(total_volume(opt.geometry), total_volume(raw.geometry), 1e-9 * domain);
+  EXPECT_LT(total_volume(opt.geometry), domain);
+  for (const CheckResult& r :
+       {check_convexity(opt.mesh, opt.geometry), check_conformity(opt.mesh, opt.geometry, {}, &opt.build_report),
+        check_closure(opt.mesh, opt.geometry), check_volume(opt.mesh, opt.geometry),
+        check_orthogonality(opt.mesh, opt.geometry), check_auto_centering(opt.mesh, opt.geometry),
+        check_planarity(opt.mesh, opt.geometry)})
+    EXPECT_TRUE(r.ok()) << r.name << ": " << r.violations << " violations, worst " << r.worst;
+}
+
+TEST(SiteOptimizer, LeavesTheStructuredGridsUntouched) {
+  const CaseSpec cs = small_case();
+  const HybridMesh raw = build(cs, false), opt = build(cs, true);
+  // Reservoir and well cells: same count, same node coordinates, same volumes.
+  std::map<int, std::vector<double>> vol_raw, vol_opt;
+  for (int c = 0; c < raw.mesh.n_cells(); ++c)
+    if (raw.mesh.cell_region[c] != kTransition) vol_raw[raw.mesh.cell_region[c]].push_back(raw.geometry.cell_volume[c]);
+  for (int c = 0; c < opt.mesh.n_cells(); ++c)
+    if (opt.mesh.cell_region[c] != kTransition) vol_opt[opt.mesh.cell_region[c]].push_back(opt.geometry.cell_volume[c]);
+  ASSERT_EQ(vol_raw.size(), vol_opt.size());
+  for (const auto& [region, v] : vol_raw) {
+    ASSERT_EQ(v.size(), vol_opt[region].size()) << "region " << region;
+    for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], vol_opt[region][i]) << "region " << region << " cell " << i;
+  }
+}
+
+TEST(SiteOptimizer, IsDeterministic) {
+  const CaseSpec cs = small_case();
+  const HybridMesh a = build(cs, true), b = build(cs, true);
+  ASSERT_EQ(a.mesh.n_nodes(), b.mesh.n_nodes());
+  ASSERT_EQ(a.mesh.face_nodes, b.mesh.face_nodes);
+  for (int v = 0; v < a.mesh.n_nodes(); ++v) {
+    EXPECT_EQ(a.mesh.nodes[v].x, b.mesh.nodes[v].x);
+    EXPECT_EQ(a.mesh.nodes[v].y, b.mesh.nodes[v].y);
+    EXPECT_EQ(a.mesh.nodes[v].z, b.mesh.nodes[v].z);
+  }
+}
+
+// The fail half: the planarity and orthogonality measures used above do see a bent face
+// (one node of a transition face moved off its plane), so passing them means something.
+TEST(SiteOptimizer, MeasuresSeeABentFace) {
+  const CaseSpec cs = small_case();
+  HybridMesh h = build(cs, true);
+  int face = -1;
+  for (int f = 0; f < h.mesh.n_faces() && face < 0; ++f) {
+    const int o = h.mesh.face_owner[f], n = h.mesh.face_neighbour[f];
+    if (n >= 0 && h.mesh.cell_region[o] == kTransition && h.mesh.cell_region[n] == kTransition && h.mesh.face_size(f) >= 4)
+      face = f;
+  }
+  ASSERT_GE(face, 0);
+  const int32_t v = h.mesh.face_begin(face)[0];
+  h.geometry = compute_geometry(h.mesh);
+  const Vec3 n = h.geometry.face_area[face] / norm(h.geometry.face_area[face]);
+  const double size = std::sqrt(norm(h.geometry.face_area[face]));
+  h.mesh.nodes[v] += 0.2 * size * n;
+  h.geometry = compute_geometry(h.mesh);
+  const Figures f = figures(h);
+  EXPECT_GT(f.max_q_p, 1.0);
+  EXPECT_LT(f.min_q_o_internal, 90 - 1e-3);
+}
+
+}  // namespace
