@@ -1,6 +1,7 @@
-// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [--export vtu,eclipse,openfoam]
+// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam]
 // Exit codes: 0 success, 1 meshing failure, 2 bad input or arguments.
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -21,7 +22,8 @@ namespace {
 
 int usage(const std::string& why) {
   std::cerr << "meshgen: " << why << "\n"
-            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [--export vtu,eclipse,openfoam]\n"
+            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam]\n"
+            << "  -j N: at most N cavities meshed and optimised at once (default: every core)\n"
             << "  mesh.vtu, summary.json and cavity_K.obj are always written; --export adds\n"
             << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n";
   return 2;
@@ -40,6 +42,12 @@ int main(int argc, char** argv) {
       out_dir = argv[i];
     } else if (a == "--no-optimize") {
       opts.optimize = false;
+    } else if (a == "-j" || a == "--jobs") {
+      if (++i >= argc) return usage("-j needs a number of threads");
+      char* end = nullptr;
+      const long j = std::strtol(argv[i], &end, 10);
+      if (!end || *end != '\0' || j < 1 || j > 1024) return usage("-j: expected a number of threads in [1, 1024], got '" + std::string(argv[i]) + "'");
+      opts.threads = static_cast<int>(j);
     } else if (a == "--no-transition") {
       opts.build_transition = false;
     } else if (a == "--export") {

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <future>
+#include <exception>
 #include <set>
 #include <stdexcept>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace hm {
 
@@ -156,23 +159,33 @@ HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions&
         throw std::runtime_error("cavity " + std::to_string(k) + ": boundary is not a closed 2-manifold: " + problems[0]);
     }
     if (!opts.build_transition) break;
-    // Cavities are independent, so they are built concurrently; results are used in
-    // cavity order, so the output does not depend on scheduling.
+    // Cavities are independent, so they are built (and optimised) concurrently; results are
+    // used in cavity order, so the output does not depend on scheduling or on opts.threads.
     TransitionOptions topts;
     topts.optimize = opts.optimize && cs.transition.optimize;
     topts.g_remove = cs.transition.gamma[1];
     topts.g_expand = cs.transition.gamma[2];
-    std::vector<std::future<TransitionCells>> jobs;
-    for (const Cavity& cav : out.cavities.cavities)
-      jobs.push_back(std::async(std::launch::async, [&, cavp = &cav] {
-        return build_transition(*cavp, coords, out.grid, out.blocks, base, topts);
-      }));
+    // At most opts.threads at once (0: every core); each result lands in its cavity's slot.
+    const size_t n_cav = out.cavities.cavities.size();
+    std::vector<TransitionCells> built(n_cav);
+    std::vector<std::exception_ptr> failed(n_cav);
+    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+      tbb::parallel_for(size_t(0), n_cav, [&](size_t k) {
+        try {
+          built[k] = build_transition(out.cavities.cavities[k], coords, out.grid, out.blocks, base, topts);
+        } catch (...) {
+          failed[k] = std::current_exception();
+        }
+      });
+    });
     transitions.clear();
     std::vector<int32_t> more;
     std::string first_error;
-    for (auto& j : jobs) {
+    for (size_t k = 0; k < n_cav; ++k) {
       try {
-        transitions.push_back(j.get());
+        if (failed[k]) std::rethrow_exception(failed[k]);
+        transitions.push_back(std::move(built[k]));
       } catch (const TransitionError& e) {
         if (first_error.empty()) first_error = e.what();
         more.insert(more.end(), e.cells_to_deactivate.begin(), e.cells_to_deactivate.end());

@@ -19,6 +19,7 @@ namespace hm {
 struct PipelineOptions {
   bool build_transition = true;  ///< false: stop after the cavities (the mesh then has open cavity faces)
   bool optimize = true;          ///< run the small-edge optimisation when the case asks for it
+  int threads = 0;               ///< cavities built at once (meshgen -j); 0: every core
 };
 
 /// The paper's Table 1 and 2 quantities for the transition cells of a mesh.

@@ -37,6 +37,7 @@ struct Move {
   SiteState before, after;
   std::vector<int> region;  // cells
   bool removal = false;
+  bool skew = false;  // a step against a skewed face
   // The edge (power-sphere site quadruples of its ends; a constrained node as {-1,-1,-1,id})
   // and the site tried on it: a move refused once is not tried again.
   std::array<int, 9> tag{};
@@ -76,6 +77,25 @@ bool centred(const SiteSet& set, int s) {
   return true;
 }
 
+// Per cell: its faces shared with another transition cell whose OpenFOAM skewness exceeds
+// checkMesh's limit (exact on the submesh: both cell centroids are there).
+std::vector<int> skewed_faces_of_cells(const PolyMesh& sub, std::vector<int>* skewed_faces = nullptr) {
+  const std::vector<double> sk = openfoam_face_skewness(sub);
+  std::vector<int> per_cell(sub.n_cells(), 0);
+  std::vector<std::pair<double, int>> worst;
+  for (int f = 0; f < sub.n_faces(); ++f)
+    if (sub.face_neighbour[f] >= 0 && sk[f] > kOpenFoamSkewnessLimit) {
+      ++per_cell[sub.face_owner[f]], ++per_cell[sub.face_neighbour[f]];
+      worst.push_back({-sk[f], f});
+    }
+  std::sort(worst.begin(), worst.end());
+  if (skewed_faces) {
+    skewed_faces->clear();
+    for (const auto& w : worst) skewed_faces->push_back(w.second);
+  }
+  return per_cell;
+}
+
 class SiteOptimizer {
  public:
   SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -84,7 +104,9 @@ class SiteOptimizer {
       : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt) {}
 
   // One round on `out` (a valid diagram of set_): true if some move was kept.
-  bool round(TransitionCells& out, SiteOptimizeReport& rep);
+  // skew_only: only steps against skewed faces. Sets skewed_left() to the count on entry.
+  bool round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only);
+  int skewed_left() const { return skewed_left_; }
 
  private:
   Vec3 node(const TransitionCells& t, int32_t v) const {
@@ -103,6 +125,9 @@ class SiteOptimizer {
   // The move of site d (or of its partner) that puts the power vertex it shares with
   // reference site a at x; false if it leaves the admissible range. Changes nothing.
   bool trial_move(int d, int a, Vec3 x, double max_shift, Move* m);
+  // A step of site s: a polygon site toward (or away from) its polygon by the correction's
+  // factor, a free site toward (or away from) `other` by a tenth of their distance.
+  bool trial_step(int s, int other, bool away, Move* m);
 
   SiteSet& set_;
   const Cavity& cavity_;
@@ -111,6 +136,7 @@ class SiteOptimizer {
   const std::vector<double>& h_ref_;
   const TransitionOptions& opt_;
   std::set<std::array<int, 9>> refused_;
+  int skewed_left_ = 0;
 };
 
 bool SiteOptimizer::rebuild(TransitionCells& fresh, int32_t base) const {
@@ -162,10 +188,35 @@ bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, Move* m) 
   return ok;
 }
 
-bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep) {
+bool SiteOptimizer::trial_step(int s, int other, bool away, Move* m) {
+  const Site& site = set_.sites[s];
+  m->site = s;
+  m->before = state(s);
+  if (site.kind == SiteKind::InternalPolygon) {
+    const int q = site.polygon;
+    constexpr double kStep = 0.8;
+    const double t = away ? std::min(site.t / kStep, max_t(set_, q, frames_)) : std::max(site.t * kStep, min_t(frames_, q));
+    if (!(std::abs(t - site.t) > 1e-3 * site.t)) return false;
+    place_polygon_site(set_, s, t, cavity_, coords_, frames_);
+  } else if (site.kind == SiteKind::Free) {
+    const Vec3 d = site.p - set_.sites[other].p;
+    set_.sites[s].p = site.p + (away ? 0.1 : -0.1) * d;
+  } else {
+    return false;
+  }
+  const bool ok = centred(set_, s);
+  m->after = state(s);
+  restore(s, m->before);
+  return ok;
+}
+
+bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only) {
   std::vector<int32_t> global;
   const PolyMesh sub = transition_submesh(out, coords_, &global);
   const std::vector<double> qs = cell_shape_quality(sub, h_ref_);
+  std::vector<int> skewed_faces;
+  const std::vector<int> skewed = skewed_faces_of_cells(sub, &skewed_faces);
+  skewed_left_ = static_cast<int>(skewed_faces.size());
   const int nc = sub.n_cells();
   // node -> cells and edge -> cells over local node ids (sorted incidence lists)
   std::vector<std::pair<int32_t, int32_t>> node_cell;
@@ -235,7 +286,33 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep) {
 
   std::vector<char> locked(ns, 0), moved(ns, 0);
   std::vector<Move> moves;
+  auto admit = [&](Move& m) {
+    m.region = region_of(m.site);
+    for (int c : m.region)
+      if (moved[out.cell_site[c]]) return;
+    restore(m.site, m.after);
+    moved[m.site] = 1;
+    for (int c : m.region) locked[out.cell_site[c]] = 1;
+    locked[m.site] = 1;
+    moves.push_back(m);
+  };
+  // Skewed faces first, worst first: one of their two sites moves a step (toward or away from
+  // its polygon, or from the other site), kept if the cells around have fewer skewed faces.
+  for (int f : skewed_faces) {
+    const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
+    if (moved[s1] || moved[s2] || locked[s1] || locked[s2]) continue;
+    Move best;
+    for (int k = 0; k < 4 && best.site < 0; ++k) {
+      const int s = k < 2 ? s1 : s2, other = k < 2 ? s2 : s1;
+      Move m;
+      m.tag = {-2, s, other, k % 2, 0, 0, 0, 0, 0};
+      m.skew = true;
+      if (!refused_.count(m.tag) && trial_step(s, other, k % 2 == 1, &m)) best = m;
+    }
+    if (best.site >= 0) admit(best);
+  }
   for (const Candidate& e : cand) {
+    if (skew_only) break;
     std::vector<int> around;  // sites of the cells around the edge
     for (size_t k = e.first; k < e.last; ++k) around.push_back(out.cell_site[edge_cell[k][2]]);
     bool busy = false;
@@ -268,16 +345,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep) {
         if (shift < best_shift) best = m, best_shift = shift;
       }
     }
-    if (best.site < 0) continue;
-    best.region = region_of(best.site);
-    bool clash = false;
-    for (int c : best.region) clash = clash || moved[out.cell_site[c]];
-    if (clash) continue;
-    restore(best.site, best.after);
-    moved[best.site] = 1;
-    for (int c : best.region) locked[out.cell_site[c]] = 1;
-    locked[best.site] = 1;
-    moves.push_back(best);
+    if (best.site >= 0) admit(best);
   }
   rep.proposed += static_cast<int>(moves.size());
   if (moves.empty()) return false;
@@ -299,12 +367,18 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep) {
   moves.resize(keep);
   // Keep a move only if the Q_S of the cells it touches improves (sum over its region).
   std::vector<int32_t> g2;
-  const std::vector<double> qs2 = cell_shape_quality(transition_submesh(fresh, coords_, &g2), h_ref_);
+  const PolyMesh sub2 = transition_submesh(fresh, coords_, &g2);
+  const std::vector<double> qs2 = cell_shape_quality(sub2, h_ref_);
+  const std::vector<int> skewed2 = skewed_faces_of_cells(sub2);
   std::vector<Move> kept;
   for (const Move& m : moves) {
     double before = 0, after = 0;
-    for (int c : m.region) before += qs[c], after += qs2[c];
-    if (after > before + 1e-12) kept.push_back(m);
+    int skew_before = 0, skew_after = 0;
+    for (int c : m.region) before += qs[c], after += qs2[c], skew_before += skewed[c], skew_after += skewed2[c];
+    // A step against skewness must lower it; a short-edge move must raise Q_S without adding
+    // a skewed face.
+    const bool better = m.skew ? skew_after < skew_before : skew_after <= skew_before && after > before + 1e-12;
+    if (better) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
   rep.refused += static_cast<int>(moves.size() - kept.size());
@@ -323,6 +397,8 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep) {
 
 }  // namespace
 
+constexpr int kSkewRounds = 4;
+
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                                   TransitionCells& out) {
@@ -331,7 +407,12 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
   SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt);
   while (rep.rounds < opt.max_rounds) {
     ++rep.rounds;
-    if (!optimizer.round(out, rep)) break;
+    if (!optimizer.round(out, rep, false)) break;
+  }
+  // Faces above checkMesh's skewness limit left: a few more rounds against them alone.
+  for (int extra = 0; extra < kSkewRounds; ++extra) {
+    ++rep.rounds;
+    if (!optimizer.round(out, rep, true) || optimizer.skewed_left() == 0) break;
   }
   out.h_ref = h_ref;
   return rep;
