@@ -79,13 +79,18 @@ bool centred(const SiteSet& set, int s) {
 
 // Per cell: its faces shared with another transition cell whose OpenFOAM skewness exceeds
 // checkMesh's limit (exact on the submesh: both cell centroids are there).
-std::vector<int> skewed_faces_of_cells(const PolyMesh& sub, std::vector<int>* skewed_faces = nullptr) {
+// Also (max_skew) the largest such skewness per cell, 0 if none is above the limit.
+std::vector<int> skewed_faces_of_cells(const PolyMesh& sub, std::vector<int>* skewed_faces = nullptr,
+                                       std::vector<double>* max_skew = nullptr) {
   const std::vector<double> sk = openfoam_face_skewness(sub);
   std::vector<int> per_cell(sub.n_cells(), 0);
+  if (max_skew) max_skew->assign(sub.n_cells(), 0.0);
   std::vector<std::pair<double, int>> worst;
   for (int f = 0; f < sub.n_faces(); ++f)
     if (sub.face_neighbour[f] >= 0 && sk[f] > kOpenFoamSkewnessLimit) {
       ++per_cell[sub.face_owner[f]], ++per_cell[sub.face_neighbour[f]];
+      if (max_skew)
+        for (int c : {sub.face_owner[f], sub.face_neighbour[f]}) (*max_skew)[c] = std::max((*max_skew)[c], sk[f]);
       worst.push_back({-sk[f], f});
     }
   std::sort(worst.begin(), worst.end());
@@ -126,8 +131,10 @@ class SiteOptimizer {
   // reference site a at x; false if it leaves the admissible range. Changes nothing.
   bool trial_move(int d, int a, Vec3 x, double max_shift, Move* m);
   // A step of site s: a polygon site toward (or away from) its polygon by the correction's
-  // factor, a free site toward (or away from) `other` by a tenth of their distance.
-  bool trial_step(int s, int other, bool away, Move* m);
+  // factor 0.95 (size 2: 0.8), a free site toward (or away from) `other` by a tenth (a fifth)
+  // of their distance. Small steps first: sites left by the correction at the edge of
+  // condition (6) only allow those.
+  bool trial_step(int s, int other, bool away, int size, Move* m);
 
   SiteSet& set_;
   const Cavity& cavity_;
@@ -188,19 +195,19 @@ bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, Move* m) 
   return ok;
 }
 
-bool SiteOptimizer::trial_step(int s, int other, bool away, Move* m) {
+bool SiteOptimizer::trial_step(int s, int other, bool away, int size, Move* m) {
   const Site& site = set_.sites[s];
   m->site = s;
   m->before = state(s);
   if (site.kind == SiteKind::InternalPolygon) {
     const int q = site.polygon;
-    constexpr double kStep = 0.8;
+    const double kStep = size == 1 ? 0.95 : 0.8;
     const double t = away ? std::min(site.t / kStep, max_t(set_, q, frames_)) : std::max(site.t * kStep, min_t(frames_, q));
     if (!(std::abs(t - site.t) > 1e-3 * site.t)) return false;
     place_polygon_site(set_, s, t, cavity_, coords_, frames_);
   } else if (site.kind == SiteKind::Free) {
     const Vec3 d = site.p - set_.sites[other].p;
-    set_.sites[s].p = site.p + (away ? 0.1 : -0.1) * d;
+    set_.sites[s].p = site.p + (away ? 0.1 : -0.1) * size * d;
   } else {
     return false;
   }
@@ -215,7 +222,8 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   const PolyMesh sub = transition_submesh(out, coords_, &global);
   const std::vector<double> qs = cell_shape_quality(sub, h_ref_);
   std::vector<int> skewed_faces;
-  const std::vector<int> skewed = skewed_faces_of_cells(sub, &skewed_faces);
+  std::vector<double> max_skew, max_skew2;
+  const std::vector<int> skewed = skewed_faces_of_cells(sub, &skewed_faces, &max_skew);
   skewed_left_ = static_cast<int>(skewed_faces.size());
   const int nc = sub.n_cells();
   // node -> cells and edge -> cells over local node ids (sorted incidence lists)
@@ -302,12 +310,13 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
     if (moved[s1] || moved[s2] || locked[s1] || locked[s2]) continue;
     Move best;
-    for (int k = 0; k < 4 && best.site < 0; ++k) {
-      const int s = k < 2 ? s1 : s2, other = k < 2 ? s2 : s1;
+    // Small steps of either site in either direction first, then larger ones.
+    for (int k = 0; k < 8 && best.site < 0; ++k) {
+      const int s = k % 4 < 2 ? s1 : s2, other = k % 4 < 2 ? s2 : s1;
       Move m;
-      m.tag = {-2, s, other, k % 2, 0, 0, 0, 0, 0};
+      m.tag = {-2, s, other, k, 0, 0, 0, 0, 0};
       m.skew = true;
-      if (!refused_.count(m.tag) && trial_step(s, other, k % 2 == 1, &m)) best = m;
+      if (!refused_.count(m.tag) && trial_step(s, other, k % 2 == 1, k < 4 ? 1 : 2, &m)) best = m;
     }
     if (best.site >= 0) admit(best);
   }
@@ -369,15 +378,20 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   std::vector<int32_t> g2;
   const PolyMesh sub2 = transition_submesh(fresh, coords_, &g2);
   const std::vector<double> qs2 = cell_shape_quality(sub2, h_ref_);
-  const std::vector<int> skewed2 = skewed_faces_of_cells(sub2);
+  const std::vector<int> skewed2 = skewed_faces_of_cells(sub2, nullptr, &max_skew2);
   std::vector<Move> kept;
   for (const Move& m : moves) {
     double before = 0, after = 0;
     int skew_before = 0, skew_after = 0;
-    for (int c : m.region) before += qs[c], after += qs2[c], skew_before += skewed[c], skew_after += skewed2[c];
-    // A step against skewness must lower it; a short-edge move must raise Q_S without adding
-    // a skewed face.
-    const bool better = m.skew ? skew_after < skew_before : skew_after <= skew_before && after > before + 1e-12;
+    double worst_before = 0, worst_after = 0;
+    for (int c : m.region) {
+      before += qs[c], after += qs2[c], skew_before += skewed[c], skew_after += skewed2[c];
+      worst_before = std::max(worst_before, max_skew[c]), worst_after = std::max(worst_after, max_skew2[c]);
+    }
+    // A step against skewness must lower the count of skewed faces around, or their worst
+    // skewness; a short-edge move must raise Q_S without adding a skewed face.
+    const bool better = m.skew ? skew_after < skew_before || (skew_after == skew_before && worst_after < worst_before)
+                               : skew_after <= skew_before && after > before + 1e-12;
     if (better) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
@@ -397,7 +411,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
 
 }  // namespace
 
-constexpr int kSkewRounds = 4;
+constexpr int kSkewRounds = 8;
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
