@@ -150,6 +150,7 @@ int main(int argc, char** argv) {
     const pid_t pid = fork();
     if (pid == 0) {
       run_case(n);
+      std::fflush(stdout);
       std::_Exit(0);
     }
     int status = 0;
