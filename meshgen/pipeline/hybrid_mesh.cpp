@@ -189,11 +189,23 @@ HybridMesh build_hybrid_mesh(const CaseSpec& input, const PipelineOptions& opts)
       if (enlargements.empty()) throw;
       // Else the latest enlargements ran into it (e.g. the reservoir boundary): those cavities
       // get flat ends where they may, or the transition's refusal stands (not the input's).
+      // Which of them: those without which the cavities can be built (all, if none alone is).
       const int last = enlargements.back().round;
-      std::vector<Enlargement> latest;
+      std::vector<Enlargement> latest, culprits;
       for (const Enlargement& en : enlargements)
         if (en.round == last) latest.push_back(en);
-      for (const Enlargement& en : latest) {
+      for (size_t i = 0; i < latest.size() && latest.size() > 1; ++i) {
+        std::vector<int32_t> others;
+        for (const Enlargement& en : enlargements)
+          if (!(en.round == last && en.wells == latest[i].wells)) others.insert(others.end(), en.cells.begin(), en.cells.end());
+        try {
+          build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, others);
+          culprits.push_back(latest[i]);
+        } catch (const InputError&) {
+        }
+      }
+      if (culprits.empty()) culprits = latest;
+      for (const Enlargement& en : culprits) {
         const std::string why = en.reason + " (the cavity was enlarged for it: " + e.what() + ")";
         if (!flatten(en.wells, why))
           throw MeshingError("transition", en.wells,
@@ -233,7 +245,7 @@ HybridMesh build_hybrid_mesh(const CaseSpec& input, const PipelineOptions& opts)
           c.wells.clear();  // used
           break;
         }
-      if (!outcomes[k])
+      if (!outcomes[k] && ++out.transition_builds)
         jobs[k] = std::async(std::launch::async, [&, cavp = &cav] {
           return try_build_transition(*cavp, coords, out.grid, out.blocks, base);
         });

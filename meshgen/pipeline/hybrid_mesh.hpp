@@ -49,6 +49,7 @@ struct HybridMesh {
   TransitionQuality transition_after;   ///< after optimisation (when optimized)
   bool optimized = false;
   OptimizeReport optimize_report;
+  int transition_builds = 0;         ///< transition meshes built, all cavities and rounds (refused ones too)
   SelfCheck self_check;              ///< the checks of the finished mesh (ok, or the job threw)
   std::vector<std::string> notes;    ///< every automatic change made to the input (sectors, dilation, ...)
   std::vector<std::pair<std::string, double>> timings_s;  ///< stage name -> seconds, in stage order

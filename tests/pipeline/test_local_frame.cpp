@@ -136,3 +136,44 @@ TEST(LocalFrame, TranslateMeshMovesPositionsOnly) {
   EXPECT_EQ(h.mesh.face_nodes, before.face_nodes);
   for (int c = 0; c < before.n_cells(); ++c) EXPECT_TRUE(h.mesh.cell_perm[c] == before.cell_perm[c]);
 }
+
+// The self-check is a pass/fail pair on one mesh: the box meshes and passes; a node moved off
+// its faces' planes fails (planarity: its faces bend by far more than 15 degrees), a NaN
+// permeability fails "finite" (the cell and, through the NaN transmissibility of their shared
+// face, its neighbour); each failure names the check and the cells.
+TEST(SelfCheck, PassesAGoodMeshAndNamesWhatFailsInABadOne) {
+  CaseSpec cs;
+  cs.name = "box";
+  cs.reservoir.x = {0, 1, 3};
+  cs.reservoir.y = {0, 2};
+  cs.reservoir.z = {0, 1};
+  const HybridMesh h = build_hybrid_mesh(cs);
+  EXPECT_TRUE(h.self_check.ok()) << h.self_check.message;
+  EXPECT_TRUE(self_check(h.mesh, h.geometry, h.build_report, h.cell_cavity, {}, cs).ok());
+
+  PolyMesh dented = h.mesh;
+  // Node at (1, 0, 0) is shared by both cells: pushing it inward (in x and y) dents both.
+  int moved = -1;
+  for (int v = 0; v < dented.n_nodes(); ++v)
+    if (dented.nodes[v] == Vec3({1, 0, 0})) moved = v;
+  ASSERT_GE(moved, 0);
+  dented.nodes[moved] = {1.3, 0.4, 0.3};
+  const SelfCheck bad = self_check(dented, compute_geometry(dented), h.build_report, h.cell_cavity, {}, cs);
+  ASSERT_FALSE(bad.ok());
+  bool planarity = false;
+  for (const SelfCheckFailure& f : bad.failures) {
+    planarity = planarity || f.check == "planarity";
+    EXPECT_FALSE(f.cells.empty()) << f.check;
+  }
+  EXPECT_TRUE(planarity) << bad.message;
+  EXPECT_EQ(bad.message.rfind("self-check: the mesh fails ", 0), 0u) << bad.message;
+
+  PolyMesh nan_perm = h.mesh;
+  nan_perm.cell_perm[1].x = std::nan("");
+  const SelfCheck nan = self_check(nan_perm, h.geometry, h.build_report, h.cell_cavity, {}, cs);
+  ASSERT_EQ(nan.failures.size(), 1u);
+  EXPECT_EQ(nan.failures[0].check, "finite");
+  EXPECT_EQ(nan.failures[0].cells, (std::vector<int32_t>{0, 1}));
+  EXPECT_NE(nan.message.find("finite (2 cells: cell 0 (reservoir 0,0,0), 1 (reservoir 1,0,0))"), std::string::npos)
+      << nan.message;
+}
