@@ -277,7 +277,13 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
     const std::string cell = f.path("grdecl") + ": cell " + std::to_string(c);
     require(r.cell_poro[c] > 0 && r.cell_poro[c] <= 1, cell, "porosity x NTG must be in (0, 1], got " + fmt(r.cell_poro[c]));
     require(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0, cell, "permeability must be > 0");
+    for (double k : {r.cell_permx[c], r.cell_permy[c], r.cell_permz[c]})
+      require(k >= kMinPermeability && k <= kMaxPermeability, cell,
+              "permeability must be in [" + fmt(kMinPermeability) + ", " + fmt(kMaxPermeability) + "] mD, got " + fmt(k) +
+                  " (docs/case-format.md, Limits)");
   }
+  for (const auto* axis : {&r.x, &r.y, &r.z})
+    for (double v : *axis) require_coordinate(v, f.path("grdecl"));
   r.grdecl = path;
   if (model.has_mapaxes) {
     r.has_map_axes = true;

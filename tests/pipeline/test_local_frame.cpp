@@ -122,17 +122,19 @@ TEST(LocalFrame, TranslateMeshMovesPositionsOnly) {
   cs.reservoir.y = {20, 22};
   cs.reservoir.z = {100, 101};
   EXPECT_EQ(case_origin(cs).x, 10.0);
-  EXPECT_EQ(case_origin(cs).z, 100.0);
+  EXPECT_EQ(case_origin(cs).y, 20.0);
+  EXPECT_EQ(case_origin(cs).z, 0.0);  // depth is not moved
   const CaseSpec local = translated_case(cs, -case_origin(cs));
   EXPECT_EQ(local.reservoir.x, (std::vector<double>{0, 1, 3}));
   EXPECT_EQ(local.reservoir.y, (std::vector<double>{0, 2}));
+  EXPECT_EQ(local.reservoir.z, (std::vector<double>{100, 101}));
   HybridMesh h = build_hybrid_mesh(local);
   const PolyMesh before = h.mesh;
   translate_mesh(h.mesh, case_origin(cs));
   ASSERT_EQ(h.mesh.n_nodes(), before.n_nodes());
-  for (int v = 0; v < before.n_nodes(); ++v) EXPECT_TRUE(h.mesh.nodes[v] == before.nodes[v] + Vec3({10, 20, 100}));
+  for (int v = 0; v < before.n_nodes(); ++v) EXPECT_TRUE(h.mesh.nodes[v] == before.nodes[v] + Vec3({10, 20, 0}));
   for (int c = 0; c < before.n_cells(); ++c)
-    EXPECT_TRUE(h.mesh.cell_fv_center[c] == before.cell_fv_center[c] + Vec3({10, 20, 100}));
+    EXPECT_TRUE(h.mesh.cell_fv_center[c] == before.cell_fv_center[c] + Vec3({10, 20, 0}));
   EXPECT_EQ(h.mesh.face_nodes, before.face_nodes);
   for (int c = 0; c < before.n_cells(); ++c) EXPECT_TRUE(h.mesh.cell_perm[c] == before.cell_perm[c]);
 }
