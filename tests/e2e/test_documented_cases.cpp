@@ -136,3 +136,27 @@ TEST(DocumentedCases, FieldCoordinatesAreWrittenAtFullPrecision) {
   const std::string deck = hm_test::slurp(dir / "b/eclipse/MY_CASE.DATA") + hm_test::slurp(dir / "b/eclipse/MY_CASE_GRID.GRDECL");
   EXPECT_NE(deck.find("452105 6780110 "), std::string::npos) << "COORD does not hold the field coordinates";
 }
+
+// A mesh that fails the self-check is never written with exit 0 (issue: the bend of
+// examples/paper_single_well.yaml raised to 110 degrees exited 0 and fvcheck failed the mesh with 8
+// non-convex cells): exit 1, the stage, the cells and the well named, no mesh.vtu.
+TEST(DocumentedCases, ABendTheTransitionCannotHoldIsRefusedNotWritten) {
+  const fs::path dir = hm_test::fresh_dir("bend110");
+  hm_test::RemoveAtExit cleanup{dir};
+  std::string text = hm_test::slurp(fs::path(HM_SOURCE_DIR) / "examples/paper_single_well.yaml");
+  const std::string leg = "[222.981, 200, 1059.284]";  // 30 m at 50 degrees from the vertical
+  const size_t at = text.find(leg);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, leg.size(), "[228.190779, 200, 1029.739396]");  // 30 m at 110 degrees
+  {
+    std::ofstream(dir / "bend110.yaml") << text;
+  }
+  const auto r = hm_test::run_command(meshgen() + hm_test::q(dir / "bend110.yaml") + " -o " + hm_test::q(dir / "out"));
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("meshing failed at stage self-check: self-check: the mesh fails convexity"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("(transition, cavity 0)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("at wells[0] (P1)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out/mesh.vtu"));
+  EXPECT_FALSE(fs::exists(dir / "out/summary.json"));
+}
