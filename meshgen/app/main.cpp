@@ -1,9 +1,11 @@
 // meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam]
-// Exit codes: 0 success, 1 meshing failure, 2 bad input or arguments.
+// Exit codes: 0 success, 1 meshing failure (a stage, wells named; a mesh that fails the
+// self-check is never written), 2 bad input or arguments.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "exporters/eclipse/eclipse_deck.hpp"
@@ -14,6 +16,7 @@
 #include "meshgen/core/cli.hpp"
 #include "meshgen/core/text_file.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "meshgen/pipeline/summary.hpp"
 
 namespace fs = std::filesystem;
@@ -73,26 +76,48 @@ int main(int argc, char** argv) {
 
   hm::CaseSpec cs;
   hm::HybridMesh result;
+  hm::Vec3 origin;
   try {
     cs = hm::load_case(case_path);
     if (const std::string why = hm::create_output_directory(out_dir); !why.empty()) {
       std::cerr << "meshgen: " << why << "\n";
       return 2;
     }
-    result = hm::build_hybrid_mesh(cs, opts);
+    // Mesh in the local frame (local_frame.hpp); the user's coordinates come back when writing.
+    origin = hm::case_origin(cs);
+    result = hm::build_hybrid_mesh(hm::translated_case(cs, -origin), opts);
   } catch (const hm::InputError& e) {
     std::cerr << "meshgen: " << e.what() << "\n";
     return 2;
+  } catch (const hm::MeshingError& e) {
+    std::cerr << "meshgen: meshing failed at stage " << e.stage << ": " << e.what() << "\n";
+    return 1;
   } catch (const std::exception& e) {
-    std::cerr << "meshgen: meshing failed: " << e.what() << "\n";
+    std::cerr << "meshgen: meshing failed (internal error, not caused by the input): " << e.what() << "\n";
     return 1;
   }
+
+  // Everything that depends only on the mesh's shape is computed in the local frame, then the
+  // mesh moves to the user's coordinates for the writers.
+  const hm::PolyMesh& m = result.mesh;
+  // write_vtu adds the mesh's own per-cell data (region, FV centre, ijk, rock, radial structure).
+  const std::vector<hm::VtuCellArray> extra = {
+      hm::VtuCellArray::int32("cavity", 1, result.cell_cavity),
+      hm::VtuCellArray::real("volume", 1, result.geometry.cell_volume),
+      hm::VtuCellArray::real("h_ref", 1, result.cell_h_ref),
+      hm::VtuCellArray::real("Q_S", 1, hm::cell_shape_quality(m, result.cell_h_ref)),
+      hm::VtuCellArray::real("Q_O", 1, hm::cell_min_of_faces(m, hm::face_orthogonality(m, result.geometry))),
+      hm::VtuCellArray::real("Q_P", 1, hm::cell_max_of_faces(m, hm::face_planarity(m, result.geometry)))};
+  std::optional<hm::Transmissibilities> trans;
+  if (export_eclipse) trans = hm::compute_transmissibilities(result.mesh, result.geometry);
+  const nlohmann::json summary = hm::make_summary(cs, result);
+  hm::translate_mesh(result.mesh, origin);
 
   const fs::path out(out_dir);
   std::vector<std::string> written;
   for (size_t k = 0; k < result.cavities.cavities.size(); ++k) {
     const fs::path p = out / ("cavity_" + std::to_string(k) + ".obj");
-    if (!hm::write_cavity_surface(result.cavities.cavities[k], result.cavity_node_coords, p.string())) {
+    if (!hm::write_cavity_surface(result.cavities.cavities[k], result.cavity_node_coords, p.string(), origin)) {
       std::cerr << "meshgen: cannot write '" << p.string() << "'\n";
       return 2;
     }
@@ -100,15 +125,6 @@ int main(int argc, char** argv) {
   }
   {
     // mesh.vtu: the hybrid mesh with its FV data and per-cell quality for ParaView.
-    const hm::PolyMesh& m = result.mesh;
-    // write_vtu adds the mesh's own per-cell data (region, FV centre, ijk, rock, radial structure).
-    const std::vector<hm::VtuCellArray> extra = {
-        hm::VtuCellArray::int32("cavity", 1, result.cell_cavity),
-        hm::VtuCellArray::real("volume", 1, result.geometry.cell_volume),
-        hm::VtuCellArray::real("h_ref", 1, result.cell_h_ref),
-        hm::VtuCellArray::real("Q_S", 1, hm::cell_shape_quality(m, result.cell_h_ref)),
-        hm::VtuCellArray::real("Q_O", 1, hm::cell_min_of_faces(m, hm::face_orthogonality(m, result.geometry))),
-        hm::VtuCellArray::real("Q_P", 1, hm::cell_max_of_faces(m, hm::face_planarity(m, result.geometry)))};
     const fs::path p = out / "mesh.vtu";
     const hm::WriteStatus st = hm::write_vtu(p.string(), m, extra);
     if (!st.ok) {
@@ -118,10 +134,9 @@ int main(int argc, char** argv) {
     written.push_back(p.string());
   }
   if (export_eclipse) {
-    const hm::Transmissibilities trans = hm::compute_transmissibilities(result.mesh, result.geometry);
     hm::EclipseDeckInfo info;
     const hm::WriteStatus st =
-        hm::write_eclipse_deck((out / "eclipse").string(), cs, result.mesh, result.geometry, trans, {}, &info);
+        hm::write_eclipse_deck((out / "eclipse").string(), cs, result.mesh, result.geometry, *trans, {}, &info);
     if (!st.ok) {
       std::cerr << "meshgen: " << st.message << "\n";
       return 2;
@@ -141,7 +156,6 @@ int main(int argc, char** argv) {
     }
     written.push_back((out / "openfoam").string() + "/");
   }
-  const nlohmann::json summary = hm::make_summary(cs, result);
   std::string error;
   if (!hm::write_text_file((out / "summary.json").string(), summary.dump(2) + "\n", &error)) {
     std::cerr << "meshgen: " << error << "\n";

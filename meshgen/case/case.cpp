@@ -83,6 +83,10 @@ std::string fmt6(double v) {
   const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 6);
   return std::string(buf, r.ptr);
 }
+void require_coordinate(double v, const std::string& path) {
+  if (!(std::abs(v) <= kMaxAbsCoordinate))
+    fail(path, "coordinates must be within +-" + fmt(kMaxAbsCoordinate) + " m (docs/case-format.md, Limits)");
+}
 std::string fmt_count(double v) {
   return v < 1e15 ? std::to_string(static_cast<long long>(v)) : fmt6(v);
 }
@@ -245,6 +249,7 @@ std::vector<double> read_axis(const YAML::Node& n, const std::string& path) {
   v.reserve(n.size());
   for (size_t i = 0; i < n.size(); ++i) {
     v.push_back(read_number(n[i], index_path(path, i)));
+    require_coordinate(v.back(), index_path(path, i));
     if (i > 0 && !(v[i] > v[i - 1])) fail(path, "not strictly increasing at index " + std::to_string(i));
   }
   return v;
@@ -252,6 +257,12 @@ std::vector<double> read_axis(const YAML::Node& n, const std::string& path) {
 
 void require(bool ok, const std::string& path, const std::string& reason) {
   if (!ok) fail(path, reason);
+}
+// v in [lo, hi] (lo_open: (lo, hi]); the message gives the range with its unit.
+void require_range(double v, double lo, double hi, bool lo_open, const std::string& path, const char* unit) {
+  require(lo_open ? v > lo : v >= lo, path,
+          std::string("must be ") + (lo_open ? "> " : ">= ") + fmt(lo) + (lo == 0 ? std::string() : " " + std::string(unit)));
+  require(v <= hi, path, "must be <= " + fmt(hi) + " " + unit + " (docs/case-format.md, Limits)");
 }
 
 // reservoir.grdecl: a model file read by OPM instead of the x/y/z axes and the uniform rock.
@@ -266,7 +277,13 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
     const std::string cell = f.path("grdecl") + ": cell " + std::to_string(c);
     require(r.cell_poro[c] > 0 && r.cell_poro[c] <= 1, cell, "porosity x NTG must be in (0, 1], got " + fmt(r.cell_poro[c]));
     require(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0, cell, "permeability must be > 0");
+    for (double k : {r.cell_permx[c], r.cell_permy[c], r.cell_permz[c]})
+      require(k >= kMinPermeability && k <= kMaxPermeability, cell,
+              "permeability must be in [" + fmt(kMinPermeability) + ", " + fmt(kMaxPermeability) + "] mD, got " + fmt(k) +
+                  " (docs/case-format.md, Limits)");
   }
+  for (const auto* axis : {&r.x, &r.y, &r.z})
+    for (double v : *axis) require_coordinate(v, f.path("grdecl"));
   r.grdecl = path;
   if (model.has_mapaxes) {
     r.has_map_axes = true;
@@ -297,12 +314,14 @@ ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir) {
   if (auto k = f.get("permeability")) {
     const auto v = read_triple(*k, f.path("permeability"), "[kx, ky, kz]");
     for (size_t i = 0; i < 3; ++i) require(v[i] > 0, index_path(f.path("permeability"), i), "must be > 0");
+    for (size_t i = 0; i < 3; ++i)
+      require_range(v[i], kMinPermeability, kMaxPermeability, false, index_path(f.path("permeability"), i), "mD");
     r.permeability = {v[0], v[1], v[2]};
   }
   f.number("porosity", r.porosity);
   require(r.porosity > 0 && r.porosity <= 1, f.path("porosity"), "must be in (0, 1]");
   f.number("initial_pressure", r.initial_pressure);
-  require(r.initial_pressure > 0, f.path("initial_pressure"), "must be > 0");
+  require_range(r.initial_pressure, 0, kMaxPressure, true, f.path("initial_pressure"), "bar");
   return r;
 }
 
@@ -331,10 +350,13 @@ FluidSpec read_fluid(const YAML::Node& n) {
   const Fields f(n, "fluid", {"viscosity", "density", "compressibility"});
   f.number("viscosity", fl.viscosity);
   require(fl.viscosity > 0, f.path("viscosity"), "must be > 0");
+  require_range(fl.viscosity, kMinViscosity, kMaxViscosity, false, f.path("viscosity"), "cP");
   f.number("density", fl.density);
   require(fl.density > 0, f.path("density"), "must be > 0");
+  require_range(fl.density, kMinDensity, kMaxDensity, false, f.path("density"), "kg/m3");
   f.number("compressibility", fl.compressibility);
   require(fl.compressibility >= 0, f.path("compressibility"), "must be >= 0");
+  require_range(fl.compressibility, 0, kMaxCompressibility, false, f.path("compressibility"), "1/bar");
   return fl;
 }
 
@@ -350,6 +372,7 @@ std::vector<Vec3> read_trajectory(const YAML::Node& n, const std::string& path, 
     const std::string p = index_path(path, i);
     if (!n[i].IsSequence()) fail(p, "expected a point [x, y, z], got " + describe(n[i]));
     const auto v = read_triple(n[i], p, "[x, y, z]");
+    for (size_t d = 0; d < 3; ++d) require_coordinate(v[d], index_path(p, d));
     pts.push_back({v[0], v[1], v[2]});
     if (i > 0 && pts[i] == pts[i - 1]) fail(p, "repeats the previous point");
   }
@@ -409,16 +432,21 @@ WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_
                         : read_trajectory(f.required("trajectory"), f.path("trajectory"), points_budget);
   w.radius = read_number(f.required("radius"), f.path("radius"));
   require(w.radius > 0, f.path("radius"), "must be > 0");
+  require_range(w.radius, kMinWellRadius, kMaxWellRadius, false, f.path("radius"), "m");
   w.drainage_radius = read_number(f.required("drainage_radius"), f.path("drainage_radius"));
   require(w.drainage_radius > w.radius, f.path("drainage_radius"), "must be > radius (" + fmt(w.radius) + ")");
+  require(w.drainage_radius <= kMaxDrainageRadius, f.path("drainage_radius"),
+          "must be <= " + fmt(kMaxDrainageRadius) + " m (docs/case-format.md, Limits)");
   f.integer("rings", w.rings);
   require(w.rings >= 1, f.path("rings"), "must be >= 1");
   f.integer("sectors", w.sectors);
   require(w.sectors >= 3, f.path("sectors"), "must be >= 3");
   f.number("segment_length", w.segment_length);
   require(w.segment_length > 0, f.path("segment_length"), "must be > 0");
+  require(w.segment_length <= kMaxSegmentLength, f.path("segment_length"),
+          "must be <= " + fmt(kMaxSegmentLength) + " m (docs/case-format.md, Limits)");
   w.bhp = read_number(f.required("bhp"), f.path("bhp"));
-  require(w.bhp > 0, f.path("bhp"), "must be > 0");
+  require_range(w.bhp, 0, kMaxPressure, true, f.path("bhp"), "bar");
   if (auto e = f.get("end_caps")) {
     const std::string s = e->IsScalar() ? e->Scalar() : std::string();
     w.end_caps_fallback = false;

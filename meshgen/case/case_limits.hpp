@@ -17,4 +17,22 @@ inline constexpr double kMaxSurveyDoglegDeg = 90;
 inline constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
 inline constexpr std::size_t kMaxCaseFileBytes = std::size_t(64) << 20;
 
+
+// Physical bounds (docs/case-format.md, "Limits"): wide enough for any real model, narrow enough
+// that no product the mesher, the transmissibilities or a deck form from them overflows or
+// underflows (permeability 1e300 mD made inf - inf = NaN transmissibilities).
+inline constexpr double kMaxAbsCoordinate = 1e8;     ///< m, any coordinate (UTM northings are < 1e7)
+inline constexpr double kMinPermeability = 1e-9;     ///< mD (1 picodarcy)
+inline constexpr double kMaxPermeability = 1e9;      ///< mD (1e6 darcy)
+inline constexpr double kMaxPressure = 1e5;          ///< bar, initial pressure and bhp
+inline constexpr double kMinWellRadius = 1e-3;       ///< m
+inline constexpr double kMaxWellRadius = 10;         ///< m
+inline constexpr double kMaxDrainageRadius = 1e4;    ///< m
+inline constexpr double kMaxSegmentLength = 1e5;     ///< m
+inline constexpr double kMinViscosity = 1e-4;        ///< cP
+inline constexpr double kMaxViscosity = 1e9;         ///< cP
+inline constexpr double kMinDensity = 1e-3;          ///< kg/m3
+inline constexpr double kMaxDensity = 1e5;           ///< kg/m3
+inline constexpr double kMaxCompressibility = 1;     ///< 1/bar
+
 }  // namespace hm

@@ -63,7 +63,10 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
 /// faces with opposite directions, every vertex's fan a single disk. Returns problems.
 std::vector<std::string> check_cavity_manifold(const Cavity& cavity, const std::vector<Vec3>& node_coords);
 
-/// Writes the boundary surface of a cavity as an .obj (OpenMesh); returns false on I/O failure.
-bool write_cavity_surface(const Cavity& cavity, const std::vector<Vec3>& node_coords, const std::string& path);
+/// Writes the boundary surface of a cavity as an .obj with every coordinate as the shortest
+/// decimal that reads back as the same double, node_coords[v] + origin (the case's frame when the
+/// mesh was built in a local one); returns false on I/O failure.
+bool write_cavity_surface(const Cavity& cavity, const std::vector<Vec3>& node_coords, const std::string& path,
+                          Vec3 origin = {});
 
 }  // namespace hm

@@ -1,14 +1,15 @@
 // The cavity boundary as an OpenMesh polygon mesh: manifold checks and .obj output.
 // GCC 12 reports a false -Wmaybe-uninitialized inside OpenMesh's property vectors.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
+#include <charconv>
 #include <cstdio>
 #include <map>
 #include <set>
 
 #include "cavity.hpp"
+#include "meshgen/core/text_file.hpp"
 
 namespace hm {
 
@@ -65,20 +66,35 @@ std::vector<std::string> check_cavity_manifold(const Cavity& cavity, const std::
   return problems;
 }
 
-bool write_cavity_surface(const Cavity& cavity, const std::vector<Vec3>& coords, const std::string& path) {
-  int refused = 0;
-  SurfaceMesh mesh = to_openmesh(cavity, coords, &refused);
-  // Temp file + rename: a failed write never leaves a complete-looking file. The temp
-  // name keeps the extension, which OpenMesh uses to pick the format.
-  const std::string tmp = path + ".tmp.obj";
-  OpenMesh::IO::Options opt;
-  omlog().disable();  // OpenMesh's writer chatters on its log streams
-  omout().disable();
-  if (!OpenMesh::IO::write_mesh(mesh, tmp, opt, 17)) {
-    std::remove(tmp.c_str());
-    return false;
+// Written here rather than by OpenMesh: its OBJ writer goes through Vec3f (float32) points,
+// which move field coordinates (UTM, 1e6-1e7 m) by decimetres. Shortest round-trip doubles.
+bool write_cavity_surface(const Cavity& cavity, const std::vector<Vec3>& coords, const std::string& path,
+                          Vec3 origin) {
+  std::string text = "# cavity boundary: constrained polygons, normals into the cavity\n";
+  std::map<int32_t, int> index;  // global node id -> 1-based .obj vertex index
+  char buf[32];
+  auto number = [&](double v) {
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    text.append(buf, r.ptr);
+  };
+  for (int32_t v : cavity.vertices) {
+    index[v] = static_cast<int>(index.size()) + 1;
+    const Vec3 p = coords[v] + origin;
+    text += "v ";
+    number(p.x);
+    text += ' ';
+    number(p.y);
+    text += ' ';
+    number(p.z);
+    text += '\n';
   }
-  return std::rename(tmp.c_str(), path.c_str()) == 0;
+  for (const ConstrainedFace& f : cavity.faces) {
+    text += 'f';
+    for (int32_t v : f.nodes) text += ' ' + std::to_string(index.at(v));
+    text += '\n';
+  }
+  std::string error;
+  return write_text_file(path, text, &error);
 }
 
 }  // namespace hm

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <exception>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -75,135 +75,264 @@ class StageTimer {
 }  // namespace
 
 namespace {
-HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions& opts);
-}  // namespace
 
-// end_caps: auto. Hemispherical caps reach a drainage radius beyond the end points; next to much
-// coarser reservoir cells the transition may not be buildable there (docs/transition.md, known
-// limits). Wells that did not ask for caps explicitly are then closed with flat ends, and the
-// notes say so; an error with flat ends too is the case's own and is reported as such.
-HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
-  std::vector<int> fallback;
-  for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w)
-    if (cs.wells[w].end_caps == EndCaps::Hemisphere && cs.wells[w].end_caps_fallback) fallback.push_back(w);
-  if (fallback.empty()) return build_hybrid_mesh_as_given(cs, opts);
-  std::string why;
-  try {
-    return build_hybrid_mesh_as_given(cs, opts);
-  } catch (const std::exception& e) {  // InputError (cavity) or a transition failure
-    why = e.what();
-    why = why.substr(0, why.find("; with hemispherical end caps"));  // the hint is what happens next
-  }
-  CaseSpec flat = cs;
-  for (int w : fallback) flat.wells[w].end_caps = EndCaps::Flat;
-  HybridMesh out = build_hybrid_mesh_as_given(flat, opts);
-  std::string wells;
-  for (int w : fallback) wells += (wells.empty() ? "" : ", ") + ("wells[" + std::to_string(w) + "]");
-  out.notes.insert(out.notes.begin(), wells + ": closed with flat ends (end_caps: auto): the hemispherical end caps "
-                                      "could not be meshed: " + why);
-  return out;
+// "wells[0] (P1), wells[2] (P2)"
+std::string well_list(const CaseSpec& cs, const std::vector<int>& wells) {
+  std::string s;
+  for (int w : wells) s += (s.empty() ? "" : ", ") + ("wells[" + std::to_string(w) + "] (" + cs.wells[w].name + ")");
+  return s.empty() ? std::string("no well") : s;
 }
 
-namespace {
+bool share_a_well(const std::vector<int>& a, const std::vector<int>& b) {
+  for (int w : a)
+    if (std::find(b.begin(), b.end(), w) != b.end()) return true;
+  return false;
+}
 
-HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions& opts) {
+// end_caps: auto, per well, before meshing: hemispherical caps if the capped block can be built
+// (building the Gabriel block is the caps' feasibility test; its InputError is the refusal),
+// flat ends otherwise.
+WellBlock block_with_feasible_caps(CaseSpec& cs, int w, std::vector<std::string>& flat_because) {
+  WellSpec& ws = cs.wells[w];
+  if (ws.end_caps == EndCaps::Hemisphere && ws.end_caps_fallback) {
+    try {
+      return make_gabriel_well_block(cs, w);
+    } catch (const InputError& e) {
+      ws.end_caps = EndCaps::Flat;
+      flat_because[w] = e.what();
+    }
+  }
+  return make_gabriel_well_block(cs, w);
+}
+
+// Reservoir cells deactivated so that one cavity's transition can be built, and why.
+struct Enlargement {
+  std::vector<int> wells;  ///< the wells of the cavity that asked
+  std::vector<int32_t> cells;
+  std::string reason;
+  int round = 0;
+};
+
+// A transition mesh kept for the next round: valid while its cavity is the same (same wells,
+// same caps, same deactivated cells, hence the same constrained polygons).
+struct CachedTransition {
+  std::vector<int> wells;
+  std::vector<EndCaps> caps;
+  std::vector<int32_t> deactivated;
+  size_t faces = 0;
+  std::vector<int32_t> well_offset;  ///< builder id of each block's first node when it was built
+  TransitionCells cells;
+};
+
+// Builder ids of constrained nodes: the reservoir's first, then block by block; free nodes
+// from base_node_id on. Moves a cached transition's ids to this round's layout.
+void renumber(TransitionCells& t, int32_t reservoir_nodes, const std::vector<int32_t>& old_offset,
+              const std::vector<int32_t>& new_offset, int32_t new_base) {
+  auto map = [&](int32_t v) {
+    if (v >= t.base_node_id) return v - t.base_node_id + new_base;
+    if (v < reservoir_nodes) return v;
+    const size_t w = std::upper_bound(old_offset.begin(), old_offset.end(), v) - old_offset.begin() - 1;
+    return v - old_offset[w] + new_offset[w];
+  };
+  for (auto& cell : t.cells)
+    for (CellFace& f : cell)
+      for (int32_t& v : f.nodes) v = map(v);
+  if (t.unoptimized) {  // the raw diagram kept for the before/after figures: same node layout
+    auto raw = std::make_shared<TransitionCells>(*t.unoptimized);
+    renumber(*raw, reservoir_nodes, old_offset, new_offset, new_base);
+    t.unoptimized = std::move(raw);
+  }
+  t.base_node_id = new_base;
+}
+
+std::string caps_hint(const CaseSpec& cs, const std::vector<int>& wells) {
+  for (int w : wells)
+    if (cs.wells[w].end_caps == EndCaps::Hemisphere)
+      return "; with hemispherical end caps next to coarse reservoir cells, refining the reservoir beyond the "
+             "well ends or wells[i].end_caps: flat may help (docs/case-format.md)";
+  return "; refining the reservoir cells around the well, a smaller drainage_radius or moving the well away from "
+         "coarse cells may help (docs/transition.md, known limits)";
+}
+
+}  // namespace
+
+// The job: well blocks (end caps decided per well), cavities, one transition per cavity. A
+// transition that refuses its cavity says why and which reservoir cells to deactivate; only that
+// cavity's transition is built again, with those cells deactivated (a local dilation), at most
+// kMaxEnlargements times; then its auto-capped wells get flat ends and only its transition is
+// built again. The other cavities keep their transitions.
+HybridMesh build_hybrid_mesh(const CaseSpec& input, const PipelineOptions& opts) {
   HybridMesh out;
   StageTimer timer(&out.timings_s);
+  CaseSpec cs = input;  // end caps as meshed
+  const int nw = static_cast<int>(cs.wells.size());
 
   out.grid = make_reservoir_grid(cs.reservoir);
-  for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w) {
-    out.blocks.push_back(make_gabriel_well_block(cs, w));
-    for (const std::string& n : out.blocks.back().notes) out.notes.push_back(n);
-  }
+  std::vector<std::string> flat_because(nw);
+  for (int w = 0; w < nw; ++w) out.blocks.push_back(block_with_feasible_caps(cs, w, flat_because));
   timer.mark("well_blocks");
 
-  // Nodes first (reservoir lattice, then each block) so that the cavity can name them.
-  MeshBuilder builder;
-  const std::vector<int32_t> res_nodes = add_reservoir_nodes(out.grid, builder);
-  std::vector<std::vector<int32_t>> well_nodes;
-  for (const WellBlock& b : out.blocks) {
-    well_nodes.push_back(add_well_block(b, builder));
-  }
-  std::vector<Vec3> coords(builder.n_nodes());
-  for (int32_t i = 0; i < builder.n_nodes(); ++i) coords[i] = builder.node(i);
-
-  // Cavities, then their transition meshes. A transition may refuse a cavity part (a
-  // polygon that is not Delaunay admissible, or sites whose correction does not converge:
-  // typically a large reservoir face close to a well) and name the reservoir cells whose
-  // deactivation moves that part away; the cavities are then rebuilt with those cells
-  // deactivated (a local dilation), a bounded number of times.
-  std::vector<int32_t> extra_deactivated;
+  constexpr int kMaxEnlargements = 5;  // per cavity, and as many again with flat ends
+  std::vector<Enlargement> enlargements;
+  std::vector<CachedTransition> cache;
   std::vector<TransitionCells> transitions;
-  const int32_t base = builder.n_nodes();
-  constexpr int kMaxRetries = 5;
-  std::string enlarged_for;  // the transition error that made the last enlargement
-  // Hemispherical caps reach a drainage radius beyond the end points: next to much coarser
-  // reservoir cells the site correction can fail there (docs/transition.md, known limits).
-  bool any_caps = false;
-  for (const WellSpec& w : cs.wells) any_caps = any_caps || w.end_caps == EndCaps::Hemisphere;
-  const std::string caps_hint =
-      any_caps ? "; with hemispherical end caps next to coarse reservoir cells, refining the reservoir beyond the "
-                 "well ends or wells[i].end_caps: flat may help (docs/case-format.md)"
-               : "";
-  for (int attempt = 0;; ++attempt) {
-    try {
-      out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, extra_deactivated);
-    } catch (const InputError& e) {
-      if (enlarged_for.empty()) throw;
-      // The cavity was enlarged for the transition (below) and can no longer be built: say why.
-      throw InputError(std::string(e.what()) + " (the cavity was enlarged because " + enlarged_for + ")" + caps_hint);
+  std::vector<int32_t> res_nodes;
+  MeshBuilder builder;
+  std::vector<Vec3> coords;
+  auto flatten = [&](const std::vector<int>& wells, const std::string& why) {
+    bool any = false;
+    for (int w : wells) {
+      WellSpec& ws = cs.wells[w];
+      if (!(ws.end_caps == EndCaps::Hemisphere && ws.end_caps_fallback)) continue;
+      ws.end_caps = EndCaps::Flat;
+      flat_because[w] = why;
+      out.blocks[w] = make_gabriel_well_block(cs, w);
+      any = true;
     }
-    for (size_t k = 0; k < out.cavities.cavities.size(); ++k) {
+    if (any)
+      enlargements.erase(std::remove_if(enlargements.begin(), enlargements.end(),
+                                        [&](const Enlargement& e) { return share_a_well(e.wells, wells); }),
+                         enlargements.end());
+    return any;
+  };
+  for (int round = 0;; ++round) {
+    // Nodes first (reservoir lattice, then each block) so that the cavity can name them.
+    builder = MeshBuilder{};
+    res_nodes = add_reservoir_nodes(out.grid, builder);
+    std::vector<std::vector<int32_t>> well_nodes;
+    std::vector<int32_t> well_offset;
+    for (const WellBlock& b : out.blocks) {
+      well_offset.push_back(builder.n_nodes());
+      well_nodes.push_back(add_well_block(b, builder));
+    }
+    coords.resize(builder.n_nodes());
+    for (int32_t i = 0; i < builder.n_nodes(); ++i) coords[i] = builder.node(i);
+    const int32_t base = builder.n_nodes();
+
+    std::vector<int32_t> extra;
+    for (const Enlargement& e : enlargements) extra.insert(extra.end(), e.cells.begin(), e.cells.end());
+    std::sort(extra.begin(), extra.end());
+    extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
+    try {
+      out.cavities = build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, extra);
+    } catch (const InputError& e) {
+      // Without enlargements the cavity is the input's (dilation, wells too close): exit 2.
+      if (enlargements.empty()) throw;
+      // Else the latest enlargements ran into it (e.g. the reservoir boundary): those cavities
+      // get flat ends where they may, or the transition's refusal stands (not the input's).
+      // Which of them: those without which the cavities can be built (all, if none alone is).
+      const int last = enlargements.back().round;
+      std::vector<Enlargement> latest, culprits;
+      for (const Enlargement& en : enlargements)
+        if (en.round == last) latest.push_back(en);
+      for (size_t i = 0; i < latest.size() && latest.size() > 1; ++i) {
+        std::vector<int32_t> others;
+        for (const Enlargement& en : enlargements)
+          if (!(en.round == last && en.wells == latest[i].wells)) others.insert(others.end(), en.cells.begin(), en.cells.end());
+        try {
+          build_cavities(cs, out.grid, out.blocks, res_nodes, well_nodes, coords, others);
+          culprits.push_back(latest[i]);
+        } catch (const InputError&) {
+        }
+      }
+      if (culprits.empty()) culprits = latest;
+      for (const Enlargement& en : culprits) {
+        const std::string why = en.reason + " (the cavity was enlarged for it: " + e.what() + ")";
+        if (!flatten(en.wells, why))
+          throw MeshingError("transition", en.wells,
+                             "transition of the cavity of " + well_list(cs, en.wells) + ": " + why +
+                                 caps_hint(cs, en.wells));
+      }
+      continue;
+    }
+    const int nk = static_cast<int>(out.cavities.cavities.size());
+    for (int k = 0; k < nk; ++k) {
       const auto problems = check_cavity_manifold(out.cavities.cavities[k], coords);
       if (!problems.empty())
-        throw std::runtime_error("cavity " + std::to_string(k) + ": boundary is not a closed 2-manifold: " + problems[0]);
+        throw MeshingError("cavity", out.cavities.cavities[k].wells,
+                           "cavity " + std::to_string(k) + " of " + well_list(cs, out.cavities.cavities[k].wells) +
+                               ": boundary is not a closed 2-manifold: " + problems[0]);
     }
     if (!opts.build_transition) break;
-    // Cavities are independent, so they are built (and optimised) concurrently; results are
-    // used in cavity order, so the output does not depend on scheduling or on opts.threads.
+
+    // Transitions (optimised) of the cavities not met before, concurrently, at most opts.threads
+    // at once (0: every core); each result lands in its cavity's slot, so the output does not
+    // depend on scheduling or on opts.threads. The others are reused.
     TransitionOptions topts;
     topts.optimize = opts.optimize && cs.transition.optimize;
     topts.g_remove = cs.transition.gamma[1];
     topts.g_expand = cs.transition.gamma[2];
-    // At most opts.threads at once (0: every core); each result lands in its cavity's slot.
-    const size_t n_cav = out.cavities.cavities.size();
-    std::vector<TransitionCells> built(n_cav);
-    std::vector<std::exception_ptr> failed(n_cav);
-    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
-    arena.execute([&] {
-      tbb::parallel_for(size_t(0), n_cav, [&](size_t k) {
-        try {
-          built[k] = build_transition(out.cavities.cavities[k], coords, out.grid, out.blocks, base, topts);
-        } catch (...) {
-          failed[k] = std::current_exception();
+    std::vector<CachedTransition> keys(nk);
+    std::vector<std::optional<TransitionOutcome>> outcomes(nk);
+    std::vector<int> to_build;
+    for (int k = 0; k < nk; ++k) {
+      const Cavity& cav = out.cavities.cavities[k];
+      CachedTransition& key = keys[k];
+      key.wells = cav.wells;
+      for (int w : cav.wells) key.caps.push_back(cs.wells[w].end_caps);
+      key.deactivated = cav.deactivated_cells;
+      key.faces = cav.faces.size();
+      key.well_offset = well_offset;
+      for (CachedTransition& c : cache)
+        if (!c.wells.empty() && c.wells == key.wells && c.caps == key.caps && c.deactivated == key.deactivated &&
+            c.faces == key.faces) {
+          renumber(c.cells, static_cast<int32_t>(res_nodes.size()), c.well_offset, well_offset, base);
+          outcomes[k] = TransitionOutcome{std::move(c.cells), std::nullopt};
+          c.wells.clear();  // used
+          break;
         }
-      });
-    });
-    transitions.clear();
-    std::vector<int32_t> more;
-    std::string first_error;
-    for (size_t k = 0; k < n_cav; ++k) {
-      try {
-        if (failed[k]) std::rethrow_exception(failed[k]);
-        transitions.push_back(std::move(built[k]));
-      } catch (const TransitionError& e) {
-        if (first_error.empty()) first_error = e.what();
-        more.insert(more.end(), e.cells_to_deactivate.begin(), e.cells_to_deactivate.end());
+      if (!outcomes[k]) {
+        ++out.transition_builds;
+        to_build.push_back(k);
       }
     }
-    if (first_error.empty()) break;
-    if (more.empty() || attempt == kMaxRetries)
-      throw std::runtime_error(first_error +
-                               (attempt > 0 ? " (after " + std::to_string(attempt) + " cavity enlargements)"
-                                            : std::string()) +
-                               caps_hint);
-    enlarged_for = first_error;
-    extra_deactivated.insert(extra_deactivated.end(), more.begin(), more.end());
-    std::sort(extra_deactivated.begin(), extra_deactivated.end());
-    extra_deactivated.erase(std::unique(extra_deactivated.begin(), extra_deactivated.end()), extra_deactivated.end());
-    out.notes.push_back("cavity: " + std::to_string(more.size()) +
-                        " reservoir cells deactivated so that the transition mesh can be built (" + first_error + ")");
+    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+      tbb::parallel_for(size_t(0), to_build.size(), [&](size_t i) {
+        const int k = to_build[i];
+        outcomes[k] = try_build_transition(out.cavities.cavities[k], coords, out.grid, out.blocks, base, topts);
+      });
+    });
+    bool refused = false;
+    for (int k = 0; k < nk; ++k) refused = refused || !outcomes[k]->ok();
+    if (!refused) {
+      transitions.clear();
+      for (int k = 0; k < nk; ++k) transitions.push_back(std::move(outcomes[k]->cells));
+      break;
+    }
+    cache.clear();
+    for (int k = 0; k < nk; ++k)
+      if (outcomes[k]->ok()) {
+        keys[k].cells = std::move(outcomes[k]->cells);
+        cache.push_back(std::move(keys[k]));
+      }
+    for (int k = 0; k < nk; ++k) {
+      if (outcomes[k]->ok()) continue;
+      const TransitionRefusal& r = *outcomes[k]->refusal;
+      const std::vector<int>& wells = out.cavities.cavities[k].wells;
+      int done = 0;
+      for (const Enlargement& e : enlargements) done += share_a_well(e.wells, wells);
+      if (!r.cells_to_deactivate.empty() && done < kMaxEnlargements) {
+        enlargements.push_back({wells, r.cells_to_deactivate, r.reason, round});
+        continue;
+      }
+      if (flatten(wells, r.reason + (done > 0 ? " (after " + std::to_string(done) + " cavity enlargements)" : "")))
+        continue;
+      throw MeshingError("transition", wells,
+                         "transition of the cavity of " + well_list(cs, wells) + ": " + r.reason +
+                             (done > 0 ? " (after " + std::to_string(done) + " cavity enlargements)" : std::string()) +
+                             caps_hint(cs, wells));
+    }
   }
+  for (int w = 0; w < nw; ++w)
+    if (!flat_because[w].empty())
+      out.notes.push_back("wells[" + std::to_string(w) + "]: closed with flat ends (end_caps: auto): the hemispherical "
+                          "end caps could not be meshed: " + flat_because[w]);
+  for (const WellBlock& b : out.blocks)
+    for (const std::string& n : b.notes) out.notes.push_back(n);
+  for (const Enlargement& e : enlargements)
+    out.notes.push_back("cavity: " + std::to_string(e.cells.size()) + " reservoir cells deactivated so that the " +
+                        "transition mesh of " + well_list(cs, e.wells) + " can be built (" + e.reason + ")");
   for (const std::string& n : out.cavities.notes) out.notes.push_back(n);
   out.cavity_node_coords = coords;
   timer.mark(opts.build_transition ? "cavities_and_transition" : "cavities");
@@ -252,8 +381,10 @@ HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions&
   }
   out.geometry = compute_geometry(out.mesh);
   timer.mark("assembly_geometry");
+  std::vector<int> all_wells(nw);
+  for (int w = 0; w < nw; ++w) all_wells[w] = w;
   if (opts.build_transition && !out.build_report.ok)
-    throw std::runtime_error("assembly: the hybrid mesh is not conforming: " +
+    throw MeshingError("assembly", all_wells, "assembly: the hybrid mesh is not conforming: " +
                              (out.build_report.problems.empty() ? std::string("?") : out.build_report.problems[0]) +
                              " (" + std::to_string(out.build_report.unmatched_faces) + " unmatched, " +
                              std::to_string(out.build_report.misoriented_faces) + " misoriented, " +
@@ -276,9 +407,14 @@ HybridMesh build_hybrid_mesh_as_given(const CaseSpec& cs, const PipelineOptions&
     a.proposed += o.proposed, a.kept += o.kept, a.refused += o.refused, a.invalid += o.invalid;
   }
   timer.mark("transition_quality");
+  std::vector<std::vector<int>> cavity_wells;
+  for (const Cavity& c : out.cavities.cavities) cavity_wells.push_back(c.wells);
+  out.self_check = self_check(out.mesh, out.geometry, out.build_report, out.cell_cavity, cavity_wells, cs);
+  timer.mark("self_check");
+  if (!out.self_check.ok())
+    throw MeshingError("self-check", out.self_check.wells,
+                       out.self_check.message + (out.optimized ? " (after optimisation)" : " (no optimisation)"));
   return out;
 }
-
-}  // namespace
 
 }  // namespace hm

@@ -1,6 +1,7 @@
 // The whole meshing job: case -> reservoir grid + well blocks -> cavities ->
 // transition meshes -> one conforming PolyMesh, with a report of every stage.
 #pragma once
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "meshgen/grids/reservoir_grid.hpp"
 #include "fvcheck/lib/quality.hpp"
 #include "meshgen/grids/well_block.hpp"
+#include "meshgen/pipeline/self_check.hpp"
 #include "meshgen/transition/transition.hpp"
 
 namespace hm {
@@ -51,12 +53,26 @@ struct HybridMesh {
   TransitionQuality transition_after;   ///< after optimisation (when optimized)
   bool optimized = false;
   SiteOptimizeReport optimize_report;   ///< summed over the cavities (rounds: the largest)
+  int transition_builds = 0;         ///< transition meshes built, all cavities and rounds (refused ones too)
+  SelfCheck self_check;              ///< the checks of the finished mesh (ok, or the job threw)
   std::vector<std::string> notes;    ///< every automatic change made to the input (sectors, dilation, ...)
   std::vector<std::pair<std::string, double>> timings_s;  ///< stage name -> seconds, in stage order
 };
 
-/// Runs the job. Throws InputError for bad input, std::runtime_error for a meshing failure
-/// (with a message saying which stage and why).
+/// A failure the input did not cause (exit 1): the stage ("cavity", "transition", "assembly",
+/// "optimize", "self-check"), the wells concerned (case indices) and, in what(), the cause and
+/// what the user can change.
+class MeshingError : public std::runtime_error {
+ public:
+  MeshingError(std::string stage_name, std::vector<int> wells_concerned, const std::string& what)
+      : std::runtime_error(what), stage(std::move(stage_name)), wells(std::move(wells_concerned)) {}
+  std::string stage;
+  std::vector<int> wells;
+};
+
+/// Runs the job in the case's own frame (meshgen moves the case to a local frame first,
+/// local_frame.hpp). Throws InputError for bad input, MeshingError for a meshing failure,
+/// including a mesh that fails the self-check (self_check.hpp) that ends the job.
 HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts = {});
 
 }  // namespace hm

@@ -82,6 +82,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
     t["hidden_sites"] = hidden;
     t["snapped_vertices"] = snapped;
     t["removed_faces"] = removed;
+    t["builds"] = h.transition_builds;  // transition meshes built, refused ones included
     j["transition"] = t;
   }
   double total = 0;

@@ -53,9 +53,10 @@ std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector
   return non_admissible(cavity, frames_of(cavity, node_coords, notes));
 }
 
-TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
-                                 const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
-                                 int32_t base_node_id, const TransitionOptions& options) {
+namespace {
+TransitionCells build_transition_or_throw(const Cavity& cavity, const std::vector<Vec3>& node_coords,
+                                          const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                          int32_t base_node_id, const TransitionOptions& options) {
   TransitionReport report;
   using Clock = std::chrono::steady_clock;
   auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
@@ -126,7 +127,11 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
       std::ostringstream os;
       os << "transition: " << hidden.size() << " sites stay " << (degenerate ? "in duplicate faces" : "hidden")
          << " after " << kMaxHiddenRepairs << " repairs";
-      throw std::runtime_error(os.str());
+      std::vector<int32_t> polygons;
+      for (int s : hidden) polygons.insert(polygons.end(), set.sites[s].polygons.begin(), set.sites[s].polygons.end());
+      std::sort(polygons.begin(), polygons.end());
+      polygons.erase(std::unique(polygons.begin(), polygons.end()), polygons.end());
+      throw TransitionError(os.str(), std::move(polygons), {});
     }
     ++report.hidden_repairs;
     for (int s : hidden)
@@ -173,6 +178,37 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     r.notes.push_back(std::to_string(r.free_sites) + " tip sites (weight 0) grade the cells beyond the well ends" +
                       (r.dropped_tip_sites > 0 ? " (" + std::to_string(r.dropped_tip_sites) + " dropped)" : ""));
   return out;
+}
+}  // namespace
+
+TransitionOutcome try_build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
+                                       const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                       int32_t base_node_id, const TransitionOptions& options) {
+  TransitionOutcome out;
+  TransitionRefusal refusal;
+  try {
+    out.cells = build_transition_or_throw(cavity, node_coords, grid, blocks, base_node_id, options);
+    return out;
+  } catch (const TransitionError& e) {  // the stages' refusals: admissibility, correction, hidden sites
+    refusal = {e.what(), e.polygons, e.cells_to_deactivate, {}};
+  } catch (const std::runtime_error& e) {  // the diagram leaked (transition_power.cpp)
+    refusal.reason = e.what();
+  }
+  for (int32_t q : refusal.polygons)
+    if (q >= 0 && q < static_cast<int32_t>(cavity.faces.size()) && cavity.faces[q].side == FaceSide::Well)
+      refusal.wells.push_back(cavity.faces[q].well);
+  std::sort(refusal.wells.begin(), refusal.wells.end());
+  refusal.wells.erase(std::unique(refusal.wells.begin(), refusal.wells.end()), refusal.wells.end());
+  out.refusal = std::move(refusal);
+  return out;
+}
+
+TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
+                                 const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                 int32_t base_node_id, const TransitionOptions& options) {
+  TransitionOutcome o = try_build_transition(cavity, node_coords, grid, blocks, base_node_id, options);
+  if (o.refusal) throw TransitionError(o.refusal->reason, o.refusal->polygons, o.refusal->cells_to_deactivate);
+  return std::move(o.cells);
 }
 
 PolyMesh transition_submesh(const TransitionCells& t, const std::vector<Vec3>& node_coords,

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -88,11 +89,29 @@ struct TransitionCells {
   TransitionReport report;
 };
 
-/// Thrown by build_transition when the cavity cannot carry a valid transition mesh: some
-/// constrained polygon is not Delaunay admissible, or the site correction (5.5.3) does not
-/// converge (typically a large reservoir face close to a well). `cells_to_deactivate` are
-/// the active reservoir cells behind the polygons involved: deactivating them moves that
-/// part of the cavity boundary away, after which the caller may retry.
+/// Why the transition mesh of a cavity could not be built, as a value (docs/transition.md,
+/// "Refusals"): some constrained polygon is not Delaunay admissible, the site correction
+/// (5.5.3) does not converge (typically a large reservoir face close to a well), sites stay
+/// hidden, or the diagram leaks. `cells_to_deactivate` are the active reservoir cells behind
+/// the polygons involved: deactivating them moves that part of the cavity boundary away, after
+/// which the caller may rebuild this cavity; empty when no reservoir cell is to blame.
+struct TransitionRefusal {
+  std::string reason;                        ///< "transition: ..." (one line)
+  std::vector<int32_t> polygons;             ///< cavity face indices involved (sorted)
+  std::vector<int32_t> cells_to_deactivate;  ///< reservoir linear cell indices (sorted, unique)
+  std::vector<int32_t> wells;                ///< wells whose block polygons are involved (sorted, unique)
+};
+
+/// The transition of one cavity: its cells, or the refusal (then `cells` is empty).
+struct TransitionOutcome {
+  TransitionCells cells;
+  std::optional<TransitionRefusal> refusal;
+  bool ok() const { return !refusal; }
+};
+
+/// The stages' internal signal of a refusal (transition_sites.cpp, transition.cpp); meshed
+/// callers get it as a TransitionRefusal from try_build_transition, tests may catch it from
+/// build_transition.
 class TransitionError : public std::runtime_error {
  public:
   TransitionError(const std::string& what, std::vector<int32_t> polygons_involved,
@@ -103,9 +122,14 @@ class TransitionError : public std::runtime_error {
 };
 
 /// Builds the transition mesh of one cavity. `node_coords` holds the coordinates of all
-/// global node ids (at least every cavity vertex). Throws TransitionError (a
-/// std::runtime_error) with a clear message if the cavity is not admissible or the site
-/// correction does not converge, std::runtime_error if the cavity leaks (not closed).
+/// global node ids (at least every cavity vertex). A cavity it cannot mesh is returned as a
+/// refusal, never thrown.
+TransitionOutcome try_build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
+                                       const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                       int32_t base_node_id, const TransitionOptions& options = {});
+
+/// try_build_transition for callers that want an exception: throws the refusal as a
+/// TransitionError (a std::runtime_error) with its reason, polygons and cells.
 TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
                                  const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                                  int32_t base_node_id, const TransitionOptions& options = {});

@@ -419,6 +419,37 @@ TEST(CaseErrors, PermeabilityPorosityPressure) {
             "reservoir.initial_pressure: must be > 0");
 }
 
+// Physical bounds (case_limits.hpp): the permeability 1e300 wrote -nan into NNC and COMPDAT;
+// each bound is checked just inside (accepted) and just outside (refused with the range).
+TEST(CaseErrors, PhysicalValuesAreBounded) {
+  EXPECT_EQ(error_of(with(kBase, "permeability: [100, 100, 10]", "permeability: [1e300, 100, 10]")),
+            "reservoir.permeability[0]: must be <= 1e+09 mD (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(with(kBase, "permeability: [100, 100, 10]", "permeability: [1e9, 100, 10]")), "");
+  EXPECT_EQ(error_of(with(kBase, "permeability: [100, 100, 10]", "permeability: [100, 100, 1e-10]")),
+            "reservoir.permeability[2]: must be >= 1e-09 mD");
+  EXPECT_EQ(error_of(with(kBase, "permeability: [100, 100, 10]", "permeability: [100, 100, 1e-9]")), "");
+  EXPECT_EQ(error_of(with(kBase, "initial_pressure: 200", "initial_pressure: 1e6")),
+            "reservoir.initial_pressure: must be <= 1e+05 bar (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(with(kBase, "bhp: 150", "bhp: 1e300")),
+            "wells[0].bhp: must be <= 1e+05 bar (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(with(kBase, "    radius: 0.1\n    drainage_radius: 8.0\n    bhp: 250",
+                          "    radius: 1e-4\n    drainage_radius: 8.0\n    bhp: 250")),
+            "wells[1].radius: must be >= 0.001 m");
+  EXPECT_EQ(error_of(with(kBase, "drainage_radius: 8.0\n    rings", "drainage_radius: 1e5\n    rings")),
+            "wells[0].drainage_radius: must be <= 10000 m (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(with(kBase, "segment_length: 4.0", "segment_length: 1e6")),
+            "wells[0].segment_length: must be <= 1e+05 m (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(kBase + "fluid: {viscosity: 1e300}\n"),
+            "fluid.viscosity: must be <= 1e+09 cP (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(kBase + "fluid: {viscosity: 1e-5}\n"), "fluid.viscosity: must be >= 1e-04 cP");
+  EXPECT_EQ(error_of(kBase + "fluid: {density: 1e300}\n"),
+            "fluid.density: must be <= 1e+05 kg/m3 (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(kBase + "fluid: {compressibility: 2}\n"),
+            "fluid.compressibility: must be <= 1 1/bar (docs/case-format.md, Limits)");
+  EXPECT_EQ(error_of(with(kBase, "x: [0, 30,", "x: [-2e8, 30,")),
+            "reservoir.x[0]: coordinates must be within +-1e+08 m (docs/case-format.md, Limits)");
+}
+
 TEST(CaseErrors, CaseName) {
   EXPECT_EQ(error_of(with(kBase, "name: paper_single_well", "name: paper well")), "name: must match [A-Za-z0-9_-]+");
   EXPECT_EQ(error_of(with(kBase, "name: paper_single_well", "name: ''")), "name: must match [A-Za-z0-9_-]+");
