@@ -2,6 +2,7 @@
 // stages are in transition_delaunay.cpp and transition_power.cpp.
 #include "transition.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 #include <stdexcept>
@@ -38,6 +39,43 @@ std::vector<int> non_admissible(const Cavity& cavity, const std::vector<PolygonF
 }
 }  // namespace
 
+namespace transition_detail {
+
+std::vector<int32_t> BoundaryImages::image_of(int k, const std::vector<int32_t>& ids) const {
+  std::vector<int32_t> out;
+  out.reserve(ids.size());
+  for (int32_t v : ids) {
+    const auto it = std::lower_bound(vertices.begin(), vertices.end(), v);
+    out.push_back(it != vertices.end() && *it == v ? image[k][it - vertices.begin()] : v);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+BoundaryImages add_boundary_images(Cavity& cavity, std::vector<Vec3>& coords) {
+  BoundaryImages im;
+  im.planes = cavity.mirrors;
+  im.vertices = cavity.vertices;
+  im.first_image = static_cast<int32_t>(coords.size());
+  for (const MirrorPlane& m : im.planes) {
+    std::vector<int32_t> ids(im.vertices.size());
+    for (size_t i = 0; i < im.vertices.size(); ++i) {
+      const Vec3 p = coords[im.vertices[i]];
+      if (p[m.axis] == m.value) {
+        ids[i] = im.vertices[i];
+        continue;
+      }
+      ids[i] = static_cast<int32_t>(coords.size());
+      coords.push_back(reflect(p, m));
+      cavity.vertices.push_back(ids[i]);
+    }
+    im.image.push_back(std::move(ids));
+  }
+  return im;
+}
+
+}  // namespace transition_detail
+
 std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<Vec3>& node_coords) {
   std::vector<std::string> notes;
   const std::vector<PolygonFrame> frames = frames_of(cavity, node_coords, notes);
@@ -52,9 +90,11 @@ std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector
   return non_admissible(cavity, frames_of(cavity, node_coords, notes));
 }
 
-TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,
-                                 const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
-                                 int32_t base_node_id) {
+namespace {
+
+TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Vec3>& node_coords,
+                                      const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                      int32_t base_node_id, const BoundaryImages& images) {
   TransitionReport report;
   using Clock = std::chrono::steady_clock;
   auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
@@ -86,7 +126,7 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
   for (;;) {
     out = TransitionCells{};
     out.base_node_id = base_node_id;
-    std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out);
+    std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out, images);
     bool degenerate = false;
     if (hidden.empty()) {
       // Free sites are optional: one whose cell came out unusable (near-degenerate sites whose
@@ -133,11 +173,11 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     enforce_empty_spheres(set, cavity, node_coords, grid, frames);
     // Free sites now inside a moved sphere go first, so that the correction never shrinks a
     // polygon or box site on account of an optional site; and again after it.
-    report.dropped_tip_sites += drop_blocked_tip_sites(set);
+    report.dropped_tip_sites += drop_blocked_tip_sites(set, cavity.mirrors);
     report.site_corrections +=
         correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
     report.correction_iterations += iterations;
-    report.dropped_tip_sites += drop_blocked_tip_sites(set);
+    report.dropped_tip_sites += drop_blocked_tip_sites(set, cavity.mirrors);
   }
   // Merge the stage reports.
   TransitionReport& r = out.report;
@@ -163,6 +203,20 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
     r.notes.push_back(std::to_string(r.free_sites) + " tip sites (weight 0) grade the cells beyond the well ends" +
                       (r.dropped_tip_sites > 0 ? " (" + std::to_string(r.dropped_tip_sites) + " dropped)" : ""));
   return out;
+}
+
+}  // namespace
+
+TransitionCells build_transition(const Cavity& real_cavity, const std::vector<Vec3>& real_coords,
+                                 const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                 int32_t base_node_id) {
+  // Outer-boundary planes: every stage sees the images of the cavity vertices too (empty
+  // spheres, Delaunay); the power diagram adds the images of the sites.
+  if (real_cavity.mirrors.empty()) return build_transition_with(real_cavity, real_coords, grid, blocks, base_node_id, {});
+  Cavity cavity = real_cavity;
+  std::vector<Vec3> coords = real_coords;
+  const BoundaryImages images = add_boundary_images(cavity, coords);
+  return build_transition_with(cavity, coords, grid, blocks, base_node_id, images);
 }
 
 }  // namespace hm
