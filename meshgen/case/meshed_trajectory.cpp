@@ -132,7 +132,7 @@ MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, c
     // along axis k; the end moves back along the leg until that disc keeps the gap.
     const double dk = std::abs(d[k]);
     const double reach = ws.drainage_radius * std::sqrt(std::max(0.0, 1.0 - dk * dk));
-    const double s = (reach + kBoundaryGap * ws.drainage_radius) / dk;
+    const double s = (reach + kRetractGap * ws.drainage_radius) / dk;
     if (!(s < len))
       throw InputError(tkey + ": the leg that crosses " + boundary_plane_name(k, upper, p[k]) + " at " +
                        num(std::acos(dk) * 180.0 / 3.14159265358979323846) +
@@ -168,8 +168,7 @@ MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, c
         if (ends_here) continue;
         const double da = upper ? hi[k] - a[k] : a[k] - lo[k], db = upper ? hi[k] - b[k] : b[k] - lo[k];
         const double dist = std::min(da, db) - reach;
-        // (a retracted end keeps exactly the gap, up to the rounding of its construction)
-        if (dist < (1 - 1e-9) * gap) too_close("the radial block around leg " + std::to_string(s), k, upper, dist);
+        if (dist < gap) too_close("the radial block around leg " + std::to_string(s), k, upper, dist);
       }
     }
   }
