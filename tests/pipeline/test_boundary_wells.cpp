@@ -11,6 +11,7 @@
 #include <set>
 
 #include "fvcheck/lib/checks.hpp"
+#include "fvcheck/lib/quality.hpp"
 #include "meshgen/case/meshed_trajectory.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
@@ -99,6 +100,43 @@ void check_case(const std::string& name, Expect want) {
   EXPECT_EQ(well_boundary, want.boundary_ends * h.blocks[0].rings * h.blocks[0].sectors);
   const double box_area = 2 * (lx * ly + ly * lz + lz * lx) - hole_sections;
   EXPECT_NEAR(boundary_area, box_area, 1e-9 * box_area);
+
+  // Orthogonality of the interior faces of transition cells that reach a boundary plane, against
+  // the other transition cells' (docs/transition.md, "Outer-boundary planes": figures).
+  std::vector<char> at_plane(h.mesh.n_cells(), 0);
+  for (int f = 0; f < h.mesh.n_faces(); ++f)
+    if (h.mesh.face_patch[f] == kOuterBoundary && h.mesh.cell_region[h.mesh.face_owner[f]] == kTransition)
+      at_plane[h.mesh.face_owner[f]] = 1;
+  const std::vector<double> q_o = face_orthogonality(h.mesh, h.geometry);
+  double worst[2] = {90, 90}, sum[2] = {0, 0};
+  int count[2] = {0, 0};
+  for (int f = 0; f < h.mesh.n_faces(); ++f) {
+    const int o = h.mesh.face_owner[f], n = h.mesh.face_neighbour[f];
+    if (n < 0) continue;
+    if (h.mesh.cell_region[o] != kTransition && h.mesh.cell_region[n] != kTransition) continue;
+    const int k = at_plane[o] || at_plane[n] ? 0 : 1;
+    worst[k] = std::min(worst[k], q_o[f]);
+    sum[k] += q_o[f];
+    ++count[k];
+  }
+  std::printf("[ figures  ] %s: transition faces, cells at a boundary plane: %d faces, Q_O min %.2f mean %.3f deg; "
+              "others: %d faces, min %.2f mean %.3f deg\n",
+              name.c_str(), count[0], worst[0], sum[0] / std::max(1, count[0]), count[1], worst[1],
+              sum[1] / std::max(1, count[1]));
+  EXPECT_GT(count[0], 0);
+  int wf = -1;
+  for (int f = 0; f < h.mesh.n_faces(); ++f)
+    if (h.mesh.face_neighbour[f] >= 0 && (wf < 0 || q_o[f] < q_o[wf])) wf = f;
+  std::printf("[ figures  ] %s: worst interior face %.2f deg between regions %d and %d\n", name.c_str(), q_o[wf],
+              h.mesh.cell_region[h.mesh.face_owner[wf]], h.mesh.cell_region[h.mesh.face_neighbour[wf]]);
+  // Boundary faces in the planes: site to face centroid (no flux crosses them; only a Dirichlet
+  // condition imposed there would use it).
+  double worst_boundary = 90;
+  for (int f = 0; f < h.mesh.n_faces(); ++f)
+    if (h.mesh.face_patch[f] == kOuterBoundary && h.mesh.cell_region[h.mesh.face_owner[f]] == kTransition)
+      worst_boundary = std::min(worst_boundary, q_o[f]);
+  std::printf("[ figures  ] %s: transition cells' outer-boundary faces, site to centroid: worst %.2f deg\n",
+              name.c_str(), worst_boundary);
 }
 
 TEST(BoundaryWells, FullyPenetratingVerticalWells) { check_case("vertical_through", {4, {{2, 1000}, {2, 1060}}}); }
