@@ -57,7 +57,7 @@ std::string boundary_plane_name(int axis, bool upper, double value) {
   return what + " (" + names[axis] + " = " + num(value) + ")";
 }
 
-MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, const std::string& key) {
+MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, const std::string& key, bool check_fit) {
   const std::string tkey = key + ".trajectory";
   const Vec3 lo{r.x.front(), r.y.front(), r.z.front()};
   const Vec3 hi{r.x.back(), r.y.back(), r.z.back()};
@@ -168,12 +168,12 @@ MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, c
         if (ends_here) continue;
         const double da = upper ? hi[k] - a[k] : a[k] - lo[k], db = upper ? hi[k] - b[k] : b[k] - lo[k];
         const double dist = std::min(da, db) - reach;
-        if (dist < gap) too_close("the radial block around leg " + std::to_string(s), k, upper, dist);
+        if (check_fit && dist < gap) too_close("the radial block around leg " + std::to_string(s), k, upper, dist);
       }
     }
   }
   const bool explicit_caps = ws.end_caps == EndCaps::Hemisphere && !ws.end_caps_fallback;
-  if (explicit_caps && out.clipped())
+  if (check_fit && explicit_caps && out.clipped())
     throw InputError(key + ".end_caps: hemisphere caps need both ends of the trajectory inside the reservoir; "
                            "this well crosses the reservoir boundary (use flat or auto)");
   out.caps_fit = !out.clipped();
@@ -184,7 +184,7 @@ MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, c
         const bool upper = side == 1;
         const double dist = (upper ? hi[k] - p[k] : p[k] - lo[k]) - R;
         if (dist >= gap) continue;
-        if (explicit_caps)
+        if (check_fit && explicit_caps)
           too_close(std::string("the hemispherical cap at its ") + (e == 0 ? "start" : "end"), k, upper, dist);
         out.caps_fit = false;
       }
@@ -194,7 +194,7 @@ MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, c
 
 WellSpec meshed_well_spec(const CaseSpec& cs, int w) {
   WellSpec ws = cs.wells.at(w);
-  const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, ws, "wells[" + std::to_string(w) + "]");
+  const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, ws, "wells[" + std::to_string(w) + "]", false);
   ws.trajectory = mt.points;
   if (ws.end_caps == EndCaps::Hemisphere && !mt.caps_fit) {
     ws.end_caps = EndCaps::Flat;

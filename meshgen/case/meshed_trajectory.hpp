@@ -46,8 +46,10 @@ struct MeshedTrajectory {
 /// one connected part inside, crossings through one plane at a time, a block that keeps
 /// kBoundaryGap x drainage_radius from every plane it does not end on (hemispherical caps
 /// included). Throws InputError "<key>.trajectory: reason" (or "<key>.end_caps: ..." for
-/// explicit hemispherical caps on a well that crosses the boundary).
-MeshedTrajectory meshed_trajectory(const ReservoirSpec& reservoir, const WellSpec& well, const std::string& key);
+/// explicit hemispherical caps on a well that crosses the boundary). With check_fit false only the
+/// clipping is done (the mesher's own use on a validated case; tests build blocks in any box).
+MeshedTrajectory meshed_trajectory(const ReservoirSpec& reservoir, const WellSpec& well, const std::string& key,
+                                   bool check_fit = true);
 
 /// The well as the mesher builds it: trajectory = the meshed part; end caps flat when the
 /// trajectory crosses the boundary or the caps would come closer to it than the gap

@@ -459,7 +459,7 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   if (w < 0 || w >= static_cast<int>(cs.wells.size())) throw std::out_of_range("make_well_block: no well " + std::to_string(w));
   validate_well(cs.wells[w], w, sectors);
   // Only the part of the trajectory inside the reservoir is meshed (meshed_trajectory.hpp).
-  const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, cs.wells[w], well_key(w));
+  const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, cs.wells[w], well_key(w), false);
   const WellSpec ws = meshed_well_spec(cs, w);
 
   WellBlock block;
