@@ -20,6 +20,7 @@
 
 #include "meshgen/case/case_limits.hpp"
 #include "meshgen/case/grdecl.hpp"
+#include "meshgen/case/meshed_trajectory.hpp"
 #include "meshgen/case/segment_distance.hpp"
 #include "meshgen/case/survey.hpp"
 
@@ -467,23 +468,14 @@ std::string lower(std::string s) {
 // radial grids apart, bounded total size.
 void check_wells(const CaseSpec& cs) {
   const ReservoirSpec& r = cs.reservoir;
-  const Vec3 lo{r.x.front(), r.y.front(), r.z.front()};
-  const Vec3 hi{r.x.back(), r.y.back(), r.z.back()};
+  std::vector<std::vector<Vec3>> meshed;  // the parts of the trajectories inside the box
   double total_cells = double(r.x.size() - 1) * double(r.y.size() - 1) * double(r.z.size() - 1);
 
   for (size_t a = 0; a < cs.wells.size(); ++a) {
     const WellSpec& w = cs.wells[a];
     const std::string path = index_path("wells", a);
-    // The dilated well block must fit in the box: every trajectory point strictly inside
-    // the box shrunk by drainage_radius x dilation.
-    const double margin = w.drainage_radius * cs.transition.dilation;
-    for (size_t i = 0; i < w.trajectory.size(); ++i) {
-      const Vec3 p = w.trajectory[i];
-      bool inside = true;
-      for (int d = 0; d < 3; ++d) inside = inside && p[d] > lo[d] + margin && p[d] < hi[d] - margin;
-      if (!inside)
-        fail(index_path(path + ".trajectory", i), "outside the reservoir (with drainage radius x dilation margin)");
-    }
+    // The part inside the box is meshed; its radial block must fit (meshed_trajectory.hpp).
+    meshed.push_back(meshed_trajectory(r, w, path).points);
     for (size_t b = 0; b < a; ++b) {
       if (cs.wells[b].name == w.name) fail(path + ".name", "duplicate of " + index_path("wells", b) + ".name");
       if (lower(cs.wells[b].name) == lower(w.name))
@@ -508,7 +500,7 @@ void check_wells(const CaseSpec& cs) {
   for (size_t b = 1; b < cs.wells.size(); ++b) {
     for (size_t a = 0; a < b; ++a) {
       const double limit = cs.wells[a].drainage_radius + cs.wells[b].drainage_radius;
-      const double d = polyline_distance(cs.wells[a].trajectory, cs.wells[b].trajectory, limit);
+      const double d = polyline_distance(meshed[a], meshed[b], limit);
       if (d < limit)
         fail(index_path("wells", b) + ".trajectory",
              "too close to " + index_path("wells", a) + " (distance " + fmt6(d) + " m < " + fmt6(limit) +

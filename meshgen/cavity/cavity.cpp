@@ -114,15 +114,16 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
   const double dil = cs.transition.dilation;
   for (size_t w = 0; w < blocks.size(); ++w) {
     const WellSpec& ws = cs.wells[blocks[w].well];
+    const std::vector<Vec3>& traj = blocks[w].trajectory;  // the meshed part
     const double reach = dil * ws.drainage_radius;
-    Vec3 lo = ws.trajectory[0], hi = ws.trajectory[0];
-    for (Vec3 p : ws.trajectory)
+    Vec3 lo = traj[0], hi = traj[0];
+    for (Vec3 p : traj)
       for (int a = 0; a < 3; ++a) { lo[a] = std::min(lo[a], p[a]); hi[a] = std::max(hi[a], p[a]); }
     for (int c = 0; c < nc; ++c) {
       const Vec3 clo = grid.cell_lo(c), chi = grid.cell_hi(c);
       bool far = false;
       for (int a = 0; a < 3; ++a) far = far || clo[a] > hi[a] + reach || chi[a] < lo[a] - reach;
-      if (!far && box_polyline_dist(clo, chi, ws.trajectory) <= reach) active[c] = 0;
+      if (!far && box_polyline_dist(clo, chi, traj) <= reach) active[c] = 0;
     }
   }
   for (int32_t c : extra_deactivated)
@@ -210,14 +211,7 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
       if (active[c]) continue;
       for (int side = 0; side < 6; ++side) {
         const int n = grid.neighbour(c, side);
-        if (n < 0) {
-          std::ostringstream os;
-          const auto ijk = grid.cell_ijk(c);
-          os << "transition.dilation: the cavity reaches the reservoir boundary at cell (" << ijk[0] << "," << ijk[1]
-             << "," << ijk[2] << "); move the wells inward, lower the dilation or extend reservoir.x/y/z";
-          throw InputError(os.str());
-        }
-        if (!active[n]) continue;
+        if (n < 0 || !active[n]) continue;  // the outer boundary: a mirror plane, no polygon
         const auto fn = grid.cell_face_nodes(c, side);
         std::vector<int32_t> poly;
         for (int i = 0; i < 4; ++i) {
@@ -289,9 +283,9 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
   out.cavities.resize(n_comp);
   for (size_t d = 0; d < dead.size(); ++d) out.cavities[comp[d]].deactivated_cells.push_back(dead[d]);
 
-  // Assign each well to the cavity containing its first trajectory point.
+  // Assign each well to the cavity containing the middle of its block's first segment.
   for (size_t w = 0; w < blocks.size(); ++w) {
-    const Vec3 p = cs.wells[blocks[w].well].trajectory[0];
+    const Vec3 p = 0.5 * (blocks[w].layer_center[0] + blocks[w].layer_center[1]);
     int cell = -1;
     for (int c : dead) {
       const Vec3 lo = grid.cell_lo(c), hi = grid.cell_hi(c);
@@ -306,7 +300,14 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
     for (int c : cav.deactivated_cells)
       for (int side = 0; side < 6; ++side) {
         const int n = grid.neighbour(c, side);
-        if (n < 0 || !active[n]) continue;
+        if (n < 0) {
+          const int axis = side / 2;
+          const std::vector<double>& coord = axis == 0 ? grid.x : axis == 1 ? grid.y : grid.z;
+          const MirrorPlane m{axis, side % 2 ? coord.back() : coord.front()};
+          if (std::find(cav.mirrors.begin(), cav.mirrors.end(), m) == cav.mirrors.end()) cav.mirrors.push_back(m);
+          continue;
+        }
+        if (!active[n]) continue;
         ConstrainedFace f;
         const auto fn = grid.cell_face_nodes(n, side ^ 1);  // the active cell's face: outward = into the cavity
         for (int i = 0; i < 4; ++i) f.nodes.push_back(res_node(fn[i]));
@@ -336,11 +337,15 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
       double best = INFINITY;
       for (int w : cav.wells) {
         const WellSpec& ws = cs.wells[blocks[w].well];
-        best = std::min(best, box_polyline_dist(grid.cell_lo(c), grid.cell_hi(c), ws.trajectory) / ws.drainage_radius);
+        best = std::min(best, box_polyline_dist(grid.cell_lo(c), grid.cell_hi(c), blocks[w].trajectory) /
+                                  ws.drainage_radius);
       }
       dmax = std::max(dmax, best);
     }
     cav.dilation_used = std::max(dil, dmax);
+    std::sort(cav.mirrors.begin(), cav.mirrors.end(), [](const MirrorPlane& a, const MirrorPlane& b) {
+      return a.axis != b.axis ? a.axis < b.axis : a.value < b.value;
+    });
     if (cav.wells.empty()) throw InputError("wells: internal error, a cavity without a well");
   }
   return out;

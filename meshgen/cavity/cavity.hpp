@@ -30,12 +30,29 @@ struct ConstrainedFace {
   int32_t patch = kInteriorFace;  ///< kInteriorFace, or wellbore_patch(w) for an end cap (boundary face)
 };
 
+/// A plane of the reservoir's outer boundary that a cavity touches (docs/transition.md,
+/// "Outer-boundary planes"): x[axis] = value. The cavity surface is open there: its part of
+/// the plane is no constrained polygon; the transition mesh sees the mirror image of the
+/// cavity through the plane, and its faces in the plane are outer-boundary faces.
+struct MirrorPlane {
+  int axis = 2;
+  double value = 0;
+  bool operator==(const MirrorPlane& o) const { return axis == o.axis && value == o.value; }
+};
+
+/// p reflected through the plane (exact for points on it: 2 v - v = v).
+inline Vec3 reflect(Vec3 p, const MirrorPlane& m) {
+  p[m.axis] = 2.0 * m.value - p[m.axis];
+  return p;
+}
+
 struct Cavity {
   std::vector<int> wells;                 ///< wells whose blocks lie in this cavity
   std::vector<int32_t> deactivated_cells; ///< reservoir linear cell indices, sorted
   std::vector<ConstrainedFace> faces;     ///< the closed boundary surface
   std::vector<int32_t> vertices;          ///< distinct global node ids of `faces`, sorted
   double dilation_used = 0;               ///< largest local dilation used
+  std::vector<MirrorPlane> mirrors;       ///< outer-boundary planes the cavity touches (sorted by axis, value)
 };
 
 struct CavitySet {
@@ -51,8 +68,9 @@ struct CavitySet {
 /// and `well_node_ids[w]` map lattice/local node indices to builder ids.
 /// `extra_deactivated` (reservoir linear indices) are deactivated too: the cells a
 /// transition mesh asked to move out of its way (TransitionError::cells_to_deactivate).
-/// Throws InputError when a well block does not fit (e.g. pokes out of the reservoir) or
-/// when two well blocks are too close for a Gabriel cavity.
+/// A cavity may reach the reservoir's outer boundary: its deactivated cells' faces on the box
+/// are no constrained polygons; the planes are listed in Cavity::mirrors.
+/// Throws InputError when two well blocks are too close for a Gabriel cavity.
 CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                          const std::vector<int32_t>& reservoir_node_ids,
                          const std::vector<std::vector<int32_t>>& well_node_ids,
@@ -60,7 +78,8 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
                          const std::vector<int32_t>& extra_deactivated = {});
 
 /// Closed 2-manifold check of a cavity boundary (OpenMesh): every edge in exactly two
-/// faces with opposite directions, every vertex's fan a single disk. Returns problems.
+/// faces with opposite directions, every vertex's fan a single disk; edges lying in one of
+/// the cavity's mirror planes may have one face (the surface is open there). Returns problems.
 std::vector<std::string> check_cavity_manifold(const Cavity& cavity, const std::vector<Vec3>& node_coords);
 
 /// Writes the boundary surface of a cavity as an .obj with every coordinate as the shortest

@@ -46,10 +46,16 @@ std::vector<std::string> check_cavity_manifold(const Cavity& cavity, const std::
   std::map<std::pair<int32_t, int32_t>, int> directed;
   for (const ConstrainedFace& f : cavity.faces)
     for (size_t i = 0; i < f.nodes.size(); ++i) ++directed[{f.nodes[i], f.nodes[(i + 1) % f.nodes.size()]}];
+  // An edge in a mirror plane may be open: the surface continues as its mirror image.
+  auto in_mirror = [&](Vec3 a, Vec3 b) {
+    for (const MirrorPlane& m : cavity.mirrors)
+      if (a[m.axis] == m.value && b[m.axis] == m.value) return true;
+    return false;
+  };
   int open_edges = 0, overused = 0;
   for (const auto& [e, n] : directed) {
     if (n > 1) ++overused;
-    if (!directed.count({e.second, e.first})) ++open_edges;
+    if (!directed.count({e.second, e.first}) && !in_mirror(coords[e.first], coords[e.second])) ++open_edges;
   }
   if (open_edges) problems.push_back(std::to_string(open_edges) + " directed edges without their reverse (open surface)");
   if (overused) problems.push_back(std::to_string(overused) + " directed edges used by more than one face (non-manifold)");
@@ -58,8 +64,11 @@ std::vector<std::string> check_cavity_manifold(const Cavity& cavity, const std::
   SurfaceMesh mesh = to_openmesh(cavity, coords, &refused);
   if (refused) problems.push_back(std::to_string(refused) + " faces refused by OpenMesh (non-manifold vertex or edge)");
   int boundary_halfedges = 0;
-  for (auto he : mesh.halfedges())
-    if (mesh.is_boundary(he)) ++boundary_halfedges;
+  for (auto he : mesh.halfedges()) {
+    if (!mesh.is_boundary(he)) continue;
+    const auto a = mesh.point(mesh.from_vertex_handle(he)), b = mesh.point(mesh.to_vertex_handle(he));
+    if (!in_mirror(Vec3{a[0], a[1], a[2]}, Vec3{b[0], b[1], b[2]})) ++boundary_halfedges;
+  }
   if (boundary_halfedges) problems.push_back(std::to_string(boundary_halfedges) + " boundary half-edges (surface not closed)");
   for (auto v : mesh.vertices())
     if (!mesh.is_manifold(v)) { problems.push_back("non-manifold vertex"); break; }

@@ -27,6 +27,7 @@
 #include <stdexcept>
 
 #include "gabriel.hpp"
+#include "meshgen/case/meshed_trajectory.hpp"
 #include "meshgen/case/segment_distance.hpp"
 
 namespace hm {
@@ -456,11 +457,29 @@ void orient_outward(const std::vector<Vec3>& x, std::vector<CellFace>& faces) {
 
 WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   if (w < 0 || w >= static_cast<int>(cs.wells.size())) throw std::out_of_range("make_well_block: no well " + std::to_string(w));
-  const WellSpec& ws = cs.wells[w];
-  validate_well(ws, w, sectors);
+  validate_well(cs.wells[w], w, sectors);
+  // Only the part of the trajectory inside the reservoir is meshed (meshed_trajectory.hpp).
+  const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, cs.wells[w], well_key(w), false);
+  const WellSpec ws = meshed_well_spec(cs, w);
 
   WellBlock block;
   block.well = w;
+  block.trajectory = ws.trajectory;
+  for (int e = 0; e < 2; ++e) {
+    block.boundary_end[e] = mt.ends[e] == WellEndKind::Boundary;
+    block.boundary_axis[e] = block.boundary_end[e] ? mt.plane_axis[e] : -1;
+    block.boundary_value[e] = mt.plane_value[e];
+    if (mt.ends[e] != WellEndKind::Inside)
+      block.notes.push_back(well_label(cs, w) + ": the trajectory crosses " +
+                            boundary_plane_name(mt.plane_axis[e], mt.plane_upper[e], mt.plane_value[e]) +
+                            (mt.ends[e] == WellEndKind::Boundary
+                                 ? ": the radial block ends in that plane (its end faces are outer-boundary faces)"
+                                 : ": the radial block ends " + num(mt.retraction[e]) +
+                                       " m inside (flat end), the transition mesh fills the rest up to the plane"));
+  }
+  if (cs.wells[w].end_caps == EndCaps::Hemisphere && ws.end_caps == EndCaps::Flat)
+    block.notes.push_back(well_label(cs, w) + ": closed with flat ends (end_caps: auto): hemispherical caps do not fit "
+                                              "between the trajectory's ends and the reservoir boundary");
   block.rings = ws.rings;
   block.sectors = sectors;
   block.sectors_requested = ws.sectors;
@@ -536,8 +555,9 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
         faces[1] = {{d, c, c2, d2}, kInteriorFace};                     // outer ring face
         faces[2] = {{a, d, d2, a2}, kInteriorFace};                     // angular face at sector s
         faces[3] = {{b, b2, c2, c}, kInteriorFace};                     // angular face at sector s + 1
-        faces[4] = {{a, b, c, d}, kInteriorFace};                       // axial face on layer l
-        faces[5] = {{a2, d2, c2, b2}, kInteriorFace};                   // axial face on layer l + 1
+        // axial faces on layers l and l + 1; an end lying in a boundary plane is outer boundary
+        faces[4] = {{a, b, c, d}, l == 0 && block.boundary_end[0] ? kOuterBoundary : kInteriorFace};
+        faces[5] = {{a2, d2, c2, b2}, l + 1 == n_segments && block.boundary_end[1] ? kOuterBoundary : kInteriorFace};
         const double vol = hexahedron_volume(block.nodes, faces);
         if (!(vol > 0))
           throw InputError(well_key(w) + ".trajectory: radial cell (ring " + std::to_string(i) + ", sector " +
@@ -639,18 +659,21 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
     for (const auto& [c, k] : cap_outer) add_surface(block.cell_faces[c][k].nodes, c, kInteriorFace);
     return block;
   }
+  // Flat ends: the end annulus and the cap polygon over the wellbore, except at an end lying in
+  // a boundary plane (no flow there, nothing for the transition to claim).
   for (int i = 0; i < rings; ++i)
     for (int s = 0; s < sectors; ++s) {
-      add_surface(block.cell_faces[cell(0, i, s)][4].nodes, cell(0, i, s), kInteriorFace);
-      add_surface(block.cell_faces[cell(n_segments - 1, i, s)][5].nodes, cell(n_segments - 1, i, s), kInteriorFace);
+      if (!block.boundary_end[0]) add_surface(block.cell_faces[cell(0, i, s)][4].nodes, cell(0, i, s), kInteriorFace);
+      if (!block.boundary_end[1])
+        add_surface(block.cell_faces[cell(n_segments - 1, i, s)][5].nodes, cell(n_segments - 1, i, s), kInteriorFace);
     }
   std::vector<int32_t> start_cap, end_cap;
   for (int s = 0; s < sectors; ++s) {
     start_cap.push_back(node(0, 0, sectors - 1 - s));
     end_cap.push_back(node(n_layers - 1, 0, s));
   }
-  add_surface(std::move(start_cap), -1, wellbore);
-  add_surface(std::move(end_cap), -1, wellbore);
+  if (!block.boundary_end[0]) add_surface(std::move(start_cap), -1, wellbore);
+  if (!block.boundary_end[1]) add_surface(std::move(end_cap), -1, wellbore);
   return block;
 }
 
@@ -661,7 +684,7 @@ int count_gabriel_violations(const WellBlock& block) {
 WellBlock make_gabriel_well_block(const CaseSpec& cs, int w) {
   if (w < 0 || w >= static_cast<int>(cs.wells.size()))
     throw std::out_of_range("make_gabriel_well_block: no well " + std::to_string(w));
-  const WellSpec& ws = cs.wells[w];
+  const WellSpec ws = meshed_well_spec(cs, w);
   const int requested = ws.sectors;
   int sectors = requested;
   WellBlock block;
@@ -745,7 +768,7 @@ std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder
 }
 
 double well_block_prism_length(const CaseSpec& cs, int w) {
-  const WellSpec& ws = cs.wells.at(w);
+  const WellSpec ws = meshed_well_spec(cs, w);
   const std::vector<Leg> legs = make_legs(ws, w);
   double length = 0;
   for (const Leg& g : legs) length += g.length;
@@ -780,7 +803,7 @@ double hemisphere_cap_volume(double radius, int sectors) {
 }
 
 double exact_well_block_volume(const CaseSpec& cs, int w, int sectors) {
-  const WellSpec& ws = cs.wells.at(w);
+  const WellSpec ws = meshed_well_spec(cs, w);
   const double annulus = regular_polygon_area(sectors, ws.drainage_radius) - regular_polygon_area(sectors, ws.radius);
   const double caps = ws.end_caps == EndCaps::Hemisphere
                           ? 2.0 * (hemisphere_cap_volume(ws.drainage_radius, sectors) -
@@ -790,7 +813,7 @@ double exact_well_block_volume(const CaseSpec& cs, int w, int sectors) {
 }
 
 double exact_wellbore_hole_volume(const CaseSpec& cs, int w, int sectors) {
-  const WellSpec& ws = cs.wells.at(w);
+  const WellSpec ws = meshed_well_spec(cs, w);
   const double caps = ws.end_caps == EndCaps::Hemisphere ? 2.0 * hemisphere_cap_volume(ws.radius, sectors) : 0.0;
   return regular_polygon_area(sectors, ws.radius) * well_block_prism_length(cs, w) + caps;
 }

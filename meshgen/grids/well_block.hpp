@@ -9,6 +9,7 @@
 // The wellbore r < radius is a hole: ring-0 inner faces are boundary faces (wellbore patch).
 // The two extremities are closed as documented in docs/architecture.md (end caps).
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -41,6 +42,15 @@ struct WellBlock {
   /// the cylinder's, their nodes follow the layers' (start cap first), and the outer surface
   /// is the cylinder's side plus the caps' outer shells (no end faces, no wellbore polygons).
   bool hemisphere_caps = false;
+  /// The meshed part of the trajectory (meshed_trajectory.hpp): the user's, clipped to the box.
+  std::vector<Vec3> trajectory;
+  /// Per end (start, end): the block ends IN a boundary plane (a trajectory crossing it at
+  /// right angles). Its end annulus faces are then outer-boundary faces (kOuterBoundary) and no
+  /// surface polygon: neither end annulus nor wellbore cap; boundary_axis / boundary_value
+  /// name the plane (axis -1 otherwise).
+  std::array<bool, 2> boundary_end{false, false};
+  std::array<int, 2> boundary_axis{-1, -1};
+  std::array<double, 2> boundary_value{0, 0};
   int sectors_requested = 0;       ///< as in the case file
   std::vector<std::string> notes;  ///< what was changed to make it valid (e.g. sectors raised)
 };

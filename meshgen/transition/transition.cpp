@@ -39,6 +39,43 @@ std::vector<int> non_admissible(const Cavity& cavity, const std::vector<PolygonF
 }
 }  // namespace
 
+namespace transition_detail {
+
+std::vector<int32_t> BoundaryImages::image_of(int k, const std::vector<int32_t>& ids) const {
+  std::vector<int32_t> out;
+  out.reserve(ids.size());
+  for (int32_t v : ids) {
+    const auto it = std::lower_bound(vertices.begin(), vertices.end(), v);
+    out.push_back(it != vertices.end() && *it == v ? image[k][it - vertices.begin()] : v);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+BoundaryImages add_boundary_images(Cavity& cavity, std::vector<Vec3>& coords) {
+  BoundaryImages im;
+  im.planes = cavity.mirrors;
+  im.vertices = cavity.vertices;
+  im.first_image = static_cast<int32_t>(coords.size());
+  for (const MirrorPlane& m : im.planes) {
+    std::vector<int32_t> ids(im.vertices.size());
+    for (size_t i = 0; i < im.vertices.size(); ++i) {
+      const Vec3 p = coords[im.vertices[i]];
+      if (p[m.axis] == m.value) {
+        ids[i] = im.vertices[i];
+        continue;
+      }
+      ids[i] = static_cast<int32_t>(coords.size());
+      coords.push_back(reflect(p, m));
+      cavity.vertices.push_back(ids[i]);
+    }
+    im.image.push_back(std::move(ids));
+  }
+  return im;
+}
+
+}  // namespace transition_detail
+
 std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<Vec3>& node_coords) {
   std::vector<std::string> notes;
   const std::vector<PolygonFrame> frames = frames_of(cavity, node_coords, notes);
@@ -54,9 +91,11 @@ std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector
 }
 
 namespace {
-TransitionCells build_transition_or_throw(const Cavity& cavity, const std::vector<Vec3>& node_coords,
-                                          const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
-                                          int32_t base_node_id, const TransitionOptions& options) {
+
+TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Vec3>& node_coords,
+                                      const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                      int32_t base_node_id, const BoundaryImages& images,
+                                      const TransitionOptions& options) {
   TransitionReport report;
   using Clock = std::chrono::steady_clock;
   auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
@@ -88,7 +127,7 @@ TransitionCells build_transition_or_throw(const Cavity& cavity, const std::vecto
   for (;;) {
     out = TransitionCells{};
     out.base_node_id = base_node_id;
-    std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out);
+    std::vector<int> hidden = build_power_cells(set, cavity, node_coords, frames, out, images);
     bool degenerate = false;
     if (hidden.empty()) {
       // Free sites are optional: one whose cell came out unusable (near-degenerate sites whose
@@ -139,15 +178,18 @@ TransitionCells build_transition_or_throw(const Cavity& cavity, const std::vecto
     enforce_empty_spheres(set, cavity, node_coords, grid, frames);
     // Free sites now inside a moved sphere go first, so that the correction never shrinks a
     // polygon or box site on account of an optional site; and again after it.
-    report.dropped_tip_sites += drop_blocked_tip_sites(set);
+    report.dropped_tip_sites += drop_blocked_tip_sites(set, cavity.mirrors);
     report.site_corrections +=
         correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
     report.correction_iterations += iterations;
-    report.dropped_tip_sites += drop_blocked_tip_sites(set);
+    report.dropped_tip_sites += drop_blocked_tip_sites(set, cavity.mirrors);
   }
   const Clock::time_point t3 = Clock::now();
   SiteOptimizeReport optimization;
-  if (options.optimize) {
+  // The site optimiser rebuilds the diagram without the boundary planes' mirror sites: a cavity
+  // that touches the outer boundary is left as built (docs/optimization.md).
+  const bool optimize = options.optimize && images.empty();
+  if (optimize) {
     auto raw = std::make_shared<const TransitionCells>(out);
     optimization = optimize_sites(set, cavity, node_coords, frames, options, out);
     out.unoptimized = std::move(raw);
@@ -155,7 +197,7 @@ TransitionCells build_transition_or_throw(const Cavity& cavity, const std::vecto
   // Merge the stage reports.
   TransitionReport& r = out.report;
   r.optimization = optimization;
-  r.seconds_optimize = options.optimize ? seconds(t3, Clock::now()) : 0.0;
+  r.seconds_optimize = optimize ? seconds(t3, Clock::now()) : 0.0;
   r.seconds_delaunay = seconds(t0, t1);
   r.seconds_sites = seconds(t1, t2);
   r.seconds_power = seconds(t2, t3);
@@ -179,6 +221,19 @@ TransitionCells build_transition_or_throw(const Cavity& cavity, const std::vecto
                       (r.dropped_tip_sites > 0 ? " (" + std::to_string(r.dropped_tip_sites) + " dropped)" : ""));
   return out;
 }
+// Outer-boundary planes: every stage sees the images of the cavity vertices too (empty
+// spheres, Delaunay); the power diagram adds the images of the sites.
+TransitionCells build_transition_or_throw(const Cavity& real_cavity, const std::vector<Vec3>& real_coords,
+                                          const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                                          int32_t base_node_id, const TransitionOptions& options) {
+  if (real_cavity.mirrors.empty())
+    return build_transition_with(real_cavity, real_coords, grid, blocks, base_node_id, {}, options);
+  Cavity cavity = real_cavity;
+  std::vector<Vec3> coords = real_coords;
+  const BoundaryImages images = add_boundary_images(cavity, coords);
+  return build_transition_with(cavity, coords, grid, blocks, base_node_id, images, options);
+}
+
 }  // namespace
 
 TransitionOutcome try_build_transition(const Cavity& cavity, const std::vector<Vec3>& node_coords,

@@ -48,6 +48,9 @@ enum class SiteKind : int {
   /// Weight 0, strictly inside the cavity beyond a well's end, owns no constrained polygon
   /// (grades the cells around the tip, docs/transition.md "Tip sites").
   Free = 5,
+  /// The mirror image of a site through an outer-boundary plane of the cavity (power diagram
+  /// only, docs/transition.md "Outer-boundary planes"): same weight, image constrained vertices.
+  Image = 6,
 };
 
 struct Site {
@@ -61,12 +64,31 @@ struct Site {
   double t = 0;           ///< InternalPolygon: parameter on the dual line
   double t_cap = kInf;    ///< InternalPolygon: largest t the correction may grow it to (end faces)
   double clearance = 0;   ///< Free: distance it keeps from every other site's sphere
+  int image_of = -1;      ///< Image: the site it reflects
+  int plane = -1;         ///< Image: index of the plane in Cavity::mirrors
   std::vector<int> polygons;       ///< constrained polygons of this site (cavity face indices)
   std::vector<int32_t> vertices;   ///< sorted distinct global node ids of those polygons
   bool internal() const {
     return kind == SiteKind::InternalBox || kind == SiteKind::InternalPolygon || kind == SiteKind::Free;
   }
 };
+
+/// The images of a cavity's vertices through its outer-boundary planes. A vertex on a plane is
+/// its own image; the others get ids from `first_image` on (past the caller's coordinates).
+struct BoundaryImages {
+  std::vector<MirrorPlane> planes;
+  std::vector<int32_t> vertices;            ///< the cavity's own vertices, sorted
+  std::vector<std::vector<int32_t>> image;  ///< [plane][i]: id of the image of vertices[i]
+  int32_t first_image = 0;
+  bool empty() const { return planes.empty(); }
+  /// Sorted image ids of the given (own, sorted) vertex ids through plane k.
+  std::vector<int32_t> image_of(int k, const std::vector<int32_t>& ids) const;
+};
+
+/// Appends the images of the cavity vertices that are off its planes to `cavity.vertices` and
+/// `coords` (ids coords.size(), ...): every stage that keeps spheres empty or builds the
+/// Delaunay of the vertices then sees the mirrored cavity too.
+BoundaryImages add_boundary_images(Cavity& cavity, std::vector<Vec3>& coords);
 
 struct SiteSet {
   std::vector<Site> sites;
@@ -141,8 +163,9 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
                     const std::vector<WellBlock>& blocks);
 
 /// Drops the Free sites that an other site's sphere (grown by the free site's clearance) now
-/// reaches, after sites moved (hidden-site repair). Returns the number dropped.
-int drop_blocked_tip_sites(SiteSet& set);
+/// reaches, after sites moved (hidden-site repair), also through the outer-boundary planes.
+/// Returns the number dropped.
+int drop_blocked_tip_sites(SiteSet& set, const std::vector<MirrorPlane>& planes = {});
 
 /// Free sites whose cells came out of the power diagram unusable: a face whose node set is also
 /// another face's (after vertex identification; the builder would see a face named by three
@@ -158,9 +181,12 @@ std::vector<int> sites_in_duplicate_faces(const SiteSet& set, const TransitionCe
 /// Stage 5.6-5.7 (CGAL Regular_triangulation_3): power cells of the internal sites,
 /// power vertices identified combinatorially, external faces snapped to the constrained
 /// polygons. Fills `out` (cells, new nodes, report counters). Returns the ids of internal
-/// sites that are hidden (no cell); nothing is emitted then.
+/// sites that are hidden (no cell); nothing is emitted then. With outer-boundary planes every
+/// site's image joins the diagram; the face between a site and its own image lies in the plane
+/// and is emitted as an outer-boundary face (kOuterBoundary).
 std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
-                                   const std::vector<PolygonFrame>& frames, TransitionCells& out);
+                                   const std::vector<PolygonFrame>& frames, TransitionCells& out,
+                                   const BoundaryImages& images = {});
 
 /// The site optimiser (transition_optimize.cpp): rounds of independent site moves that
 /// remove or expand short edges, each followed by a rebuild of the exact diagram; `out` is a

@@ -126,11 +126,38 @@ struct RawFace {
   int s = -1, t = -1;          // sites; s internal; cycle is outward for s
   std::vector<int> classes;    // power vertex classes in cycle order
   bool external = false;       // t is an external site
+  bool boundary = false;       // t is the image of s: the face lies in an outer-boundary plane
+  bool stray = false;          // t is the image of another site (zero area in exact geometry)
 };
+
+// The real sites plus, per outer-boundary plane, the image of every live site.
+SiteSet with_images(const SiteSet& real, const BoundaryImages& images) {
+  SiteSet set = real;
+  const int n = static_cast<int>(real.sites.size());
+  for (int k = 0; k < static_cast<int>(images.planes.size()); ++k)
+    for (int s = 0; s < n; ++s) {
+      const Site& r = real.sites[s];
+      if (!r.alive || r.kind == SiteKind::Guard) continue;
+      Site im;
+      im.kind = SiteKind::Image;
+      im.p = reflect(r.p, images.planes[k]);
+      im.w2 = r.w2;
+      im.unchecked = false;
+      im.vertices = images.image_of(k, r.vertices);
+      im.image_of = s;
+      im.plane = k;
+      set.sites.push_back(std::move(im));
+    }
+  return set;
+}
 }  // namespace
 
-std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
-                                   const std::vector<PolygonFrame>& frames, TransitionCells& out) {
+std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                   const std::vector<PolygonFrame>& frames, TransitionCells& out,
+                                   const BoundaryImages& images) {
+  const SiteSet imaged = images.empty() ? SiteSet{} : with_images(real_set, images);
+  const SiteSet& set = images.empty() ? real_set : imaged;
+  const int n_real = static_cast<int>(real_set.sites.size());
   const int ns = static_cast<int>(set.sites.size());
   TransitionReport& rep = out.report;
   // ---- regular triangulation of the sites plus 8 far guard points of weight 0
@@ -156,7 +183,9 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
   std::vector<int> hidden;
   for (int s = 0; s < ns; ++s)
     if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard && vertex_of[s] == Regular::Vertex_handle())
-      hidden.push_back(s);
+      hidden.push_back(s < n_real ? s : set.sites[s].image_of);  // an image is hidden with its site
+  std::sort(hidden.begin(), hidden.end());
+  hidden.erase(std::unique(hidden.begin(), hidden.end()), hidden.end());
   if (!hidden.empty()) return hidden;
   auto is_guard = [&](int id) { return id >= ns; };
   auto is_internal = [&](int id) { return id < ns && set.sites[id].internal(); };
@@ -275,6 +304,10 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     f.s = s;
     f.t = t;
     f.external = !ti || !si;
+    if (set.sites[t].kind == SiteKind::Image) {
+      f.external = false;
+      (set.sites[t].image_of == s ? f.boundary : f.stray) = true;
+    }
     faces.push_back(std::move(f));
   }
   // Deterministic face order: by (s, t) site ids.
@@ -396,6 +429,11 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     for (int cls : faces[i].classes) cycles[i].push_back(token(cls));
     clean_cycle(cycles[i]);
     if (cycles[i].size() < 3) ++removed;
+    // A cell is on its site's side of every outer-boundary plane: it never reaches an image vertex.
+    for (Token tk : cycles[i])
+      if (!images.empty() && cycles[i].size() >= 3 && tk >= images.first_image)
+        throw std::runtime_error("transition: the cell of site " + std::to_string(faces[i].s) +
+                                 " reaches the image of a cavity vertex through an outer-boundary plane");
   }
   rep.removed_faces = removed;
 
@@ -430,6 +468,14 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     out.new_nodes.push_back(class_info(cls).point);
     out.new_node_sites.push_back(key);
   }
+  // Free vertices of the faces in an outer-boundary plane lie in it exactly (the images are
+  // reflections rounded once: the power vertices are within rounding of the plane).
+  for (size_t i = 0; i < faces.size(); ++i) {
+    if (!faces[i].boundary || cycles[i].size() < 3) continue;
+    const MirrorPlane& m = images.planes[set.sites[faces[i].t].plane];
+    for (Token tk : cycles[i])
+      if (tk < 0) out.new_nodes[free_id.at(static_cast<int>(-1 - tk)) - out.base_node_id][m.axis] = m.value;
+  }
   rep.identified_vertices = identified;
   rep.free_vertices = static_cast<int>(out.new_nodes.size());
   rep.ambiguous_vertices = ambiguous;
@@ -459,6 +505,22 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
     std::vector<int32_t> cyc;
     for (Token tk : cycles[i]) cyc.push_back(node_of(tk));
     CellFace cf;
+    if (f.boundary || f.stray) {
+      // In an outer-boundary plane: a boundary face of the cell (a stray face, which cannot
+      // have area in exact geometry, is left interior so that the builder reports it).
+      cf.nodes = rotate_to_min(cyc);
+      cf.patch = f.boundary ? kOuterBoundary : kInteriorFace;
+      if (f.stray) {
+        ++unmatched;
+        std::ostringstream os;
+        os << "face of site " << f.s << " toward the image of site " << set.sites[f.t].image_of
+           << " has area (outer-boundary plane)";
+        if (rep.notes.size() < 50) rep.notes.push_back(os.str());
+      }
+      out.cells[cell_of_site[f.s]].push_back(cf);
+      ++n_faces;
+      continue;
+    }
     if (!f.external) {
       cf.nodes = rotate_to_min(cyc);
       out.cells[cell_of_site[f.s]].push_back(cf);

@@ -408,6 +408,7 @@ void shrink_or_split(SiteSet& set, int s, double alpha, const Cavity& cavity, co
       site.alive = false;
       break;
     case SiteKind::Guard:
+    case SiteKind::Image:  // power diagram only (build_power_cells)
       break;
   }
 }

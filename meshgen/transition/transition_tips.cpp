@@ -85,17 +85,18 @@ std::vector<WellEnd> well_ends(const Cavity& cavity, const std::vector<WellBlock
     if (std::find(cavity.wells.begin(), cavity.wells.end(), b.well) == cavity.wells.end()) continue;
     const std::vector<Vec3>& c = b.layer_center;
     if (c.size() < 2 || b.radii.size() < 2) continue;
+    // An end lying in an outer-boundary plane has no end faces and nothing beyond it.
     WellEnd e;
     e.well = b.well;
     e.radii = b.radii;
     e.center = c.front();
     e.axis = normalized(c[0] - c[1]);
     e.end_length = norm(c[0] - c[1]);
-    ends.push_back(e);
+    if (!b.boundary_end[0]) ends.push_back(e);
     e.center = c.back();
     e.axis = normalized(c[c.size() - 1] - c[c.size() - 2]);
     e.end_length = norm(c[c.size() - 1] - c[c.size() - 2]);
-    ends.push_back(e);
+    if (!b.boundary_end[1]) ends.push_back(e);
   }
   return ends;
 }
@@ -108,9 +109,14 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
   if (ends.empty()) return 0;
 
   // Obstacles sorted by x - radius: every live site's sphere and every cavity vertex.
+  // Through an outer-boundary plane a free site must also clear the images of the spheres (its
+  // own image is then its neighbour across the plane): the images join the obstacles.
   std::vector<Obstacle> obstacles;
   for (const Site& s : set.sites)
-    if (s.alive && s.kind != SiteKind::Guard) obstacles.push_back({s.p, std::sqrt(s.w2)});
+    if (s.alive && s.kind != SiteKind::Guard) {
+      obstacles.push_back({s.p, std::sqrt(s.w2)});
+      for (const MirrorPlane& m : cavity.mirrors) obstacles.push_back({reflect(s.p, m), std::sqrt(s.w2)});
+    }
   for (int32_t v : cavity.vertices) obstacles.push_back({coords[v], 0.0});
   double max_radius = 0;
   for (const Obstacle& o : obstacles) max_radius = std::max(max_radius, o.radius);
@@ -123,8 +129,13 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
         std::lower_bound(xs.begin(), xs.end(), f.x - max_radius - delta) - xs.begin());
     for (size_t k = lo; k < obstacles.size() && xs[k] <= f.x + max_radius + delta; ++k)
       if (norm(f - obstacles[k].p) < obstacles[k].radius + delta) return false;
-    for (const Vec3& p : placed)
+    for (const Vec3& p : placed) {
       if (norm(f - p) < delta) return false;
+      for (const MirrorPlane& m : cavity.mirrors)
+        if (norm(f - reflect(p, m)) < delta) return false;
+    }
+    for (const MirrorPlane& m : cavity.mirrors)
+      if (norm(f - reflect(f, m)) < delta) return false;
     return true;
   };
 
@@ -174,17 +185,21 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
   return added;
 }
 
-int drop_blocked_tip_sites(SiteSet& set) {
+int drop_blocked_tip_sites(SiteSet& set, const std::vector<MirrorPlane>& planes) {
   int dropped = 0;
   for (Site& f : set.sites) {
     if (!f.alive || f.kind != SiteKind::Free) continue;
-    for (const Site& s : set.sites)
-      if (s.alive && s.kind != SiteKind::Free && s.kind != SiteKind::Guard &&
-          norm(f.p - s.p) < std::sqrt(s.w2) + f.clearance) {
+    for (const Site& s : set.sites) {
+      if (!s.alive || s.kind == SiteKind::Free || s.kind == SiteKind::Guard) continue;
+      bool blocked = norm(f.p - s.p) < std::sqrt(s.w2) + f.clearance;
+      for (const MirrorPlane& m : planes)
+        blocked = blocked || norm(f.p - reflect(s.p, m)) < std::sqrt(s.w2) + f.clearance;
+      if (blocked) {
         f.alive = false;
         ++dropped;
         break;
       }
+    }
   }
   return dropped;
 }

@@ -548,17 +548,45 @@ TEST(CaseErrors, TrajectoryRepeatsPoint) {
 }
 
 TEST(CaseErrors, TrajectoryOutsideTheReservoir) {
-  // Margin 8 x 1.5 = 12: z must lie strictly inside (12, 48), x inside (12, 88).
+  // Only the part inside the box is meshed (meshed_trajectory.hpp); the block keeps
+  // 0.25 x 8 = 2 m from a plane it does not end on: x >= 10 for a vertical well.
   const std::string t = "[[30, 50, 15], [30, 50, 45]]";
-  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 47.9]]")), "");
-  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 48]]")),
-            "wells[0].trajectory[1]: outside the reservoir (with drainage radius x dilation margin)");
-  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 30], [12, 50, 40]]")),
-            "wells[0].trajectory[2]: outside the reservoir (with drainage radius x dilation margin)");
-  // The margin follows transition.dilation: 8 x 1.0 = 8 lets z = 48 in.
-  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 48]]") + "transition: {dilation: 1.0}\n"), "");
-  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 15], [30, 50, 45]]") + "transition: {dilation: 2.0}\n"),
-            "wells[0].trajectory[0]: outside the reservoir (with drainage radius x dilation margin)");
+  EXPECT_EQ(error_of(with(kBase, t, "[[10, 50, 15], [10, 50, 45]]")), "");
+  EXPECT_EQ(error_of(with(kBase, t, "[[9.5, 50, 15], [9.5, 50, 45]]")),
+            "wells[0].trajectory: the radial block around leg 0 comes within 1.5 m of the reservoir side x min (x = 0); "
+            "it must keep 2 m (0.25 x drainage_radius) from a boundary plane it does not end on, or cross the plane");
+  // Through the top and the bottom, or from the top down; not at all inside.
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, -10], [30, 50, 70]]")), "");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, -10], [30, 50, 40]]")), "");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, -20], [30, 50, -5]]")),
+            "wells[0].trajectory: no part of it lies inside the reservoir");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 10], [30, 50, -10], [40, 50, -10], [40, 50, 10]]")),
+            "wells[0].trajectory: leaves the reservoir and comes back (leg 0); only one connected part inside can be "
+            "meshed");
+  EXPECT_EQ(error_of(with(kBase, t, "[[-10, 50, -10], [30, 50, 30]]")),
+            "wells[0].trajectory: crosses the reservoir boundary at an edge or corner of the box (0, 50, 0); a well "
+            "may cross one boundary plane at a time");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 0], [40, 50, 0]]")),
+            "wells[0].trajectory: runs along the reservoir top (z = 0); a well must lie inside the reservoir or cross "
+            "its boundary");
+  // Oblique crossing: the block ends (8 sin(a) + 0.5 x 8) / cos(a) m inside, which needs a leg that long.
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, -10], [40, 50, 20]]")), "");
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, -1], [31, 50, 1]]")),
+            "wells[0].trajectory: the leg that crosses the reservoir top (z = 0) at 26.5651 degrees from its normal is "
+            "too short to end the radial block inside (the block ends 8.47214 m from the crossing, the leg has "
+            "1.11803 m inside)");
+  // Hemispherical caps: they must keep the gap too (auto falls back to flat ends), and cannot
+  // close an end on the boundary.
+  const std::string caps = "    bhp: 150\n  - name: I1";
+  EXPECT_EQ(error_of(with(kBase, t, "[[30, 50, 9], [30, 50, 45]]")), "");
+  EXPECT_EQ(error_of(with(with(kBase, t, "[[30, 50, 9], [30, 50, 45]]"), caps,
+                          "    bhp: 150\n    end_caps: hemisphere\n  - name: I1")),
+            "wells[0].trajectory: the hemispherical cap at its start comes within 1 m of the reservoir top (z = 0); it "
+            "must keep 2 m (0.25 x drainage_radius) from a boundary plane it does not end on, or cross the plane");
+  EXPECT_EQ(error_of(with(with(kBase, t, "[[30, 50, -10], [30, 50, 45]]"), caps,
+                          "    bhp: 150\n    end_caps: hemisphere\n  - name: I1")),
+            "wells[0].end_caps: hemisphere caps need both ends of the trajectory inside the reservoir; this well "
+            "crosses the reservoir boundary (use flat or auto)");
 }
 
 TEST(CaseErrors, WellsTooClose) {

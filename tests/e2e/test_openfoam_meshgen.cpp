@@ -65,5 +65,9 @@ void check_example(const std::string& example) {
 
 TEST(OpenFoamMeshgen, PaperSingleWellCaseReadsInCheckMesh) { check_example("paper_single_well"); }
 TEST(OpenFoamMeshgen, ThreeWellsCaseReadsInCheckMesh) { check_example("three_wells"); }
+// Wells through the reservoir boundary (issue 12).
+TEST(OpenFoamMeshgen, VerticalThroughCaseReadsInCheckMesh) { check_example("vertical_through"); }
+TEST(OpenFoamMeshgen, DeviatedThroughTopCaseReadsInCheckMesh) { check_example("deviated_through_top"); }
+TEST(OpenFoamMeshgen, HorizontalThroughSidesCaseReadsInCheckMesh) { check_example("horizontal_through_sides"); }
 
 }  // namespace

@@ -204,4 +204,35 @@ TEST(FlowExamples, LayeredGrdeclModelMatchesTheCompressibleSolve) {
   EXPECT_GE(near_well_k.size(), 5u);
 }
 
+// Wells through the reservoir boundary (issue 12): a producer and an injector each, fully
+// penetrating (vertical_through), entering through the top at 30 degrees (deviated_through_top),
+// horizontal from side to side in a reservoir 2.5 drainage radii thick (horizontal_through_sides).
+// The blocks' end faces in the boundary planes and the transition cells' faces there are no-flow.
+TEST(FlowExamples, VerticalThroughMatchesTheCompressibleSolve) {
+  REQUIRE_FLOW();
+  ExampleRun r;
+  run_example(load_example("vertical_through"), "vertical_through", &r);
+  if (HasFatalFailure()) return;
+  expect_match(r.c);
+  EXPECT_GT(std::abs(r.ours.well_rate[0]), 1.0);  // the injector drives a real flow
+}
+
+TEST(FlowExamples, DeviatedThroughTopMatchesTheCompressibleSolve) {
+  REQUIRE_FLOW();
+  ExampleRun r;
+  run_example(load_example("deviated_through_top"), "deviated_through_top", &r);
+  if (HasFatalFailure()) return;
+  expect_match(r.c);
+  EXPECT_GT(std::abs(r.ours.well_rate[0]), 1.0);
+}
+
+TEST(FlowExamples, HorizontalThroughSidesMatchesTheCompressibleSolve) {
+  REQUIRE_FLOW();
+  ExampleRun r;
+  run_example(load_example("horizontal_through_sides"), "horizontal_through_sides", &r);
+  if (HasFatalFailure()) return;
+  expect_match(r.c);
+  EXPECT_GT(std::abs(r.ours.well_rate[0]), 1.0);
+}
+
 }  // namespace

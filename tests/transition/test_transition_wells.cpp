@@ -156,6 +156,19 @@ WellMetrics measure(const HybridMesh& hm) {
     mt.min_site_margin = std::min(mt.min_site_margin, margin);
     mt.sites_outside += margin <= 0;
   }
+  // A cavity reaching the reservoir boundary is open there: the transition cells' faces in the
+  // boundary planes close it (outward from the cavity).
+  for (int f = 0; f < hm.mesh.n_faces(); ++f) {
+    if (hm.mesh.face_patch[f] != kOuterBoundary || hm.mesh.cell_region[hm.mesh.face_owner[f]] != kTransition) continue;
+    Vec3 g;
+    for (const int32_t* v = hm.mesh.face_begin(f); v != hm.mesh.face_end(f); ++v)
+      g += hm.mesh.nodes[*v] / static_cast<double>(hm.mesh.face_size(f));
+    for (int i = 0; i < hm.mesh.face_size(f); ++i) {
+      const Vec3 a = hm.mesh.nodes[hm.mesh.face_begin(f)[i]],
+                 b = hm.mesh.nodes[hm.mesh.face_begin(f)[(i + 1) % hm.mesh.face_size(f)]];
+      cavity_volume += dot(g, cross(a, b)) / 6.0;
+    }
+  }
   mt.mean_orth = mt.n_orth ? orth_sum / mt.n_orth : 90;
   mt.volume_error = std::abs(transition_volume - cavity_volume) / cavity_volume;
   mt.faces = static_cast<int>(tfaces.size());
@@ -272,6 +285,27 @@ TEST(TransitionWells, AutoEndCapsKeepTheCapsWhereTheyMesh) {
       build_hybrid_mesh(parse_case(case_yaml("hauto", well("H", "[[33, 50, 25], [67, 50, 25]]", 4.0, "auto"))), opts);
   EXPECT_TRUE(h.blocks.at(0).hemisphere_caps);
   for (const std::string& n : h.notes) EXPECT_EQ(n.find("closed with flat ends"), std::string::npos) << n;
+  const HybridMesh v =
+      build_hybrid_mesh(parse_case(case_yaml("vauto", well("V", "[[50, 50, 14], [50, 50, 36]]", 4.0, "auto"))), opts);
+  EXPECT_TRUE(v.blocks.at(0).hemisphere_caps);
+}
+
+// end_caps: auto where the caps do not fit between an end and the reservoir boundary (the start
+// 4.5 m below the top, R = 4 m: the cap would come within 0.5 m of it, the gap is 0.25 R = 1 m):
+// flat ends, said in the notes, and the mesh has every run_case property. Where the caps fit,
+// auto keeps them.
+TEST(TransitionWells, AutoEndCapsFallBackToFlatEndsWhereCapsDoNotFit) {
+  const CaseSpec cs = parse_case(case_yaml("vauto", well("V", "[[50, 50, 4.5], [50, 50, 36]]", 4.0, "auto")));
+  run_case("vertical, auto caps near the top", cs, 1);
+  PipelineOptions opts;
+  opts.optimize = false;
+  const HybridMesh hm = build_hybrid_mesh(cs, opts);
+  ASSERT_EQ(hm.blocks.size(), 1u);
+  EXPECT_FALSE(hm.blocks[0].hemisphere_caps);
+  bool said = false;
+  for (const std::string& n : hm.notes)
+    said = said || n.find("wells[0] (V): closed with flat ends (end_caps: auto): hemispherical caps do not fit") == 0;
+  EXPECT_TRUE(said);
   const HybridMesh v =
       build_hybrid_mesh(parse_case(case_yaml("vauto", well("V", "[[50, 50, 14], [50, 50, 36]]", 4.0, "auto"))), opts);
   EXPECT_TRUE(v.blocks.at(0).hemisphere_caps);
