@@ -157,7 +157,8 @@ PYBIND11_MODULE(hybridmesh, mod) {
 
   mod.def("load_case", &hm::load_case, py::arg("path"),
           "Reads and validates a YAML case file; raises InputError('key.path: reason').");
-  mod.def("parse_case", &hm::parse_case, py::arg("yaml_text"), "Same as load_case, from YAML text.");
+  mod.def("parse_case", &hm::parse_case, py::arg("yaml_text"), py::arg("base_dir") = std::string(),
+          "Same as load_case, from YAML text; base_dir: where relative paths (reservoir.grdecl) start.");
 
   py::class_<Mesh, std::shared_ptr<Mesh>>(mod, "Mesh", "A conforming hybrid mesh (docs/mesh-layout.md).")
       .def_property_readonly("n_nodes", [](const Mesh& m) { return m.result.mesh.n_nodes(); })
