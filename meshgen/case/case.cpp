@@ -4,6 +4,7 @@
 #include "meshgen/case/case.hpp"
 
 #include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -574,12 +575,51 @@ std::vector<double> hemisphere_end_grading(const WellSpec& ws) {
   return g;
 }
 
+namespace {
+
+/// Start marks of the documents of a YAML stream (yaml-cpp's event parser; no nodes built).
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> starts;
+  void OnDocumentStart(const YAML::Mark& mark) override { starts.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+/// Number of documents in the stream. yaml-cpp 0.7's LoadAll loops forever, allocating a null
+/// document per turn, on a token that starts no node (a ',' outside [ ] or { }: jbeder/yaml-cpp#1040,
+/// fixed upstream by PR #1319; found by tests/fuzz/fuzz_case): a document that starts where the
+/// previous one started made no progress, and is refused.
+size_t count_documents(const std::string& yaml_text) {
+  std::istringstream in(yaml_text);
+  YAML::Parser parser(in);
+  DocumentStarts docs;
+  while (parser.HandleNextDocument(docs)) {
+    const size_t n = docs.starts.size();
+    if (n >= 2 && docs.starts[n - 1].pos == docs.starts[n - 2].pos) {
+      const YAML::Mark& m = docs.starts[n - 1];
+      fail("case file", "YAML error at line " + std::to_string(m.line + 1) + ", column " + std::to_string(m.column + 1) +
+                            ": unexpected token (a ',' outside a [ ] or { } list?)");
+    }
+  }
+  return docs.starts.size();
+}
+
+}  // namespace
+
 CaseSpec parse_case(const std::string& yaml_text, const std::string& base_dir) {
   try {
-    const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
-    if (docs.empty() || (docs.size() == 1 && docs[0].IsNull())) fail("case file", "empty document");
-    if (docs.size() > 1) fail("case file", "expected one YAML document, got " + std::to_string(docs.size()));
-    return read_case(docs[0], base_dir);
+    const size_t n_docs = count_documents(yaml_text);
+    if (n_docs > 1) fail("case file", "expected one YAML document, got " + std::to_string(n_docs));
+    const YAML::Node doc = YAML::Load(yaml_text);
+    if (n_docs == 0 || doc.IsNull()) fail("case file", "empty document");
+    return read_case(doc, base_dir);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp reports its nesting limit as "bad file"; say what happened.
     fail("case file", "YAML error at line " + std::to_string(e.mark.line + 1) + ", column " +

@@ -277,6 +277,19 @@ TEST(CaseErrors, SeveralDocuments) {
   EXPECT_EQ(error_of(kBase + "---\nname: b\n"), "case file: expected one YAML document, got 2");
 }
 
+// yaml-cpp 0.7's LoadAll never returns (and allocates without bound) on a stray ',' (found by
+// tests/fuzz/fuzz_case); parse_case must refuse it. Before the fix this test hung.
+TEST(CaseErrors, StrayCommaIsRefusedNotALoop) {
+  EXPECT_EQ(error_of(","), "case file: YAML error at line 1, column 1: unexpected token (a ',' outside a [ ] or { } list?)");
+  EXPECT_EQ(error_of(", nameNULL:h}at\n").rfind("case file: YAML error at line 1, column 1: unexpected token", 0), 0u);
+  // After a complete document ("..." ends it) the comma stalls the second one: refused at its line.
+  const std::string late = error_of(kBase + "...\n,\n");
+  EXPECT_EQ(late.rfind("case file: YAML error at line ", 0), 0u) << late;
+  EXPECT_NE(late.find(", column 1: unexpected token"), std::string::npos) << late;
+  // The same text without the comma is a valid case (the pair of the test).
+  EXPECT_NO_THROW(parse_case(kBase));
+}
+
 TEST(CaseErrors, TopLevelNotAMap) {
   EXPECT_EQ(error_of("[1, 2]\n"), "case file: expected a map with keys name, reservoir, ..., got a list");
   EXPECT_EQ(error_of("hello\n"), "case file: expected a map with keys name, reservoir, ..., got 'hello'");

@@ -1,0 +1,139 @@
+"""Tests of the Python module hybridmesh (meshgen/python, docs/python.md); run by ctest (Python/unittest).
+
+Needs build/python on sys.path (ctest sets PYTHONPATH) and HM_SOURCE_DIR (the repository root).
+"""
+import os
+import tempfile
+import unittest
+
+import numpy as np
+
+import hybridmesh
+
+ROOT = os.environ.get("HM_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+README_CASE = os.path.join(ROOT, "examples", "readme_example.yaml")
+
+
+def read_text(path):
+    with open(path, encoding="utf-8") as f:
+        return f.read()
+
+
+class BuiltMesh(unittest.TestCase):
+    """One mesh of the README's example, shared by the tests of this class."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.case = hybridmesh.load_case(README_CASE)
+        cls.mesh = hybridmesh.build(cls.case)
+
+    def test_case_fields(self):
+        self.assertEqual(self.case.name, "my_case")
+        self.assertEqual(len(self.case.wells), 1)
+        self.assertEqual(self.case.wells[0]["name"], "P1")
+        self.assertEqual(len(self.case.wells[0]["trajectory"]), 3)
+
+    def test_csr_faces_and_cells(self):
+        m = self.mesh
+        fp, fn = m.face_node_ptr, m.face_nodes
+        self.assertEqual(fp.shape, (m.n_faces + 1,))
+        self.assertEqual(fp[0], 0)
+        self.assertEqual(fp[-1], len(fn))
+        self.assertTrue(np.all(np.diff(fp) >= 3))
+        self.assertTrue(np.all((fn >= 0) & (fn < m.n_nodes)))
+        cp, cf = m.cell_face_ptr, m.cell_faces
+        self.assertEqual(cp.shape, (m.n_cells + 1,))
+        self.assertEqual(cp[-1], len(cf))
+        # Every face is listed by its owner and, if interior, its neighbour: exactly once each.
+        interior = m.face_neighbour >= 0
+        listed = np.bincount(cf, minlength=m.n_faces)
+        np.testing.assert_array_equal(listed, 1 + interior.astype(np.int64))
+        np.testing.assert_array_equal(m.face_patch == -1, interior)
+        cell_of_entry = np.repeat(np.arange(m.n_cells), np.diff(cp))
+        is_owner = m.face_owner[cf] == cell_of_entry
+        is_neighbour = m.face_neighbour[cf] == cell_of_entry
+        self.assertTrue(np.all(is_owner ^ is_neighbour))
+
+    def test_shapes(self):
+        m = self.mesh
+        self.assertEqual(m.nodes.shape, (m.n_nodes, 3))
+        self.assertEqual(m.fv_centers.shape, (m.n_cells, 3))
+        self.assertEqual(m.cell_centroids.shape, (m.n_cells, 3))
+        self.assertEqual(m.face_areas.shape, (m.n_faces, 3))
+        self.assertEqual(m.cell_ijk.shape, (m.n_cells, 3))
+        self.assertEqual(m.volumes.shape, (m.n_cells,))
+        self.assertEqual(m.transmissibilities.shape, (m.n_faces,))
+        self.assertEqual(set(np.unique(m.cell_region)), {0, 1, 2})
+
+    def test_volume_is_box_minus_wellbore_hole(self):
+        m = self.mesh
+        x, y, z = self.case.x, self.case.y, self.case.z
+        box = (x[-1] - x[0]) * (y[-1] - y[0]) * (z[-1] - z[0])
+        expected = box - m.wellbore_hole_volume
+        self.assertGreater(m.wellbore_hole_volume, 0)
+        self.assertTrue(np.all(m.volumes > 0))
+        self.assertAlmostEqual(m.volumes.sum() / expected, 1.0, delta=1e-9)
+        self.assertAlmostEqual(m.total_volume / expected, 1.0, delta=1e-9)
+
+    def test_closure(self):
+        # Sum of outward area vectors of every cell is zero (relative to the cell's total face area).
+        m = self.mesh
+        cp, cf = m.cell_face_ptr, m.cell_faces
+        cell_of_entry = np.repeat(np.arange(m.n_cells), np.diff(cp))
+        sign = np.where(m.face_owner[cf] == cell_of_entry, 1.0, -1.0)
+        vec = m.face_areas[cf] * sign[:, None]
+        total = np.zeros((m.n_cells, 3))
+        np.add.at(total, cell_of_entry, vec)
+        area = np.zeros(m.n_cells)
+        np.add.at(area, cell_of_entry, np.linalg.norm(m.face_areas[cf], axis=1))
+        self.assertLess(np.max(np.linalg.norm(total, axis=1) / area), 1e-9)
+
+    def test_check_and_transmissibilities(self):
+        report = hybridmesh.check(self.mesh)
+        self.assertTrue(report["ok"], report)
+        t = self.mesh.transmissibilities
+        interior = self.mesh.face_neighbour >= 0
+        self.assertTrue(np.all(np.isfinite(t)))
+        self.assertTrue(np.all(t[interior] > 0))
+        wellbore = self.mesh.face_patch >= 1
+        self.assertTrue(np.all(t[wellbore] > 0))
+
+    def test_arrays_are_read_only_views(self):
+        with self.assertRaises(ValueError):
+            self.mesh.volumes[0] = 1.0
+        v = self.mesh.volumes
+        self.assertFalse(v.flags.owndata)
+
+    def test_export(self):
+        with tempfile.TemporaryDirectory() as d:
+            written = hybridmesh.export(self.mesh, d, ["vtu", "eclipse"])
+            self.assertIn(os.path.join(d, "mesh.vtu"), written)
+            with open(os.path.join(d, "mesh.vtu"), "rb") as f:
+                self.assertIn(b"<VTKFile", f.read(200))
+            self.assertTrue(os.path.isfile(os.path.join(d, "eclipse", "MY_CASE.DATA")))
+            with self.assertRaises(hybridmesh.InputError):
+                hybridmesh.export(self.mesh, d, ["stl"])
+
+    def test_summary(self):
+        s = self.mesh.summary()
+        self.assertEqual(sum(s["cells"][k] for k in ("reservoir", "transition", "well")), self.mesh.n_cells)
+
+
+class BadInput(unittest.TestCase):
+    def test_bad_value_names_the_key(self):
+        text = read_text(README_CASE).replace("radius: 0.1", "radius: -0.1")
+        with self.assertRaises(hybridmesh.InputError) as ctx:
+            hybridmesh.parse_case(text)
+        self.assertTrue(str(ctx.exception).startswith("wells[0].radius:"), str(ctx.exception))
+
+    def test_input_error_is_a_value_error(self):
+        with self.assertRaises(ValueError):
+            hybridmesh.load_case(os.path.join(ROOT, "examples", "no_such_case.yaml"))
+
+    def test_good_text_parses(self):
+        cs = hybridmesh.parse_case(read_text(README_CASE))
+        self.assertEqual(cs.name, "my_case")
+
+
+if __name__ == "__main__":
+    unittest.main()
