@@ -13,6 +13,7 @@
 #include "fvcheck/lib/report.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "realistic_cases.hpp"
 
 namespace hm::testing {
@@ -53,7 +54,8 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
   CaseResult res;
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    const HybridMesh h = build_hybrid_mesh(rc.spec);
+    // As meshgen does: mesh in the local frame (a field-coordinate case is moved to its origin).
+    const HybridMesh h = build_hybrid_mesh(translated_case(rc.spec, -1.0 * case_origin(rc.spec)));
     std::string bad;
     if (!h.build_report.ok) bad += "builder; ";
     for (const WellBlock& b : h.blocks)
