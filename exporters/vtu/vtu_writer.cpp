@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "exporters/vtu/vtu_mesh_arrays.hpp"
+#include "meshgen/core/fv_quality.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 #include "meshgen/core/text_file.hpp"
 
@@ -236,6 +237,17 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
     return fail("cannot rename " + tmp + ": " + why);
   }
   return WriteStatus{};
+}
+
+std::vector<VtuCellArray> mesh_file_quality_arrays(const PolyMesh& mesh, const MeshGeometry& geo,
+                                                   const std::vector<int32_t>& cell_cavity,
+                                                   const std::vector<double>& cell_h_ref) {
+  return {VtuCellArray::int32("cavity", 1, cell_cavity),
+          VtuCellArray::real("volume", 1, geo.cell_volume),
+          VtuCellArray::real("h_ref", 1, cell_h_ref),
+          VtuCellArray::real("Q_S", 1, cell_shape_quality(mesh, cell_h_ref)),
+          VtuCellArray::real("Q_O", 1, cell_min_of_faces(mesh, face_orthogonality(mesh, geo))),
+          VtuCellArray::real("Q_P", 1, cell_max_of_faces(mesh, face_planarity(mesh, geo)))};
 }
 
 }  // namespace hm

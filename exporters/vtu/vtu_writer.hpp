@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "meshgen/core/geometry.hpp"
 #include "meshgen/core/polymesh.hpp"
 
 namespace hm {
@@ -48,5 +49,12 @@ struct WriteStatus {
 /// a polyhedron, vtkHexahedron's face order for a hexahedron; -1 for interior faces). Writes `path + ".tmp"` then renames it, so a
 /// failed write never leaves a complete-looking file. Never throws for I/O problems.
 WriteStatus write_vtu(const std::string& path, const PolyMesh& mesh, const std::vector<VtuCellArray>& extra = {});
+
+/// The cell arrays meshgen's mesh.vtu carries beside the mesh's own data: `cavity` (cell_cavity),
+/// `volume`, `h_ref` (Q_S's reference length) and the quality criteria `Q_S`, `Q_O`, `Q_P`
+/// (meshgen/core/fv_quality.hpp). One list for every writer of a mesh file (meshgen, Python).
+std::vector<VtuCellArray> mesh_file_quality_arrays(const PolyMesh& mesh, const MeshGeometry& geo,
+                                                   const std::vector<int32_t>& cell_cavity,
+                                                   const std::vector<double>& cell_h_ref);
 
 }  // namespace hm

@@ -101,13 +101,8 @@ int main(int argc, char** argv) {
   // mesh moves to the user's coordinates for the writers.
   const hm::PolyMesh& m = result.mesh;
   // write_vtu adds the mesh's own per-cell data (region, FV centre, ijk, rock, radial structure).
-  const std::vector<hm::VtuCellArray> extra = {
-      hm::VtuCellArray::int32("cavity", 1, result.cell_cavity),
-      hm::VtuCellArray::real("volume", 1, result.geometry.cell_volume),
-      hm::VtuCellArray::real("h_ref", 1, result.cell_h_ref),
-      hm::VtuCellArray::real("Q_S", 1, hm::cell_shape_quality(m, result.cell_h_ref)),
-      hm::VtuCellArray::real("Q_O", 1, hm::cell_min_of_faces(m, hm::face_orthogonality(m, result.geometry))),
-      hm::VtuCellArray::real("Q_P", 1, hm::cell_max_of_faces(m, hm::face_planarity(m, result.geometry)))};
+  const std::vector<hm::VtuCellArray> extra =
+      hm::mesh_file_quality_arrays(m, result.geometry, result.cell_cavity, result.cell_h_ref);
   std::optional<hm::Transmissibilities> trans;
   if (export_eclipse) trans = hm::compute_transmissibilities(result.mesh, result.geometry);
   const nlohmann::json summary = hm::make_summary(cs, result);

@@ -101,16 +101,9 @@ std::vector<std::string> export_mesh(Mesh& m, const std::string& out_dir, const 
     if (!st.ok) throw std::runtime_error("export: " + st.message);
   };
   if (vtu) {
-    // The arrays fvcheck reads back (h_ref, permeability) and the volumes; meshgen's mesh.vtu adds
-    // the quality criteria.
-    std::vector<double> perm;
-    for (const hm::Vec3& k : r.mesh.cell_perm) perm.insert(perm.end(), {k.x, k.y, k.z});
-    const std::vector<hm::VtuCellArray> extra = {
-        hm::VtuCellArray::real("volume", 1, r.geometry.cell_volume),
-        hm::VtuCellArray::real("h_ref", 1, r.cell_h_ref),
-        hm::VtuCellArray::real("permeability", 3, perm),
-        hm::VtuCellArray::real("porosity", 1, r.mesh.cell_porosity)};
-    need(hm::write_vtu(dir + "mesh.vtu", r.mesh, extra));
+    // The same file as meshgen's mesh.vtu: the mesh's own data, cavity, volume, h_ref, Q_S/Q_O/Q_P.
+    need(hm::write_vtu(dir + "mesh.vtu", r.mesh,
+                       hm::mesh_file_quality_arrays(r.mesh, r.geometry, r.cell_cavity, r.cell_h_ref)));
     written.push_back(dir + "mesh.vtu");
   }
   if (eclipse) {
