@@ -198,7 +198,9 @@ class Fields {
       if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return name == a; }) == allowed.end()) {
         std::string expected;
         for (const char* a : allowed) expected += (expected.empty() ? "" : ", ") + std::string(a);
-        fail(key_path(path, printable(name)), "unknown key (expected one of: " + expected + ")");
+        // An empty key ("": or a bare colon) is named as "" so that the message keeps its key part.
+        fail(key_path(path, name.empty() ? std::string("\"\"") : printable(name)),
+             "unknown key (expected one of: " + expected + ")");
       }
       for (const auto& e : entries_)
         if (e.first == name) fail(key_path(path, name), "duplicate key");

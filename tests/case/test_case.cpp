@@ -315,6 +315,13 @@ TEST(CaseErrors, UnknownKeyAtEveryLevel) {
             "fluid.mu: unknown key (expected one of: viscosity, density, compressibility)");
 }
 
+// Found by fuzz_case: an empty key name must still give "key.path: reason".
+TEST(CaseErrors, EmptyKeyIsNamed) {
+  EXPECT_EQ(error_of(kBase + "\"\": 1\n"),
+            "\"\": unknown key (expected one of: name, reservoir, wells, transition, fluid)");
+  EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  \"\": 0.2\n")).rfind("reservoir.\"\": unknown key", 0), 0u);
+}
+
 TEST(CaseErrors, DuplicateKey) {
   EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  porosity: 0.3\n")),
             "reservoir.porosity: duplicate key");
