@@ -35,5 +35,6 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
     -DCGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE=TRUE
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  export LSAN_OPTIONS=suppressions="$root/tests/lsan.supp":print_suppressions=0  # third-party leaks only
   (cd build-asan && ctest --output-on-failure -j"$jobs" -E '^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation)')
 fi
