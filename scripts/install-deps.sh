@@ -3,7 +3,7 @@
 # Usage: scripts/install-deps.sh [--validators]   (--validators adds OPM Flow, OpenFOAM, VTK, clang for fuzzing)
 set -euo pipefail
 build_pkgs=(cmake g++ make libcgal-dev libeigen3-dev libopenmesh-dev libboost-graph-dev libgtest-dev
-            libyaml-cpp-dev nlohmann-json3-dev libtbb-dev libopm-common-dev libvtk9-dev clang libclang-rt-14-dev)
+            libyaml-cpp-dev nlohmann-json3-dev libtbb-dev libopm-common-dev libvtk9-dev)
 validator_pkgs=(python3-vtk9 libopm-simulators-bin python3-opm-common openfoam xvfb)
 build_pkgs+=(pybind11-dev python3-dev python3-numpy)  # the Python module hybridmesh (docs/python.md)
 validator_pkgs+=(clang libclang-rt-14-dev)           # libFuzzer + ASan targets of tests/fuzz (docs/fuzzing.md)
