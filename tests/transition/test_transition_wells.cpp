@@ -15,10 +15,11 @@
 namespace hm {
 namespace {
 
-std::string case_yaml(const std::string& name, const std::string& wells) {
+std::string case_yaml(const std::string& name, const std::string& wells,
+                      const std::string& x = "[0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100]") {
   return "name: " + name + R"(
 reservoir:
-  x: [0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100]
+  x: )" + x + R"(
   y: [0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100]
   z: [0, 6, 10, 13.5, 17, 20.5, 24, 27.5, 31, 34.5, 38, 44, 50]
 wells:
@@ -370,16 +371,11 @@ TEST(TransitionWells, TipSitesGradeTheCellsBeyondTheEnds) {
 // their own take, together, exactly the transition builds each takes alone, and each keeps the end
 // caps it gets alone: a refusal in one cavity rebuilds nothing in the other.
 TEST(TransitionWells, OnlyTheRefusedCavityIsRebuilt) {
+  // The usual refined box, extended in x by a second refined region for the second well.
   auto two_region_case = [](const std::string& name, const std::string& wells) {
-    return "name: " + name + R"(
-reservoir:
-  x: [0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100, 110, 116, 120, 124, 128, 132, 136, 140, 144, 150, 160, 180, 200]
-  y: [0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100]
-  z: [0, 6, 10, 13.5, 17, 20.5, 24, 27.5, 31, 34.5, 38, 44, 50]
-wells:
-)" + wells + R"(
-transition: {dilation: 1.5, optimize: false}
-)";
+    return case_yaml(name, wells,
+                     "[0, 20, 30, 36, 40, 44, 48, 52, 56, 60, 64, 70, 80, 100, 110, 116, 120, 124, 128, 132, 136, "
+                     "140, 144, 150, 160, 180, 200]");
   };
   const std::string h = well("H", "[[33, 50, 25], [67, 50, 25]]", 4.0, "auto");
   const std::string v = well("V", "[[132, 50, 14], [132, 50, 36]]", 4.0, "auto");
