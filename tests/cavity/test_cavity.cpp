@@ -4,24 +4,19 @@
 
 #include "meshgen/cavity/cavity.hpp"
 #include "meshgen/grids/gabriel.hpp"
+#include "uniform_nodes.hpp"
 
 using namespace hm;
+using hm::test::uniform_nodes;
 
 namespace {
-
-std::vector<double> lattice(double lo, double hi, double h) {
-  std::vector<double> v;
-  const int n = static_cast<int>(std::round((hi - lo) / h));
-  for (int i = 0; i <= n; ++i) v.push_back(lo + (hi - lo) * i / n);
-  return v;
-}
 
 CaseSpec base_case(double h) {
   CaseSpec cs;
   cs.name = "t";
-  cs.reservoir.x = lattice(0, 120, h);
-  cs.reservoir.y = lattice(0, 120, h);
-  cs.reservoir.z = lattice(1000, 1090, h);
+  cs.reservoir.x = uniform_nodes(0, 120, h);
+  cs.reservoir.y = uniform_nodes(0, 120, h);
+  cs.reservoir.z = uniform_nodes(1000, 1090, h);
   return cs;
 }
 

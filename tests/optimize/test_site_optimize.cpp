@@ -10,25 +10,20 @@
 #include "fvcheck/lib/checks.hpp"
 #include "meshgen/core/fv_quality.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "uniform_nodes.hpp"
 
 using namespace hm;
+using hm::test::uniform_nodes;
 
 namespace {
-
-std::vector<double> lattice(double lo, double hi, double h) {
-  std::vector<double> v;
-  const int n = static_cast<int>(std::round((hi - lo) / h));
-  for (int i = 0; i <= n; ++i) v.push_back(lo + (hi - lo) * i / n);
-  return v;
-}
 
 // A small deviated well in 4 m cells (a few hundred transition cells: seconds, not minutes).
 CaseSpec small_case() {
   CaseSpec cs;
   cs.name = "site_opt";
-  cs.reservoir.x = lattice(0, 60, 4);
-  cs.reservoir.y = lattice(0, 60, 4);
-  cs.reservoir.z = lattice(1000, 1040, 4);
+  cs.reservoir.x = uniform_nodes(0, 60, 4);
+  cs.reservoir.y = uniform_nodes(0, 60, 4);
+  cs.reservoir.z = uniform_nodes(1000, 1040, 4);
   WellSpec w;
   w.name = "P1";
   w.trajectory = {{25, 27, 1015}, {35, 33, 1025}};
