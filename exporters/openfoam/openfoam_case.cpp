@@ -83,7 +83,8 @@ bool make_openfoam_order(const PolyMesh& mesh, const OpenFoamOptions& options, O
     const int32_t p = mesh.face_patch[f];
     if (mesh.face_neighbour[f] >= 0) {
       internal.push_back(f);
-    } else if (p == kOuterBoundary || (is_wellbore_patch(p) && well_of_patch(p) < n_wells)) {
+    } else if (p == kOuterBoundary || (is_wellbore_patch(p) && well_of_patch(p) < n_wells) ||
+               (is_closed_wellbore_patch(p) && well_of_closed_patch(p) < n_wells)) {
       boundary.push_back(f);
     } else {
       *error = "face " + std::to_string(f) + " is a boundary face of unknown patch " + std::to_string(p) +
@@ -99,9 +100,15 @@ bool make_openfoam_order(const PolyMesh& mesh, const OpenFoamOptions& options, O
     const int32_t ha = hi(a), hb = hi(b);
     return ha != hb ? ha < hb : a < b;
   });
-  // Patch order: outer (code 0) first, then the wells in order (codes 1..n): a stable sort by code.
+  // Patch order: outer (code 0) first, then the wells in order (codes 1..n), then the closed
+  // (unperforated) wellbore walls of the wells that have them: a stable sort by that rank.
+  auto rank = [&](int32_t code) { return is_closed_wellbore_patch(code) ? n_wells + 1 + well_of_closed_patch(code) : code; };
   std::stable_sort(boundary.begin(), boundary.end(),
-                   [&](int32_t a, int32_t b) { return mesh.face_patch[a] < mesh.face_patch[b]; });
+                   [&](int32_t a, int32_t b) { return rank(mesh.face_patch[a]) < rank(mesh.face_patch[b]); });
+  std::vector<int32_t> codes;
+  for (int32_t code = 0; code <= n_wells; ++code) codes.push_back(code);
+  for (int32_t f : boundary)
+    if (is_closed_wellbore_patch(mesh.face_patch[f]) && codes.back() != mesh.face_patch[f]) codes.push_back(mesh.face_patch[f]);
 
   OpenFoamInfo out;
   out.n_internal_faces = static_cast<int32_t>(internal.size());
@@ -110,14 +117,16 @@ bool make_openfoam_order(const PolyMesh& mesh, const OpenFoamOptions& options, O
   out.face_flipped.assign(nf, 0);
   for (size_t i = 0; i < internal.size(); ++i) out.face_flipped[i] = mesh.face_owner[internal[i]] > mesh.face_neighbour[internal[i]];
   int32_t start = out.n_internal_faces;
-  for (int32_t code = 0; code <= n_wells; ++code) {
+  for (const int32_t code : codes) {
     OpenFoamPatch p;
     p.code = code;
     if (code == kOuterBoundary) {
       p.name = "outer";
     } else {
-      const int w = well_of_patch(code);
-      p.name = "wellbore_" + (w < static_cast<int>(options.well_names.size()) ? options.well_names[w] : std::to_string(w));
+      const bool closed = is_closed_wellbore_patch(code);
+      const int w = closed ? well_of_closed_patch(code) : well_of_patch(code);
+      p.name = "wellbore_" + (w < static_cast<int>(options.well_names.size()) ? options.well_names[w] : std::to_string(w)) +
+               (closed ? "_closed" : "");
     }
     if (!is_foam_word(p.name)) {
       *error = "patch name '" + p.name + "' is not a valid OpenFOAM word";

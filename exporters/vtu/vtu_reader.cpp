@@ -514,7 +514,9 @@ Parsed parse_document(Source& src) {
       const Array a = read_array(src, fp, n);
       if (!a.is_int || a.components != 1) fail("face_patch must be a 1-component integer array");
       for (int64_t v : a.i) {
-        if (v < -1 || v >= (1 << 30)) fail("face_patch: " + std::to_string(v) + " is not a patch code");
+        // interior (-1), outer (0), wellbore (>= 1) or closed wellbore (<= -3) codes
+        const bool is_code = v >= -1 || (v <= closed_wellbore_patch(0) && v > -(1 << 30));
+        if (!is_code || v >= (1 << 30)) fail("face_patch: " + std::to_string(v) + " is not a patch code");
         out.face_patch.push_back(static_cast<int32_t>(v));
       }
       out.has_face_patch = true;

@@ -74,7 +74,10 @@ RadialSides classify_radial_cell(const PolyMesh& m, const MeshGeometry& g, int c
     const int32_t nb = m.face_owner[f] == c ? m.face_neighbour[f] : m.face_owner[f];
     if (nb < 0) {
       const int32_t p = m.face_patch[f];
-      if (me.ring == 0 && is_wellbore_patch(p) && well_of_patch(p) == me.well)
+      // A closed (unperforated) wellbore face is still the cell's inner side; it carries no flow.
+      const bool wall = (is_wellbore_patch(p) && well_of_patch(p) == me.well) ||
+                        (is_closed_wellbore_patch(p) && well_of_closed_patch(p) == me.well);
+      if (me.ring == 0 && wall)
         wellbore.push_back(f);
       else
         other.push_back(f);

@@ -385,7 +385,8 @@ std::vector<Vec3> read_trajectory(const YAML::Node& n, const std::string& path, 
 
 // survey: {head: [x, y, z], stations: [[md, inclination, azimuth], ...]} -> the station
 // positions by minimum curvature (meshgen/case/survey.hpp).
-std::vector<Vec3> read_survey(const YAML::Node& n, const std::string& path, size_t& points_budget) {
+std::vector<Vec3> read_survey(const YAML::Node& n, const std::string& path, size_t& points_budget,
+                              std::vector<double>& md) {
   if (!n.IsMap()) fail(path, "expected a map {head: [x, y, z], stations: [[md, inclination, azimuth], ...]}, got " +
                                  describe(n));
   const Fields f(n, path, {"head", "stations"});
@@ -412,13 +413,35 @@ std::vector<Vec3> read_survey(const YAML::Node& n, const std::string& path, size
               "turns by more than " + fmt(kMaxSurveyDoglegDeg) + " degrees from the previous station");
     stations.push_back(s);
   }
+  md.assign(1, 0.0);
+  for (const SurveyStation& s : stations) md.push_back(s.md);
   return minimum_curvature_positions({h[0], h[1], h[2]}, stations);
+}
+
+// perforations: [[md_from, md_to], ...], sorted, disjoint, on the path [0, md_end].
+std::vector<std::array<double, 2>> read_perforations(const YAML::Node& n, const std::string& path, double md_end) {
+  if (!n.IsSequence() || n.size() == 0)
+    fail(path, "expected a non-empty list of intervals [[md_from, md_to], ...], got " + describe(n));
+  std::vector<std::array<double, 2>> out;
+  for (size_t i = 0; i < n.size(); ++i) {
+    const std::string p = index_path(path, i);
+    if (!n[i].IsSequence() || n[i].size() != 2) fail(p, "expected an interval [md_from, md_to], got " + describe(n[i]));
+    const double from = read_number(n[i][0], p + "[0]"), to = read_number(n[i][1], p + "[1]");
+    require(from >= 0, p, "md_from must be >= 0 (the path starts at md 0)");
+    require(to > from, p, "md_to must be greater than md_from");
+    require(to <= md_end * (1 + kMeasuredDepthTolerance), p,
+            "md_to is beyond the end of the path (md " + fmt(md_end) + " m)");
+    if (!out.empty())
+      require(from >= out.back()[1], p, "overlaps or precedes the previous interval (ends at md " + fmt(out.back()[1]) + " m)");
+    out.push_back({from, to});
+  }
+  return out;
 }
 
 WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_budget) {
   const Fields f(n, path,
                  {"name", "type", "trajectory", "survey", "radius", "drainage_radius", "rings", "sectors",
-                  "segment_length", "bhp", "end_caps"});
+                  "segment_length", "bhp", "end_caps", "perforations"});
   WellSpec w;
   w.name = read_string(f.required("name"), f.path("name"));
   require(matches_name_charset(w.name), f.path("name"), "must match [A-Za-z0-9_-]+");
@@ -432,8 +455,10 @@ WellSpec read_well(const YAML::Node& n, const std::string& path, size_t& points_
   }
   const auto survey = f.get("survey");
   if (survey && f.get("trajectory")) fail(f.path("survey"), "give either trajectory or survey, not both");
-  w.trajectory = survey ? read_survey(*survey, f.path("survey"), points_budget)
+  w.trajectory = survey ? read_survey(*survey, f.path("survey"), points_budget, w.trajectory_md)
                         : read_trajectory(f.required("trajectory"), f.path("trajectory"), points_budget);
+  if (auto pf = f.get("perforations"))
+    w.perforations = read_perforations(*pf, f.path("perforations"), well_measured_depths(w).back());
   w.radius = read_number(f.required("radius"), f.path("radius"));
   require(w.radius > 0, f.path("radius"), "must be > 0");
   require_range(w.radius, kMinWellRadius, kMaxWellRadius, false, f.path("radius"), "m");
@@ -563,6 +588,13 @@ Vec3 reservoir_permeability(const ReservoirSpec& r, int c) {
 }
 
 double reservoir_porosity(const ReservoirSpec& r, int c) { return r.cell_poro.empty() ? r.porosity : r.cell_poro[c]; }
+
+std::vector<double> well_measured_depths(const WellSpec& ws) {
+  if (ws.trajectory_md.size() == ws.trajectory.size()) return ws.trajectory_md;
+  std::vector<double> md(ws.trajectory.size(), 0.0);
+  for (size_t i = 1; i < md.size(); ++i) md[i] = md[i - 1] + norm(ws.trajectory[i] - ws.trajectory[i - 1]);
+  return md;
+}
 
 std::vector<double> hemisphere_end_grading(const WellSpec& ws) {
   std::vector<double> g;

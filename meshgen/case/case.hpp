@@ -65,7 +65,18 @@ struct WellSpec {
   /// end_caps: auto (the default): hemispherical caps, but flat ends when the caps cannot be
   /// meshed (build_hybrid_mesh retries with flat ends and says so in its notes).
   bool end_caps_fallback = true;
+  /// Measured depth (m) of each trajectory point: the survey's station depths (head at 0), or
+  /// empty for a `trajectory` (then the length along the polyline from its first point,
+  /// well_measured_depths()).
+  std::vector<double> trajectory_md;
+  /// Perforated intervals [md_from, md_to] (m), sorted and disjoint; empty: the whole path inside
+  /// the reservoir is open. Wellbore faces outside them are closed walls (closed_wellbore_patch).
+  std::vector<std::array<double, 2>> perforations;
 };
+
+/// Measured depth of each trajectory point (trajectory_md when given, else the length along
+/// the polyline from its first point).
+std::vector<double> well_measured_depths(const WellSpec& ws);
 
 /// Latitude bands of a hemispherical end cap (the polar one, a fan of triangles about the pole,
 /// included): (sectors + 2) / 4 + 1, 4 for 12 sectors, so that the polar triangles are narrow

@@ -14,6 +14,9 @@ inline constexpr std::size_t kMaxCaseNameLength = 64;       ///< the name is use
 /// Largest dogleg between two survey stations: minimum curvature's arc is undefined at 180
 /// degrees, and real surveys turn by a few degrees per station.
 inline constexpr double kMaxSurveyDoglegDeg = 90;
+/// Relative slack of a perforation's md_to beyond the path's end: a trajectory's length is a
+/// sum of rounded segment lengths, so an interval typed to its exact end may exceed it by ulps.
+inline constexpr double kMeasuredDepthTolerance = 1e-9;
 inline constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
 inline constexpr std::size_t kMaxCaseFileBytes = std::size_t(64) << 20;
 

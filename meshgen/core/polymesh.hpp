@@ -22,6 +22,10 @@ constexpr int32_t kUnmatchedFace = -2;  ///< builder: a face expected interior t
 inline constexpr int32_t wellbore_patch(int well) { return 1 + well; }
 inline constexpr bool is_wellbore_patch(int32_t p) { return p >= 1; }
 inline constexpr int well_of_patch(int32_t p) { return p - 1; }
+/// Wellbore of well w outside its perforated intervals: a closed wall (no flow, no connection).
+inline constexpr int32_t closed_wellbore_patch(int well) { return -3 - well; }
+inline constexpr bool is_closed_wellbore_patch(int32_t p) { return p <= -3; }
+inline constexpr int well_of_closed_patch(int32_t p) { return -3 - p; }
 
 /// Structured description of a radial well cell; well < 0 for every other cell.
 /// The exact radial half-transmissibility of ring faces needs these (docs/mesh-layout.md).

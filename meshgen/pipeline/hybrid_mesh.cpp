@@ -9,6 +9,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "perforations.hpp"
+
 namespace hm {
 
 TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& geo, const std::vector<double>& h_ref) {
@@ -389,6 +391,7 @@ HybridMesh build_hybrid_mesh(const CaseSpec& input, const PipelineOptions& opts)
                              " (" + std::to_string(out.build_report.unmatched_faces) + " unmatched, " +
                              std::to_string(out.build_report.misoriented_faces) + " misoriented, " +
                              std::to_string(out.build_report.overused_faces) + " overused faces)");
+  close_unperforated_wellbore(out.mesh, out.geometry, cs);
   if (!opts.build_transition) return out;
 
   // Before/after figures of the transition cells, each cavity's cells on their own (the

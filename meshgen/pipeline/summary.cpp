@@ -39,8 +39,16 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
   }
   j["cavity_list"] = cav;
   nlohmann::json wells = nlohmann::json::array();
+  std::vector<int> open_faces(cs.wells.size(), 0), closed_faces(cs.wells.size(), 0);
+  for (int f = 0; f < h.mesh.n_faces(); ++f) {
+    const int32_t p = h.mesh.face_patch[f];
+    if (is_wellbore_patch(p) && well_of_patch(p) < static_cast<int>(cs.wells.size())) ++open_faces[well_of_patch(p)];
+    if (is_closed_wellbore_patch(p) && well_of_closed_patch(p) < static_cast<int>(cs.wells.size()))
+      ++closed_faces[well_of_closed_patch(p)];
+  }
   for (const WellBlock& b : h.blocks)
     wells.push_back({{"name", cs.wells[b.well].name},
+                     {"wellbore_faces", {{"open", open_faces[b.well]}, {"closed", closed_faces[b.well]}}},
                      {"rings", b.rings},
                      {"sectors", b.sectors},
                      {"sectors_requested", b.sectors_requested},

@@ -310,7 +310,7 @@ TEST(CaseErrors, UnknownKeyAtEveryLevel) {
             "reservoir.poro: unknown key (expected one of: x, y, z, grdecl, permeability, porosity, initial_pressure)");
   EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "    bhp: 250\n    skin: 0\n")),
             "wells[1].skin: unknown key (expected one of: name, type, trajectory, survey, radius, drainage_radius, rings, "
-            "sectors, segment_length, bhp, end_caps)");
+            "sectors, segment_length, bhp, end_caps, perforations)");
   EXPECT_EQ(error_of(kBase + "fluid: {viscosity: 1, mu: 1}\n"),
             "fluid.mu: unknown key (expected one of: viscosity, density, compressibility)");
 }

@@ -148,6 +148,9 @@ TEST(FlowMeshgen, HorizontalThroughSidesDeckMatchesSolverDemo) {
   run_example("horizontal_through_sides", false, 1e-6);
 }
 
+// A survey well perforated over part of its length (closed wellbore faces elsewhere).
+TEST(FlowMeshgen, PerforatedSurveyDeckMatchesSolverDemo) { run_example("perforated_survey", false, 1e-6); }
+
 TEST(FlowMeshgen, UnwritableExportDirectoryExitsTwoAndLeavesNoDeck) {
   const fs::path d = fresh_dir("flow_unwritable");
   const RemoveAtExit cleanup{d};

@@ -69,5 +69,7 @@ TEST(OpenFoamMeshgen, ThreeWellsCaseReadsInCheckMesh) { check_example("three_wel
 TEST(OpenFoamMeshgen, VerticalThroughCaseReadsInCheckMesh) { check_example("vertical_through"); }
 TEST(OpenFoamMeshgen, DeviatedThroughTopCaseReadsInCheckMesh) { check_example("deviated_through_top"); }
 TEST(OpenFoamMeshgen, HorizontalThroughSidesCaseReadsInCheckMesh) { check_example("horizontal_through_sides"); }
+// Perforations: the closed wellbore is a wall patch of its own.
+TEST(OpenFoamMeshgen, PerforatedSurveyCaseReadsInCheckMesh) { check_example("perforated_survey"); }
 
 }  // namespace

@@ -93,6 +93,7 @@ TEST_P(MeshFile, ReadBackGivesTheDecksTransmissibilitiesExactly) {
 
 INSTANTIATE_TEST_SUITE_P(Examples, MeshFile,
                          ::testing::Values("paper_single_well", "three_wells", "readme_example", "accuracy_vertical",
-                                           "accuracy_horizontal", "accuracy_deviated45", "accuracy_bent", "layered_grdecl"));
+                                           "accuracy_horizontal", "accuracy_deviated45", "accuracy_bent", "layered_grdecl",
+                                           "perforated_survey"));
 
 }  // namespace
