@@ -37,6 +37,7 @@ THIRD_PARTY = {
     "hm_opm_common": r"opm/",  # libopmcommon (CMakeLists.txt wraps the library in this INTERFACE target)
     "pybind11::module": r"pybind11/",
     "pybind11::headers": r"pybind11/",
+    "X11::X11": r"X11/",
 }
 VTK_PATTERN = r"vtk"  # VTK::<Component> targets: vtkXMLUnstructuredGridReader.h, ...
 

@@ -1,4 +1,4 @@
-// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam]
+// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]
 // Exit codes: 0 success, 1 meshing failure (a stage, wells named; a mesh that fails the
 // self-check is never written), 2 bad input or arguments.
 #include <cstdio>
@@ -10,6 +10,8 @@
 
 #include "exporters/eclipse/eclipse_deck.hpp"
 #include "exporters/openfoam/openfoam_case.hpp"
+#include "exporters/png/mesh_pictures.hpp"
+#include "exporters/png/offscreen_display.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/quality.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
@@ -25,10 +27,13 @@ namespace {
 
 int usage(const std::string& why) {
   std::cerr << "meshgen: " << why << "\n"
-            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam]\n"
+            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]\n"
             << "  -j N: at most N cavities meshed and optimised at once (default: every core)\n"
             << "  mesh.vtu, summary.json and cavity_K.obj are always written; --export adds\n"
-            << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n";
+            << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n"
+            << "  --png: pictures beside mesh.vtu (VTK, off-screen; re-runs under xvfb-run without an X display):\n"
+            << "  well_K_region.png and well_K_qs.png (a cut along well K's trajectory), overview.png;\n"
+            << "  --png-size WxH: their size in pixels (default 1200x900; implies --png).\n";
   return 2;
 }
 
@@ -37,7 +42,8 @@ int usage(const std::string& why) {
 int main(int argc, char** argv) {
   std::string case_path, out_dir;
   hm::PipelineOptions opts;
-  bool export_eclipse = false, export_openfoam = false;
+  bool export_eclipse = false, export_openfoam = false, pictures = false;
+  hm::PictureOptions picture_opts;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-o" || a == "--output") {
@@ -65,6 +71,17 @@ int main(int argc, char** argv) {
         else if (item != "vtu") return usage("--export: unknown format '" + item + "' (expected vtu, eclipse or openfoam)");
         start = comma + 1;
       }
+    } else if (a == "--png") {
+      pictures = true;
+    } else if (a == "--png-size") {
+      if (++i >= argc) return usage("--png-size needs WIDTHxHEIGHT, e.g. 1200x900");
+      int w = 0, h = 0;
+      char tail = 0;
+      if (std::sscanf(argv[i], "%dx%d%c", &w, &h, &tail) != 2 || w < 64 || h < 64 || w > 8192 || h > 8192)
+        return usage("--png-size: expected WIDTHxHEIGHT within 64..8192 pixels, got '" + std::string(argv[i]) + "'");
+      picture_opts.width = w;
+      picture_opts.height = h;
+      pictures = true;
     } else if (a == "-h" || a == "--help") {
       usage("help");
       return 0;
@@ -73,6 +90,13 @@ int main(int argc, char** argv) {
     }
   }
   if (const std::string why = hm::check_case_and_output(case_path, out_dir); !why.empty()) return usage(why);
+  // Before meshing: without a display VTK would abort after all the work (offscreen_display.hpp).
+  if (pictures) {
+    if (const std::string why = hm::ensure_display_or_rerun_under_xvfb(argv); !why.empty()) {
+      std::cerr << "meshgen: stage pictures: " << why << "\n";
+      return 1;
+    }
+  }
 
   hm::CaseSpec cs;
   hm::HybridMesh result;
@@ -150,6 +174,16 @@ int main(int argc, char** argv) {
       return 2;
     }
     written.push_back((out / "openfoam").string() + "/");
+  }
+  if (pictures) {
+    picture_opts.title = cs.name;
+    for (const hm::WellSpec& w : cs.wells) picture_opts.well_names.push_back(w.name);
+    const hm::PicturesWritten pics = hm::write_mesh_pictures((out / "mesh.vtu").string(), out.string(), picture_opts);
+    if (!pics.status.ok) {
+      std::cerr << "meshgen: stage " << pics.status.message << "\n";
+      return 1;
+    }
+    written.insert(written.end(), pics.files.begin(), pics.files.end());
   }
   std::string error;
   if (!hm::write_text_file((out / "summary.json").string(), summary.dump(2) + "\n", &error)) {

@@ -1,0 +1,175 @@
+// meshgen --png: the pictures decode (VTK's PNG reader), have the requested size and show what they
+// claim: the region cut has each region's colour in plausible amounts, the radial block near the
+// middle of the frame; the Q_S cut is a colour map, not a flat image. Plus the refusal without a
+// display. meshgen itself re-runs under xvfb-run when DISPLAY is unset (offscreen_display.hpp).
+#include <gtest/gtest.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
+
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <set>
+
+#include "../e2e/run_command.hpp"
+#include "exporters/png/mesh_pictures.hpp"
+
+namespace fs = std::filesystem;
+using hm_test::fresh_dir;
+using hm_test::q;
+using hm_test::run_command;
+
+namespace {
+
+const std::string kMeshgen = std::string(HM_BIN_DIR) + "/meshgen";
+
+// A small vertical well (a few hundred cells): meshes in about a second.
+const char* kSmallCase = R"(name: small
+reservoir:
+  x: [0, 20, 40, 50, 55, 60, 65, 70, 80, 100, 120]
+  y: [0, 20, 40, 50, 55, 60, 65, 70, 80, 100, 120]
+  z: [1000, 1010, 1020, 1025, 1030, 1035, 1040, 1045, 1050, 1060, 1070]
+  permeability: [100, 100, 10]
+  porosity: 0.2
+  initial_pressure: 200
+wells:
+  - name: P1
+    trajectory: [[60, 60, 1027], [60, 60, 1043]]
+    radius: 0.1
+    drainage_radius: 3
+    rings: 3
+    sectors: 8
+    segment_length: 4
+    bhp: 150
+)";
+
+struct Image {
+  int width = 0, height = 0, components = 0;
+  std::vector<std::array<uint8_t, 3>> rgb;  // row 0 = bottom (VTK's order)
+  const std::array<uint8_t, 3>& at(int x, int y) const { return rgb[static_cast<size_t>(y) * width + x]; }
+};
+
+/// Decodes a PNG with VTK's reader; width 0 when it does not decode.
+Image read_png(const fs::path& p) {
+  Image im;
+  vtkNew<vtkPNGReader> r;
+  if (!r->CanReadFile(p.string().c_str())) return im;
+  r->SetFileName(p.string().c_str());
+  r->Update();
+  vtkImageData* d = r->GetOutput();
+  int dims[3];
+  d->GetDimensions(dims);
+  im.width = dims[0];
+  im.height = dims[1];
+  im.components = d->GetNumberOfScalarComponents();
+  if (im.components < 3 || d->GetScalarType() != VTK_UNSIGNED_CHAR) return im;
+  const auto* px = static_cast<const uint8_t*>(d->GetScalarPointer());
+  im.rgb.resize(static_cast<size_t>(im.width) * im.height);
+  for (size_t i = 0; i < im.rgb.size(); ++i)
+    for (int c = 0; c < 3; ++c) im.rgb[i][c] = px[i * im.components + c];
+  return im;
+}
+
+/// Pixels of each region's exact colour in the picture's left 80 % (the legend is on the right).
+struct RegionCounts {
+  std::array<int64_t, 3> count{0, 0, 0};
+  int64_t white = 0, total = 0;
+  double radial_x = 0, radial_y = 0;  ///< mean position of the radial pixels, fraction of the size
+};
+RegionCounts count_region_colours(const Image& im) {
+  RegionCounts rc;
+  const hm::RegionColours& col = hm::region_colours();
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width * 8 / 10; ++x) {
+      const auto& p = im.at(x, y);
+      ++rc.total;
+      if (p[0] == 255 && p[1] == 255 && p[2] == 255) ++rc.white;
+      for (int r = 0; r < 3; ++r)
+        if (p[0] == col.rgb[r][0] && p[1] == col.rgb[r][1] && p[2] == col.rgb[r][2]) {
+          ++rc.count[r];
+          if (r == hm::kWell) rc.radial_x += x, rc.radial_y += y;
+        }
+    }
+  if (rc.count[hm::kWell] > 0) {
+    rc.radial_x /= rc.count[hm::kWell] * static_cast<double>(im.width);
+    rc.radial_y /= rc.count[hm::kWell] * static_cast<double>(im.height);
+  }
+  return rc;
+}
+
+/// What a region cut must show: every region in plausible amounts, the radial block near the middle.
+::testing::AssertionResult shows_the_three_regions(const Image& im) {
+  const RegionCounts rc = count_region_colours(im);
+  if (rc.total == 0) return ::testing::AssertionFailure() << "empty image";
+  const double f_res = double(rc.count[hm::kReservoir]) / rc.total, f_tr = double(rc.count[hm::kTransition]) / rc.total,
+               f_well = double(rc.count[hm::kWell]) / rc.total, f_white = double(rc.white) / rc.total;
+  ::testing::AssertionResult fail = ::testing::AssertionFailure();
+  fail << "reservoir " << f_res << ", transition " << f_tr << ", radial " << f_well << ", white " << f_white
+       << ", radial centre (" << rc.radial_x << ", " << rc.radial_y << ")";
+  if (f_res < 0.05 || f_tr < 0.05 || f_well < 0.005 || f_white > 0.5) return fail;
+  if (rc.radial_x < 0.25 || rc.radial_x > 0.75 || rc.radial_y < 0.25 || rc.radial_y > 0.75) return fail;
+  return ::testing::AssertionSuccess();
+}
+
+size_t distinct_colours(const Image& im) {
+  std::set<uint32_t> s;
+  for (const auto& p : im.rgb) s.insert(uint32_t(p[0]) << 16 | uint32_t(p[1]) << 8 | p[2]);
+  return s.size();
+}
+
+}  // namespace
+
+TEST(MeshPictures, MeshgenPngWritesPicturesThatShowTheRegionsAndQs) {
+  const fs::path d = fresh_dir("pictures");
+  hm_test::RemoveAtExit cleanup{d};
+  std::ofstream(d / "case.yaml") << kSmallCase;
+  const auto r = run_command(kMeshgen + " " + q(d / "case.yaml") + " -o " + q(d / "out") + " --png-size 640x480", 300);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  for (const char* name : {"well_0_region.png", "well_0_qs.png", "overview.png"})
+    EXPECT_NE(r.out.find((d / "out" / name).string()), std::string::npos) << name << " not listed:\n" << r.out;
+
+  const Image region = read_png(d / "out" / hm::well_region_picture_name(0));
+  ASSERT_EQ(region.width, 640);
+  ASSERT_EQ(region.height, 480);
+  EXPECT_TRUE(shows_the_three_regions(region));
+
+  const Image qs = read_png(d / "out" / hm::well_qs_picture_name(0));
+  ASSERT_EQ(qs.width, 640);
+  ASSERT_EQ(qs.height, 480);
+  EXPECT_GE(distinct_colours(qs), 12u);  // a colour map over many cells and the colour bar
+  EXPECT_FALSE(shows_the_three_regions(qs)) << "the Q_S picture is coloured by region";
+
+  const Image overview = read_png(d / "out" / hm::kOverviewPictureName);
+  ASSERT_EQ(overview.width, 640);
+  ASSERT_EQ(overview.height, 480);
+  EXPECT_GE(distinct_colours(overview), 50u);  // lit cells, not a blank frame
+}
+
+TEST(MeshPictures, TheRegionCheckFailsOnABlankOrSingleRegionImage) {
+  Image blank;
+  blank.width = 100, blank.height = 100;
+  blank.rgb.assign(100 * 100, {255, 255, 255});
+  EXPECT_FALSE(shows_the_three_regions(blank));
+  Image reservoir_only = blank;
+  const unsigned char* c = hm::region_colours().rgb[hm::kReservoir];
+  for (auto& p : reservoir_only.rgb) p = {c[0], c[1], c[2]};
+  EXPECT_FALSE(shows_the_three_regions(reservoir_only));
+}
+
+TEST(MeshPictures, WithoutDisplayOrXvfbRunMeshgenStopsBeforeMeshingWithExit1) {
+  const fs::path d = fresh_dir("pictures_nodisplay");
+  hm_test::RemoveAtExit cleanup{d};
+  std::ofstream(d / "case.yaml") << kSmallCase;
+  // No DISPLAY and a PATH without xvfb-run: a clear refusal naming the stage, nothing meshed.
+  const auto r = run_command("env -u DISPLAY PATH=/nonexistent " + kMeshgen + " " + q(d / "case.yaml") + " -o " +
+                             q(d / "out") + " --png");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("stage pictures"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("xvfb"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "out" / "mesh.vtu"));
+  // Bad size: exit 2, before anything else.
+  const auto bad = run_command(kMeshgen + " " + q(d / "case.yaml") + " -o " + q(d / "out") + " --png-size 10x10");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--png-size"), std::string::npos) << bad.err;
+}
