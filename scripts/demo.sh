@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README command 1: install what is missing, build (Release) into build/, make the Python module
-# importable by /usr/bin/python3, mesh the bundled default example and list what was written.
+# importable by /usr/bin/python3, mesh the bundled default example (with its pictures) and list what
+# was written.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -21,7 +22,8 @@ fi
 case_file=${1:-examples/paper_single_well.yaml}
 name=$(basename "$case_file" .yaml)
 out="out/$name"
-build/bin/meshgen "$case_file" -o "$out"
+# --png: the pictures of docs/output-formats.md ("Pictures"), under xvfb-run when there is no display.
+build/bin/meshgen "$case_file" -o "$out" --png
 echo
 echo "Wrote:"
 ls -l "$out"

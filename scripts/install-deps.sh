@@ -4,8 +4,11 @@
 set -euo pipefail
 build_pkgs=(cmake g++ make libcgal-dev libeigen3-dev libopenmesh-dev libboost-graph-dev libgtest-dev
             libyaml-cpp-dev nlohmann-json3-dev libtbb-dev libopm-common-dev libvtk9-dev)
-validator_pkgs=(python3-vtk9 libopm-simulators-bin python3-opm-common openfoam xvfb)
+validator_pkgs=(python3-vtk9 libopm-simulators-bin python3-opm-common openfoam)
 build_pkgs+=(pybind11-dev python3-dev python3-numpy)  # the Python module hybridmesh (docs/python.md)
+# meshgen --png (the demo's pictures): VTK renders through GLX, on a virtual X server when there is no
+# display (xvfb-run, which needs xauth), with Mesa's software OpenGL (docs/output-formats.md, "Pictures").
+build_pkgs+=(libx11-dev xvfb xauth libgl1-mesa-dri libglx-mesa0)
 validator_pkgs+=(clang libclang-rt-14-dev)           # libFuzzer + ASan targets of tests/fuzz (docs/fuzzing.md)
 want=("${build_pkgs[@]}")
 if [[ "${1:-}" == "--validators" ]]; then want+=("${validator_pkgs[@]}"); fi

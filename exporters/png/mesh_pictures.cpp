@@ -5,6 +5,7 @@
 #include <vtkActor.h>
 #include <vtkActor2D.h>
 #include <vtkAutoInit.h>
+#include <vtkBase64Utilities.h>
 #include <vtkCamera.h>
 #include <vtkCellData.h>
 #include <vtkCellArray.h>
@@ -17,6 +18,7 @@
 #include <vtkIntArray.h>
 #include <vtkLookupTable.h>
 #include <vtkMath.h>
+#include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPoints.h>
@@ -41,11 +43,14 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "exporters/png/offscreen_display.hpp"
 #include "meshgen/core/polymesh.hpp"
 
 // The rendering back end and the fonts of the captions (static factories, registered explicitly).
@@ -355,6 +360,10 @@ vtkSmartPointer<vtkRenderer> white_renderer(double x0, double y0, double x1, dou
 /// Renders `mesh` (its viewport set here), the legend and the caption into a PNG.
 WriteStatus render_png(vtkRenderer* mesh, const Props& legend, const std::string& caption, int width,
                        int height, const std::string& path) {
+  // Each window opens its own X connection, and VTK aborts the process when that fails: the
+  // server may have gone since the last picture (a virtual one killed by someone else).
+  if (const std::string why = display_problem(); !why.empty())
+    return {false, "pictures: " + why + " (before '" + path + "'); VTK needs an X server to render"};
   vtkNew<vtkRenderWindow> window;
   window->SetOffScreenRendering(1);
   window->SetMultiSamples(0);  // exact colours on the unlit cut pictures (tests count them)
@@ -414,8 +423,12 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
     result.status = {false, "pictures: " + why};
     return result;
   };
+  auto input_fail = [&](const std::string& why) {
+    result.input_error = true;
+    return fail(why);
+  };
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(vtu_path, ec)) return fail("no mesh file '" + vtu_path + "'");
+  if (!std::filesystem::is_regular_file(vtu_path, ec)) return input_fail("no mesh file '" + vtu_path + "'");
   if (opt.width < 64 || opt.height < 64 || opt.width > 8192 || opt.height > 8192)
     return fail("picture size must be within 64..8192 pixels");
 
@@ -424,7 +437,7 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
   reader->Update();
   vtkUnstructuredGrid* in = reader->GetOutput();
   if (reader->GetErrorCode() != 0 || in == nullptr || in->GetNumberOfCells() == 0)
-    return fail("VTK cannot read '" + vtu_path + "' (or it has no cells)");
+    return input_fail("VTK cannot read '" + vtu_path + "' (or it has no cells)");
   const vtkIdType n = in->GetNumberOfCells();
 
   vtkCellData* cd = in->GetCellData();
@@ -444,9 +457,9 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
                            Need{"cavity", &a.cavity, 1, false}}) {
     vtkDataArray* arr = cd->GetArray(need.name);
     if (arr != nullptr && (arr->GetNumberOfComponents() != need.components || arr->GetNumberOfTuples() != n))
-      return fail(std::string("cell array '") + need.name + "' has the wrong size");
+      return input_fail(std::string("cell array '") + need.name + "' has the wrong size");
     if (arr == nullptr && need.required)
-      return fail(std::string("'") + vtu_path + "' has no cell array '" + need.name +
+      return input_fail(std::string("'") + vtu_path + "' has no cell array '" + need.name +
                   "' (the pictures need a mesh file written by meshgen)");
     *need.slot = arr;
   }
@@ -497,6 +510,8 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
     for (const auto& [k, box] : cavity_box)
       if (box.intersects(well_box[w])) well_cavities[w].push_back(k);
 
+  const DisplayConnection held;  // keeps the X server from resetting between two pictures
+  if (!held.ok()) return fail(display_problem() + "; VTK needs an X server to render");
   const vtkSmartPointer<vtkLookupTable> region_lut = region_lookup_table();
   const vtkSmartPointer<vtkLookupTable> qs_lut = qs_lookup_table();
   const std::filesystem::path dir(out_dir);
@@ -596,7 +611,23 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
     cam->SetPosition(view.data());
     cam->SetViewUp(0, 0, -1);
     ren->ResetCamera();
-    cam->Zoom(1.3);  // ResetCamera fits the bounding sphere: a box fills less of the frame
+    // ResetCamera fits the bounding sphere, so the box fills less of the frame: zoom until the
+    // model's projected corners span 92 % of the mesh's viewport (twice: the perspective projection
+    // makes one step inexact).
+    for (int step = 0; step < 2; ++step) {
+      vtkMatrix4x4* m = cam->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
+      double extent = 0;
+      for (int corner = 0; corner < 8; ++corner) {
+        const double p[4] = {(corner & 1) ? bounds[1] - shift[0] : bounds[0] - shift[0],
+                             (corner & 2) ? bounds[3] - shift[1] : bounds[2] - shift[1],
+                             (corner & 4) ? bounds[5] - shift[2] : bounds[4] - shift[2], 1.0};
+        double q[4];
+        m->MultiplyPoint(p, q);
+        if (q[3] > 0) extent = std::max({extent, std::abs(q[0] / q[3]), std::abs(q[1] / q[3])});
+      }
+      if (extent > 0) cam->Zoom(0.92 / extent);
+    }
+    ren->ResetCameraClippingRange();
     const std::string path = (dir / kOverviewPictureName).string();
     const std::string text = opt.title + ": overview, the reservoir grid as a wire frame, each cavity cut in half";
     if (WriteStatus st = render_png(ren, region_legend(legend_font), text, opt.width, opt.height, path);
@@ -607,6 +638,33 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
     result.files.push_back(path);
   }
   return result;
+}
+
+std::vector<PictureFile> find_mesh_pictures(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::vector<PictureFile> out;
+  std::error_code ec;
+  for (int w = 0;; ++w) {
+    const fs::path region = fs::path(dir) / well_region_picture_name(w), qs = fs::path(dir) / well_qs_picture_name(w);
+    const bool has_region = fs::is_regular_file(region, ec), has_qs = fs::is_regular_file(qs, ec);
+    if (!has_region && !has_qs) break;
+    const std::string well = "well " + std::to_string(w);
+    if (has_region) out.push_back({well + ": cut along its trajectory, coloured by region", region.string()});
+    if (has_qs) out.push_back({well + ": cut along its trajectory, coloured by Q_S", qs.string()});
+  }
+  const fs::path overview = fs::path(dir) / kOverviewPictureName;
+  if (fs::is_regular_file(overview, ec)) out.push_back({"overview", overview.string()});
+  return out;
+}
+
+std::string png_data_uri(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return "";
+  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  if (bytes.empty()) return "";
+  std::vector<unsigned char> text(4 * ((bytes.size() + 2) / 3) + 1);
+  const unsigned long n = vtkBase64Utilities::Encode(bytes.data(), bytes.size(), text.data());
+  return "data:image/png;base64," + std::string(text.begin(), text.begin() + static_cast<long>(n));
 }
 
 }  // namespace hm

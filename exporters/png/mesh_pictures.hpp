@@ -31,6 +31,7 @@ inline const char* kOverviewPictureName = "overview.png";
 
 struct PicturesWritten {
   WriteStatus status;              ///< !ok: "pictures: reason" (nothing after the failing picture written)
+  bool input_error = false;        ///< !ok because of the mesh file (unreadable, arrays missing): exit 2
   std::vector<std::string> files;  ///< paths written, in order: per well region then Q_S, then the overview
 };
 
@@ -40,5 +41,19 @@ struct PicturesWritten {
 /// display_problem() first, VTK aborts the process without one.
 PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::string& out_dir,
                                     const PictureOptions& options);
+
+/// A picture file of a mesh, as found on disk.
+struct PictureFile {
+  std::string caption;  ///< "well K: cut coloured by region" ...
+  std::string path;
+};
+
+/// The pictures write_mesh_pictures writes that exist in dir, in its order (per well region then
+/// Q_S, then the overview); wells are looked for from 0 up to the first index with neither picture.
+std::vector<PictureFile> find_mesh_pictures(const std::string& dir);
+
+/// "data:image/png;base64,..." holding the file's bytes (VTK's base64 encoder); "" when it cannot
+/// be read.
+std::string png_data_uri(const std::string& path);
 
 }  // namespace hm

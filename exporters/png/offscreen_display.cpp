@@ -22,6 +22,20 @@ std::string display_problem() {
   return "";
 }
 
+DisplayConnection::DisplayConnection() {
+  const char* name = std::getenv("DISPLAY");
+  if (name == nullptr || *name == '\0') return;
+  // A server that is resetting (its last client just left) refuses connections for a moment.
+  for (int attempt = 0; attempt < 10 && display_ == nullptr; ++attempt) {
+    if (attempt > 0) ::usleep(100000);
+    display_ = XOpenDisplay(name);
+  }
+}
+
+DisplayConnection::~DisplayConnection() {
+  if (display_ != nullptr) XCloseDisplay(static_cast<Display*>(display_));
+}
+
 namespace {
 
 /// The first executable `name` in $PATH, or "".
@@ -62,7 +76,7 @@ std::string ensure_display_or_rerun_under_xvfb(char** argv) {
   // -n before -a: xvfb-run looks for a free display number from N on; a start that depends on the
   // process id keeps concurrent runs (ctest -j) from racing for the same number.
   const std::string first_display = std::to_string(100 + ::getpid() % 800);
-  std::vector<std::string> args = {xvfb_run, "-n", first_display, "-a", "-s", "-screen 0 1600x1200x24", self};
+  std::vector<std::string> args = {xvfb_run, "-n", first_display, "-a", "-s", "-screen 0 1600x1200x24 -noreset", self};
   for (char** a = argv + 1; *a != nullptr; ++a) args.emplace_back(*a);
   std::vector<char*> cargs;
   for (std::string& s : args) cargs.push_back(s.data());

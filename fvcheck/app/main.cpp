@@ -1,11 +1,14 @@
-// fvcheck MESH.vtu [--json REPORT.json] [--html REPORT.html] [--min-orthogonality DEG] [--max-planarity DEG]
+// fvcheck MESH.vtu [--json REPORT.json] [--html REPORT.html [--png]] [--min-orthogonality DEG] [--max-planarity DEG]
 // Checks the finite-volume properties of a mesh (docs/fvcheck.md).
 // Exit codes: 0 every check holds, 1 a check fails, 2 unreadable input or bad arguments.
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
+#include "exporters/png/mesh_pictures.hpp"
+#include "exporters/png/offscreen_display.hpp"
 #include "exporters/vtu/vtu_reader.hpp"
 #include "fvcheck/lib/report.hpp"
 #include "fvcheck/lib/report_json.hpp"
@@ -14,8 +17,10 @@
 namespace {
 
 const char* kUsage =
-    "usage: fvcheck MESH.vtu [--json REPORT.json] [--html REPORT.html] [--min-orthogonality DEG] "
-    "[--max-planarity DEG]";
+    "usage: fvcheck MESH.vtu [--json REPORT.json] [--html REPORT.html [--png]] [--min-orthogonality DEG] "
+    "[--max-planarity DEG]\n"
+    "  the HTML report shows the pictures meshgen --png wrote beside the mesh (when not older than it);\n"
+    "  --png renders them (VTK, off-screen) beside the report instead";
 
 int usage_error(const std::string& why) {
   std::cerr << "fvcheck: " << why << " (" << kUsage << ")\n";
@@ -34,6 +39,7 @@ bool parse_degrees(const std::string& s, double* out) {
 
 int main(int argc, char** argv) {
   std::string mesh_path, json_path, html_path;
+  bool render_pictures = false;
   hm::CheckOptions opt;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -50,6 +56,8 @@ int main(int argc, char** argv) {
       if (!value(&json_path) || json_path.empty()) return usage_error("--json needs a file name");
     } else if (a == "--html") {
       if (!value(&html_path) || html_path.empty()) return usage_error("--html needs a file name");
+    } else if (a == "--png") {
+      render_pictures = true;
     } else if (a == "--min-orthogonality") {
       if (!value(&v) || !parse_degrees(v, &opt.min_orthogonality_deg))
         return usage_error("--min-orthogonality needs an angle in [0, 90] degrees");
@@ -65,6 +73,14 @@ int main(int argc, char** argv) {
     }
   }
   if (mesh_path.empty()) return usage_error("no mesh file given");
+  if (render_pictures && html_path.empty()) return usage_error("--png needs --html (the pictures go beside the report)");
+  if (render_pictures) {
+    // Before the checks: without a display VTK would abort (offscreen_display.hpp).
+    if (const std::string why = hm::ensure_display_or_rerun_under_xvfb(argv); !why.empty()) {
+      std::cerr << "fvcheck: stage pictures: " << why << "\n";
+      return 1;
+    }
+  }
 
   hm::ReadResult in = hm::read_vtu(mesh_path);
   if (!in.ok) {
@@ -109,6 +125,34 @@ int main(int argc, char** argv) {
     if (!hm::write_text_file(json_path, text, &err)) {
       std::cerr << "fvcheck: " << err << "\n";
       return 2;
+    }
+  }
+  if (!html_path.empty()) {
+    namespace fs = std::filesystem;
+    const fs::path report_dir = fs::absolute(html_path).parent_path();
+    if (render_pictures) {
+      const hm::PicturesWritten pics = hm::write_mesh_pictures(mesh_path, report_dir.string(), {});
+      if (!pics.status.ok) {
+        std::cerr << "fvcheck: stage " << pics.status.message << "\n";
+        return pics.input_error ? 2 : 1;
+      }
+    }
+    // Pictures of this mesh only: one older than the mesh file shows an earlier mesh.
+    std::error_code ec;
+    const fs::file_time_type mesh_time = fs::last_write_time(mesh_path, ec);
+    const fs::path dir = render_pictures ? report_dir : fs::absolute(mesh_path).parent_path();
+    for (const hm::PictureFile& p : hm::find_mesh_pictures(dir.string())) {
+      std::error_code pec;
+      if (!ec && fs::last_write_time(p.path, pec) < mesh_time) {
+        report.notes.push_back("picture " + p.path + " is older than the mesh file: not shown");
+        continue;
+      }
+      const std::string uri = hm::png_data_uri(p.path);
+      if (uri.empty()) {
+        report.notes.push_back("picture " + p.path + " cannot be read: not shown");
+        continue;
+      }
+      report.pictures.push_back({p.caption, uri});
     }
   }
   if (!html_path.empty() && !hm::write_text_file(html_path, hm::report_html(report), &err)) {

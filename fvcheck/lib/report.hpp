@@ -26,6 +26,12 @@ struct TransmissibilitySummary {
 /// Summary of one value per face (0 = no connection).
 TransmissibilitySummary summarize_transmissibilities(const std::vector<double>& face_values);
 
+/// A picture of the mesh shown in the HTML report (rendered by exporters/png, not by this module).
+struct ReportPicture {
+  std::string caption;
+  std::string src;  ///< the <img> source: a data: URI (the report stays self-contained) or a path
+};
+
 struct FvReport {
   std::string source;  ///< file name or label
   int64_t cells = 0, faces = 0, nodes = 0, boundary_faces = 0;
@@ -39,6 +45,7 @@ struct FvReport {
   std::vector<RegionQuality> by_region;
   TransmissibilitySummary transmissibility;
   std::vector<std::string> notes;            ///< reader warnings etc., shown in the reports
+  std::vector<ReportPicture> pictures;       ///< HTML only: shown after the counts, in this order
 
   /// True when the structure is valid, every check holds and no transmissibility is negative.
   bool ok() const;

@@ -103,6 +103,13 @@ std::string report_html(const FvReport& r) {
   for (const std::string& n : r.notes) h << "<p class='small'>Note: " << xml_escape(n) << "</p>\n";
 
   // Checks.
+  if (!r.pictures.empty()) {
+    h << "<h2>Pictures</h2>";
+    for (const ReportPicture& p : r.pictures)
+      h << "<figure><img src='" << xml_escape(p.src) << "' alt='" << xml_escape(p.caption)
+        << "' style='max-width:100%'><figcaption class='small'>" << xml_escape(p.caption) << "</figcaption></figure>\n";
+  }
+
   h << "<h2>Finite-volume checks</h2>";
   if (!r.structure.ok) {
     h << "<p><b>The mesh structure is invalid; the checks were skipped.</b></p><ul>";

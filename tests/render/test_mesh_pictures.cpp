@@ -8,9 +8,12 @@
 #include <vtkPNGReader.h>
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <fstream>
+#include <iostream>
 #include <set>
+#include <sstream>
 
 #include "../e2e/run_command.hpp"
 #include "exporters/png/mesh_pictures.hpp"
@@ -23,6 +26,13 @@ using hm_test::run_command;
 namespace {
 
 const std::string kMeshgen = std::string(HM_BIN_DIR) + "/meshgen";
+const std::string kFvcheck = std::string(HM_BIN_DIR) + "/fvcheck";
+
+size_t occurrences(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
+}
 
 // A small vertical well (a few hundred cells): meshes in about a second.
 const char* kSmallCase = R"(name: small
@@ -104,12 +114,13 @@ RegionCounts count_region_colours(const Image& im) {
   if (rc.total == 0) return ::testing::AssertionFailure() << "empty image";
   const double f_res = double(rc.count[hm::kReservoir]) / rc.total, f_tr = double(rc.count[hm::kTransition]) / rc.total,
                f_well = double(rc.count[hm::kWell]) / rc.total, f_white = double(rc.white) / rc.total;
-  ::testing::AssertionResult fail = ::testing::AssertionFailure();
-  fail << "reservoir " << f_res << ", transition " << f_tr << ", radial " << f_well << ", white " << f_white
+  std::ostringstream what;
+  what << "reservoir " << f_res << ", transition " << f_tr << ", radial " << f_well << ", white " << f_white
        << ", radial centre (" << rc.radial_x << ", " << rc.radial_y << ")";
-  if (f_res < 0.05 || f_tr < 0.05 || f_well < 0.005 || f_white > 0.5) return fail;
-  if (rc.radial_x < 0.25 || rc.radial_x > 0.75 || rc.radial_y < 0.25 || rc.radial_y > 0.75) return fail;
-  return ::testing::AssertionSuccess();
+  if (f_res < 0.05 || f_tr < 0.05 || f_well < 0.005 || f_white > 0.5 || rc.radial_x < 0.25 || rc.radial_x > 0.75 ||
+      rc.radial_y < 0.25 || rc.radial_y > 0.75)
+    return ::testing::AssertionFailure() << what.str();
+  return ::testing::AssertionSuccess() << what.str();
 }
 
 size_t distinct_colours(const Image& im) {
@@ -132,7 +143,9 @@ TEST(MeshPictures, MeshgenPngWritesPicturesThatShowTheRegionsAndQs) {
   const Image region = read_png(d / "out" / hm::well_region_picture_name(0));
   ASSERT_EQ(region.width, 640);
   ASSERT_EQ(region.height, 480);
-  EXPECT_TRUE(shows_the_three_regions(region));
+  const ::testing::AssertionResult regions = shows_the_three_regions(region);
+  EXPECT_TRUE(regions);
+  std::cout << "region picture: " << regions.message() << "\n";
 
   const Image qs = read_png(d / "out" / hm::well_qs_picture_name(0));
   ASSERT_EQ(qs.width, 640);
@@ -144,6 +157,27 @@ TEST(MeshPictures, MeshgenPngWritesPicturesThatShowTheRegionsAndQs) {
   ASSERT_EQ(overview.width, 640);
   ASSERT_EQ(overview.height, 480);
   EXPECT_GE(distinct_colours(overview), 50u);  // lit cells, not a blank frame
+
+  // fvcheck's HTML report embeds the three pictures beside the mesh (data: URIs, self-contained)...
+  const fs::path html = d / "report.html";
+  auto c = run_command(kFvcheck + " " + q(d / "out" / "mesh.vtu") + " --html " + q(html));
+  EXPECT_EQ(c.exit_code, 0) << c.out << c.err;
+  std::string page = hm_test::slurp(html);
+  EXPECT_EQ(occurrences(page, "<img src='data:image/png;base64,"), 3u);
+  EXPECT_NE(page.find("well 0: cut along its trajectory, coloured by Q_S"), std::string::npos);
+  // ... but not pictures older than the mesh (they show an earlier mesh).
+  fs::last_write_time(d / "out" / "mesh.vtu", fs::file_time_type::clock::now() + std::chrono::seconds(5));
+  c = run_command(kFvcheck + " " + q(d / "out" / "mesh.vtu") + " --html " + q(html));
+  page = hm_test::slurp(html);
+  EXPECT_EQ(occurrences(page, "<img src="), 0u);
+  EXPECT_NE(page.find("is older than the mesh file: not shown"), std::string::npos);
+  // --png renders them beside the report (the mesh's time put back in the past first).
+  fs::last_write_time(d / "out" / "mesh.vtu", fs::file_time_type::clock::now() - std::chrono::seconds(60));
+  fs::create_directories(d / "fv");
+  c = run_command(kFvcheck + " " + q(d / "out" / "mesh.vtu") + " --html " + q(d / "fv" / "report.html") + " --png", 300);
+  EXPECT_EQ(c.exit_code, 0) << c.out << c.err;
+  EXPECT_EQ(read_png(d / "fv" / hm::kOverviewPictureName).width, 1200);
+  EXPECT_EQ(occurrences(hm_test::slurp(d / "fv" / "report.html"), "<img src='data:image/png;base64,"), 3u);
 }
 
 TEST(MeshPictures, TheRegionCheckFailsOnABlankOrSingleRegionImage) {
@@ -172,4 +206,7 @@ TEST(MeshPictures, WithoutDisplayOrXvfbRunMeshgenStopsBeforeMeshingWithExit1) {
   const auto bad = run_command(kMeshgen + " " + q(d / "case.yaml") + " -o " + q(d / "out") + " --png-size 10x10");
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_NE(bad.err.find("--png-size"), std::string::npos) << bad.err;
+  const auto no_html = run_command(kFvcheck + " " + q(d / "case.yaml") + " --png");
+  EXPECT_EQ(no_html.exit_code, 2) << no_html.err;
+  EXPECT_NE(no_html.err.find("--png needs --html"), std::string::npos) << no_html.err;
 }
