@@ -80,10 +80,17 @@ Vec unit(const Vec& a) {
 /// best-fit plane; below it the well counts as straight and the cut is the vertical plane through
 /// it (the view shows depth downwards). A choice of view, not of geometry.
 constexpr double kBentTrajectoryRatio = 1e-4;
+/// A cell's bounding box within this fraction of the frame's diagonal from a plane touches it
+/// (choice of view only).
+constexpr double kTouchingPlane = 1e-9;
 /// Empty space around a well's cavity in its pictures, as a fraction of the framed size.
 constexpr double kFrameMargin = 0.3;
 
-const Vec kDown = {0, 0, 1};  // z is depth, positive down
+/// The drawing frame: the file's (x, y, depth) is a left-handed frame in the eyes of a geologist
+/// (east, north, down), and VTK would draw it mirrored; pictures are drawn in (x, y, elevation)
+/// about the model's centre: x - cx, y - cy, -(z - cz). Elevation points up.
+const Vec kUp = {0, 0, 1};
+Vec to_drawing(const Vec& p, const Vec& centre) { return {p[0] - centre[0], p[1] - centre[1], centre[2] - p[2]}; }
 
 /// Layout of a picture: the mesh on the left, the legend in a white strip on the right, the
 /// caption in a white strip at the bottom (fractions of the picture).
@@ -145,9 +152,9 @@ std::vector<Vec> well_axis_points(const CellArrays& a, vtkIdType n_cells, int we
     const bool in_cap = a.radial_band && a.radial_band->GetComponent(c, 0) >= 0;
     if (in_cap) {
       if (a.radial_cap_center) {
-        const Vec p = sub({a.radial_cap_center->GetComponent(c, 0), a.radial_cap_center->GetComponent(c, 1),
-                           a.radial_cap_center->GetComponent(c, 2)},
-                          shift);
+        const Vec p = to_drawing({a.radial_cap_center->GetComponent(c, 0), a.radial_cap_center->GetComponent(c, 1),
+                                  a.radial_cap_center->GetComponent(c, 2)},
+                                 shift);
         if (std::none_of(caps.begin(), caps.end(), [&](const Vec& q) { return q == p; })) caps.push_back(p);
       }
       continue;
@@ -160,15 +167,28 @@ std::vector<Vec> well_axis_points(const CellArrays& a, vtkIdType n_cells, int we
     ++count;
   }
   std::vector<Vec> out;
-  for (const auto& [seg, sc] : by_segment) out.push_back(sub(scale(sc.first, 1.0 / sc.second), shift));
+  for (const auto& [seg, sc] : by_segment) out.push_back(to_drawing(scale(sc.first, 1.0 / sc.second), shift));
   out.insert(out.end(), caps.begin(), caps.end());
   return out;
 }
 
-/// The plane of the cut: the trajectory's best-fit plane when it bends, else the vertical plane
-/// through it (horizontal well: the plane containing it and the vertical).
-bool cut_plane_of(const std::vector<Vec>& pts, CutPlane* out) {
-  if (pts.size() < 2) return false;
+/// A plane through centre with normal n, seen from the side n points to; up: the picture's up
+/// (elevation where the plane is not horizontal, else north, else the trajectory).
+CutPlane plane_facing(const Vec& centre, Vec n, const Vec& d1) {
+  if (dot(n, {0.3, -1, 0.1}) < 0) n = scale(n, -1);  // a stable side to look from: south, above
+  Vec up{0, 0, 0};
+  for (const Vec& want : {kUp, Vec{0, 1, 0}, d1}) {
+    up = sub(want, scale(n, dot(n, want)));
+    if (dot(up, up) > 1e-2) break;
+  }
+  return {centre, n, unit(up)};
+}
+
+/// The candidate planes of the cut, preferred first: the trajectory's best-fit plane when it
+/// bends; for a straight well the vertical plane through it, then the plane through it
+/// perpendicular to that one (for a horizontal well: the horizontal plane).
+std::vector<CutPlane> cut_planes_of(const std::vector<Vec>& pts) {
+  if (pts.size() < 2) return {};
   Vec c{0, 0, 0};
   for (const Vec& p : pts) c = add(c, p);
   c = scale(c, 1.0 / pts.size());
@@ -182,21 +202,36 @@ bool cut_plane_of(const std::vector<Vec>& pts, CutPlane* out) {
   double* rows[3] = {cov[0], cov[1], cov[2]};
   double* vrows[3] = {evec[0], evec[1], evec[2]};
   vtkMath::Jacobi(rows, eval, vrows);  // eigenvalues descending, eigenvectors in columns
-  if (!(eval[0] > 0)) return false;
+  if (!(eval[0] > 0)) return {};
   const Vec d1 = unit({evec[0][0], evec[1][0], evec[2][0]});
-  Vec normal;
-  if (eval[1] >= kBentTrajectoryRatio * eval[0]) {
-    normal = unit({evec[0][2], evec[1][2], evec[2][2]});
-  } else {
-    // Straight: the plane holds d1 and the vertical (for a vertical well: d1 and the x axis).
-    const Vec side = cross(d1, kDown);
-    normal = dot(side, side) > 1e-12 ? unit(side) : Vec{0, 1, 0};
+  if (eval[1] >= kBentTrajectoryRatio * eval[0]) return {plane_facing(c, unit({evec[0][2], evec[1][2], evec[2][2]}), d1)};
+  const Vec side = cross(d1, kUp);
+  const Vec vertical_normal = dot(side, side) > 1e-12 ? unit(side) : Vec{0, 1, 0};  // a vertical well: the x-z plane
+  return {plane_facing(c, vertical_normal, d1), plane_facing(c, unit(cross(d1, vertical_normal)), d1)};
+}
+
+/// Reservoir cells inside `box` that the plane cuts or touches (their bounding box has corners on
+/// both sides, or within a hair of it: a plane through a layer boundary touches the layers' faces).
+int64_t reservoir_cells_cut(vtkUnstructuredGrid* grid, vtkDataArray* region, const Box& box, const CutPlane& pl) {
+  const double hair = kTouchingPlane * std::sqrt(dot(sub(box.hi, box.lo), sub(box.hi, box.lo)));
+  int64_t count = 0;
+  for (vtkIdType c = 0; c < grid->GetNumberOfCells(); ++c) {
+    if (static_cast<int>(region->GetComponent(c, 0)) != kReservoir) continue;
+    double b[6];
+    grid->GetCellBounds(c, b);
+    Box cell;
+    cell.add({b[0], b[2], b[4]});
+    cell.add({b[1], b[3], b[5]});
+    if (!cell.intersects(box)) continue;
+    bool below = false, above = false;
+    for (int corner = 0; corner < 8; ++corner) {
+      const double d = dot(sub({b[corner & 1 ? 1 : 0], b[corner & 2 ? 3 : 2], b[corner & 4 ? 5 : 4]}, pl.centre), pl.normal);
+      below |= d <= hair;
+      above |= d >= -hair;
+    }
+    count += below && above;
   }
-  if (dot(normal, {0.3, -1, 0.1}) < 0) normal = scale(normal, -1);  // a stable side to look from
-  Vec up = sub(scale(kDown, -1), scale(normal, dot(normal, scale(kDown, -1))));
-  if (dot(up, up) < 1e-6) up = d1;  // a horizontal cut plane: the trajectory's direction is up
-  *out = {c, normal, unit(up)};
-  return true;
+  return count;
 }
 
 vtkSmartPointer<vtkLookupTable> region_lookup_table() {
@@ -391,13 +426,22 @@ WriteStatus render_png(vtkRenderer* mesh, const Props& legend, const std::string
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
   grab->Update();
+  // PATH.tmp first, renamed at the end (like every writer: a failed write leaves no complete-looking file).
+  const std::string tmp = path + ".tmp";
   vtkNew<vtkPNGWriter> writer;
-  writer->SetFileName(path.c_str());
+  writer->SetFileName(tmp.c_str());
   writer->SetInputConnection(grab->GetOutputPort());
   writer->Write();
   std::error_code ec;
-  if (writer->GetErrorCode() != 0 || !std::filesystem::exists(path, ec))
+  if (writer->GetErrorCode() != 0 || !std::filesystem::is_regular_file(tmp, ec)) {
+    std::filesystem::remove(tmp, ec);
     return {false, "pictures: cannot write '" + path + "'"};
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    return {false, "pictures: cannot rename '" + tmp + "' to '" + path + "'"};
+  }
   return {};
 }
 
@@ -475,13 +519,14 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
   for (vtkIdType i = 0; i < in->GetNumberOfPoints(); ++i) {
     double p[3];
     in->GetPoint(i, p);
-    pts->SetPoint(i, p[0] - shift[0], p[1] - shift[1], p[2] - shift[2]);
+    const Vec q = to_drawing({p[0], p[1], p[2]}, shift);
+    pts->SetPoint(i, q[0], q[1], q[2]);
   }
   auto grid = vtkSmartPointer<vtkUnstructuredGrid>::New();
   grid->ShallowCopy(in);
   grid->SetPoints(pts);
   auto centre_of = [&](vtkIdType c) {
-    return sub({a.fv_center->GetComponent(c, 0), a.fv_center->GetComponent(c, 1), a.fv_center->GetComponent(c, 2)}, shift);
+    return to_drawing({a.fv_center->GetComponent(c, 0), a.fv_center->GetComponent(c, 1), a.fv_center->GetComponent(c, 2)}, shift);
   };
   auto region_of = [&](vtkIdType c) { return static_cast<int>(a.region->GetComponent(c, 0)); };
   auto cavity_of = [&](vtkIdType c) { return a.cavity ? static_cast<int>(a.cavity->GetComponent(c, 0)) : -1; };
@@ -521,18 +566,30 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
 
   for (int w = 0; w < n_wells; ++w) {
     if (well_box[w].empty()) continue;  // a well with no cell in the mesh (none of it inside the reservoir)
-    const std::vector<Vec> axis = well_axis_points(a, n, w, shift);
-    if (!cut_plane_of(axis, &planes[w]))
+    const std::vector<CutPlane> candidates = cut_planes_of(well_axis_points(a, n, w, shift));
+    if (candidates.empty())
       return fail("well " + well_label(opt, w) + ": fewer than two distinct points on its meshed trajectory");
+    // Frame: the well's radial block and its cavities (then in the picture's (right, up) axes).
+    Box frame = well_box[w];
+    for (int k : well_cavities[w]) frame.add(cavity_box[k].lo), frame.add(cavity_box[k].hi);
+    // A straight well's second plane is taken when the first cuts too few reservoir cells near
+    // the well to show any (a horizontal well in a layer its cavity fills top to bottom).
+    size_t choice = 0;
+    if (candidates.size() == 2) {
+      const Vec pad = scale(sub(frame.hi, frame.lo), kFrameMargin);
+      Box near;
+      near.add(sub(frame.lo, pad));
+      near.add(add(frame.hi, pad));
+      const std::array<int64_t, 2> cut_cells = {reservoir_cells_cut(grid, a.region, near, candidates[0]),
+                                                reservoir_cells_cut(grid, a.region, near, candidates[1])};
+      if (4 * cut_cells[0] < cut_cells[1]) choice = 1;
+    }
+    planes[w] = candidates[choice];
     const CutPlane& pl = planes[w];
     std::vector<vtkIdType> behind;
     for (vtkIdType c = 0; c < n; ++c)
       if (dot(sub(centre_of(c), pl.centre), pl.normal) <= 0) behind.push_back(c);
     const vtkSmartPointer<vtkUnstructuredGrid> cut = extract(grid, behind);
-
-    // Frame: the well's radial block and its cavities, in the picture's (right, up) axes.
-    Box frame = well_box[w];
-    for (int k : well_cavities[w]) frame.add(cavity_box[k].lo), frame.add(cavity_box[k].hi);
     const Vec right = cross(pl.up, pl.normal);
     double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
     for (int corner = 0; corner < 8; ++corner) {
@@ -571,7 +628,7 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
 
   // Overview: the reservoir as a light wire frame; every cavity (transition and radial cells)
   // halved by a plane through its centre facing the camera, so that the radial blocks show.
-  const Vec view = unit({1.0, -1.5, -1.1});  // from +x, -y and above (z is depth)
+  const Vec view = unit({1.0, -1.5, 1.1});  // from the south-east and above
   std::vector<vtkIdType> reservoir, near_well;
   for (vtkIdType c = 0; c < n; ++c) {
     if (region_of(c) == kReservoir) {
@@ -609,7 +666,7 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
     vtkCamera* cam = ren->GetActiveCamera();
     cam->SetFocalPoint(0, 0, 0);
     cam->SetPosition(view.data());
-    cam->SetViewUp(0, 0, -1);
+    cam->SetViewUp(kUp.data());
     ren->ResetCamera();
     // ResetCamera fits the bounding sphere, so the box fills less of the frame: zoom until the
     // model's projected corners span 92 % of the mesh's viewport (twice: the perspective projection
@@ -618,9 +675,8 @@ PicturesWritten write_mesh_pictures(const std::string& vtu_path, const std::stri
       vtkMatrix4x4* m = cam->GetCompositeProjectionTransformMatrix(aspect, -1, 1);
       double extent = 0;
       for (int corner = 0; corner < 8; ++corner) {
-        const double p[4] = {(corner & 1) ? bounds[1] - shift[0] : bounds[0] - shift[0],
-                             (corner & 2) ? bounds[3] - shift[1] : bounds[2] - shift[1],
-                             (corner & 4) ? bounds[5] - shift[2] : bounds[4] - shift[2], 1.0};
+        const Vec v = to_drawing({bounds[corner & 1 ? 1 : 0], bounds[corner & 2 ? 3 : 2], bounds[corner & 4 ? 5 : 4]}, shift);
+        const double p[4] = {v[0], v[1], v[2], 1.0};
         double q[4];
         m->MultiplyPoint(p, q);
         if (q[3] > 0) extent = std::max({extent, std::abs(q[0] / q[3]), std::abs(q[1] / q[3])});

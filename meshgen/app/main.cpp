@@ -1,6 +1,7 @@
 // meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]
 // Exit codes: 0 success, 1 meshing failure (a stage, wells named; a mesh that fails the
 // self-check is never written), 2 bad input or arguments.
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -175,10 +176,13 @@ int main(int argc, char** argv) {
     }
     written.push_back((out / "openfoam").string() + "/");
   }
+  double picture_seconds = -1;
   if (pictures) {
     picture_opts.title = cs.name;
     for (const hm::WellSpec& w : cs.wells) picture_opts.well_names.push_back(w.name);
+    const auto start = std::chrono::steady_clock::now();
     const hm::PicturesWritten pics = hm::write_mesh_pictures((out / "mesh.vtu").string(), out.string(), picture_opts);
+    picture_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!pics.status.ok) {
       std::cerr << "meshgen: stage " << pics.status.message << "\n";
       return 1;
@@ -196,5 +200,6 @@ int main(int argc, char** argv) {
             << summary["cells"]["well"] << " well), " << summary["cavities"] << " cavities\n";
   for (const std::string& n : result.notes) std::cout << "  note: " << n << "\n";
   for (const std::string& w : written) std::cout << "  wrote " << w << "\n";
+  if (picture_seconds >= 0) std::printf("  pictures: %.2f s (reading mesh.vtu and rendering)\n", picture_seconds);
   return 0;
 }

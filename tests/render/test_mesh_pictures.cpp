@@ -180,6 +180,40 @@ TEST(MeshPictures, MeshgenPngWritesPicturesThatShowTheRegionsAndQs) {
   EXPECT_EQ(occurrences(hm_test::slurp(d / "fv" / "report.html"), "<img src='data:image/png;base64,"), 3u);
 }
 
+// A horizontal well whose cavity fills its thin layer top to bottom: the vertical plane through it
+// cuts no reservoir cell near the well, so the cut is the horizontal plane (a map view), which
+// shows all three regions.
+TEST(MeshPictures, HorizontalWellInAThinLayerIsCutInTheHorizontalPlane) {
+  const fs::path d = fresh_dir("pictures_thin");
+  hm_test::RemoveAtExit cleanup{d};
+  std::ofstream(d / "case.yaml") << R"(name: thin
+reservoir:
+  x: [0, 6, 12, 18, 24, 30, 36, 42, 48]
+  y: [0, 6, 12, 18, 24, 30, 36, 42, 48]
+  z: [1000, 1002.5, 1005, 1007.5, 1010]
+  permeability: [100, 100, 10]
+  porosity: 0.2
+  initial_pressure: 200
+wells:
+  - name: H1
+    trajectory: [[-10, 24, 1005], [58, 24, 1005]]
+    radius: 0.1
+    drainage_radius: 4
+    rings: 3
+    sectors: 12
+    segment_length: 6
+    bhp: 150
+    end_caps: flat
+)";
+  const auto r = run_command(kMeshgen + " " + q(d / "case.yaml") + " -o " + q(d / "out") + " --png-size 640x480", 300);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const Image region = read_png(d / "out" / hm::well_region_picture_name(0));
+  ASSERT_EQ(region.width, 640);
+  const ::testing::AssertionResult regions = shows_the_three_regions(region);
+  EXPECT_TRUE(regions);
+  std::cout << "thin-layer region picture: " << regions.message() << "\n";
+}
+
 TEST(MeshPictures, TheRegionCheckFailsOnABlankOrSingleRegionImage) {
   Image blank;
   blank.width = 100, blank.height = 100;
