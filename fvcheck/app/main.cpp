@@ -18,7 +18,9 @@ namespace {
 
 const char* kUsage =
     "usage: fvcheck MESH.vtu [--json REPORT.json] [--html REPORT.html [--png]] [--min-orthogonality DEG] "
-    "[--max-planarity DEG]\n"
+    "[--max-planarity DEG]";
+// --help only (an error stays one line): what --png does.
+const char* kPicturesHelp =
     "  the HTML report shows the pictures meshgen --png wrote beside the mesh (when not older than it);\n"
     "  --png renders them (VTK, off-screen) beside the report instead";
 
@@ -50,7 +52,7 @@ int main(int argc, char** argv) {
     };
     std::string v;
     if (a == "-h" || a == "--help") {
-      std::cout << kUsage << "\n";
+      std::cout << kUsage << "\n" << kPicturesHelp << "\n";
       return 0;
     } else if (a == "--json") {
       if (!value(&json_path) || json_path.empty()) return usage_error("--json needs a file name");
