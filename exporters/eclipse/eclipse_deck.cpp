@@ -98,6 +98,37 @@ std::string upper(std::string s) {
 
 std::string eclipse_deck_name(const CaseSpec& cs) { return upper(cs.name); }
 
+double eclipse_relaxation_time_days(const CaseSpec& cs, const PolyMesh& mesh, const MeshGeometry& geo,
+                                    const std::vector<std::vector<std::pair<int32_t, double>>>& well_connections) {
+  const double c = std::max(cs.fluid.compressibility, 1e-8), mu = cs.fluid.viscosity;
+  double inv_k[3] = {0, 0, 0}, phi = 0, pv = 0;
+  int n = 0;
+  for (int cell = 0; cell < mesh.n_cells(); ++cell) {
+    pv += geo.cell_volume[cell] * mesh.cell_porosity[cell];
+    if (mesh.cell_region[cell] != kReservoir) continue;
+    const Vec3& k = mesh.cell_perm[cell];
+    inv_k[0] += 1 / k.x;
+    inv_k[1] += 1 / k.y;
+    inv_k[2] += 1 / k.z;
+    phi += mesh.cell_porosity[cell];
+    ++n;
+  }
+  double tau = 0;
+  if (n > 0) {
+    const ReservoirSpec& r = cs.reservoir;
+    const double extent[3] = {r.x.back() - r.x.front(), r.y.back() - r.y.front(), r.z.back() - r.z.front()};
+    for (int d = 0; d < 3; ++d) {
+      const double k_harmonic = n / inv_k[d];
+      tau = std::max(tau, phi / n * mu * c * extent[d] * extent[d] / (kDarcyMetric * k_harmonic));
+    }
+  }
+  double cf = 0;
+  for (const auto& w : well_connections)
+    for (const auto& wc : w) cf += wc.second;
+  if (cf > 0) tau = std::max(tau, pv * c * mu / cf);
+  return tau;
+}
+
 std::vector<std::string> flow_steady_state_options() {
   return {"--enable-adaptive-time-stepping=false", "--time-step-control=newtoniterationcount",
           "--max-residual-allowed=1e30", "--linear-solver-reduction=1e-6", "--tolerance-mb=1e-9"};
@@ -132,6 +163,9 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       return fail("cell " + std::to_string(c) + " has a non-positive volume " + std::to_string(geo.cell_volume[c]));
   // Flow's calendar ends in 2262 (64-bit nanoseconds); the deck starts in 1900.
   if (!(options.tstep_days > 0 && options.tstep_days <= 130000)) return fail("tstep_days must be in (0, 130000]");
+  if (!(options.first_step_days > 0 && options.first_step_days <= 1)) return fail("first_step_days must be in (0, 1]");
+  if (!(options.end_days == 0 || (options.end_days > options.first_step_days && options.end_days <= 130000)))
+    return fail("end_days must be 0 (automatic) or in (first_step_days, 130000]");
 
   EclipseLayout L;
   std::string error;
@@ -144,6 +178,23 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     if (cs.wells[w].trajectory.empty()) return fail("well " + cs.wells[w].name + " has no trajectory");
   }
   std::vector<std::string> warnings;
+  // A well that cannot flow at its BHP from the initial pressure: flow shuts it at the start and
+  // (AsTyped) WTEST re-opens it when the reservoir pressure allows: correct, but a slower start.
+  auto text_number = [](double v) { return (TextOut() << v).text; };
+  for (const WellSpec& w : cs.wells)
+    if ((w.type == WellType::Producer) ? w.bhp > cs.reservoir.initial_pressure : w.bhp < cs.reservoir.initial_pressure)
+      warnings.push_back("well " + w.name + ": BHP " + text_number(w.bhp) + " bar cannot " +
+                         (w.type == WellType::Producer ? "produce" : "inject") + " from the initial pressure " +
+                         text_number(cs.reservoir.initial_pressure) +
+                         " bar: flow shuts it at the start of a transient run (the deck's WTEST re-opens it)");
+  // AsTyped: the transient runs 40 relaxation times (at least 1 day), within flow's calendar.
+  const double relaxation = eclipse_relaxation_time_days(cs, mesh, geo, wells);
+  double end_days = options.end_days > 0 ? options.end_days : std::max(1.0, 40 * relaxation);
+  if (end_days > 130000) {
+    warnings.push_back("the estimated relaxation time (" + std::to_string(relaxation) +
+                       " days) needs a run beyond flow's calendar: the deck ends at 130000 days");
+    end_days = 130000;
+  }
   if (conn.negative_faces > 0)
     warnings.push_back(std::to_string(conn.negative_faces) +
                        " interior faces have a negative or non-finite transmissibility (written as computed)");
@@ -280,10 +331,15 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     if (fl.compressibility < 1e-8)
       warnings.push_back("fluid compressibility raised to 1e-8 /bar in PVTW (flow needs Cw > 0)");
     TextOut o;
-    o << "-- " << name << ": single-phase steady-state deck written by HybridMesh (docs/export-eclipse.md).\n"
-      << "-- Run: flow";
-    for (const std::string& a : flow_steady_state_options()) o << ' ' << a;
-    o << ' ' << name << ".DATA\n\n"
+    o << "-- " << name << ": single-phase steady-state deck written by HybridMesh (docs/export-eclipse.md).\n";
+    if (options.schedule == EclipseSchedule::SingleStep) {
+      o << "-- Run: flow";
+      for (const std::string& a : flow_steady_state_options()) o << ' ' << a;
+      o << ' ' << name << ".DATA\n\n";
+    } else {
+      o << "-- Run: flow " << name << ".DATA   (no options needed)\n\n";
+    }
+    o
       << "RUNSPEC\n\nTITLE\n" << name << "\n\n"
       << "DIMENS\n" << L.deck_nx << ' ' << L.ny << ' ' << L.nz << " /\n\n"
       << "WATER\n\nMETRIC\n\n"
@@ -311,9 +367,20 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       << "SUMMARY\n\nWBHP\n/\nWWPR\n/\nWWIR\n/\nFWPR\nFWIR\n\n"
       << "SCHEDULE\n\n"
       << "RPTRST\n'BASIC=2' /\n\n"
-      << "INCLUDE\n" << quoted(sched_inc) << " /\n\n"
-      << "-- One long step: backward Euler then gives the steady state.\n"
-      << "TSTEP\n" << options.tstep_days << " /\n\nEND\n";
+      << "INCLUDE\n" << quoted(sched_inc) << " /\n\n";
+    if (options.schedule == EclipseSchedule::SingleStep) {
+      o << "-- One long step (run flow with the options above): backward Euler then gives the steady state.\n"
+        << "TSTEP\n" << options.tstep_days << " /\n\nEND\n";
+    } else {
+      o << "-- Run as typed: flow 2022.10 reads no time-step keyword without options (TUNING, NEXTSTEP need\n"
+        << "-- --enable-tuning); it starts at min(1 day, report step), grows at most 3x per step, at most 365 days.\n"
+        << "-- The run is the case's transient from its initial pressure to the steady state, "
+        << end_days << " days = 40 x the\n"
+        << "-- estimated relaxation time " << relaxation << " days (docs/export-eclipse.md).\n"
+        << "-- Re-open any well flow shut because it could not flow at its BHP, as soon as it can:\n"
+        << "WTEST\n'*' " << options.first_step_days << " 'P' /\n/\n\n"
+        << "TSTEP\n" << options.first_step_days << ' ' << end_days - options.first_step_days << " /\n\nEND\n";
+    }
     data_text = std::move(o.text);
   }
 
@@ -338,6 +405,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     info->tran_connections = tran_connections;
     info->well_connections = wells;
     info->warnings = warnings;
+    info->relaxation_time_days = relaxation;
+    info->end_days = options.schedule == EclipseSchedule::SingleStep ? options.tstep_days : end_days;
   }
   return {};
 }

@@ -21,10 +21,28 @@
 
 namespace hm {
 
+/// How the deck's SCHEDULE reaches the steady state (docs/export-eclipse.md, "Running as typed").
+enum class EclipseSchedule {
+  /// For `flow NAME.DATA` with no options (the default): `WTEST` re-opens every well flow shut
+  /// because it could not flow at its BHP, then `TSTEP first_step_days (end - first_step_days)`:
+  /// flow's own time stepping (x3 per step, at most 365 days) carries the transient to its
+  /// steady state. end = end_days, or automatically max(1, 40 x eclipse_relaxation_time_days).
+  AsTyped,
+  /// One report step of tstep_days, for `flow` with flow_steady_state_options() (optional).
+  SingleStep,
+};
+
 struct EclipseDeckOptions {
-  /// Length of the single report step (days). Long enough that the compressible accumulation
-  /// left after one backward-Euler step is negligible: the run is a steady-state solve. The run
-  /// starts on 1 Jan 1900 and flow's dates end in 2262: at most ~131,000 days.
+  EclipseSchedule schedule = EclipseSchedule::AsTyped;
+  /// AsTyped: the first report step (days). Flow 2022.10 starts its time stepping at
+  /// min(1 day, report step); 0.01 day keeps the first step's Newton error below the distance
+  /// still to go, so a lone producer in a closed box is not shut above its steady state.
+  double first_step_days = 0.01;
+  /// AsTyped: the end of the run (days); 0 = automatic (see EclipseSchedule::AsTyped).
+  double end_days = 0;
+  /// SingleStep: length of the single report step (days). Long enough that the compressible
+  /// accumulation left after one backward-Euler step is negligible: the run is a steady-state
+  /// solve. The run starts on 1 Jan 1900 and flow's dates end in 2262: at most ~131,000 days.
   double tstep_days = 1.0e5;
   /// Thickness (m) of the thin boxes that carry the non-reservoir cells. Their depth (centre)
   /// is exact; the thickness only decides how many fit in one column.
@@ -93,7 +111,16 @@ struct EclipseDeckInfo {
   int tran_connections = 0;           ///< non-zero TRANX/Y/Z entries written
   std::vector<std::vector<std::pair<int32_t, double>>> well_connections;  ///< per well: (cell, CF)
   std::vector<std::string> warnings;  ///< e.g. negative transmissibilities written as computed
+  double relaxation_time_days = 0;    ///< eclipse_relaxation_time_days of the case
+  double end_days = 0;                ///< simulated time of the deck's SCHEDULE (days)
 };
+
+/// An estimate of the slowest pressure relaxation time (days) of the deck's transient:
+/// max(diffusion phi mu c L_d^2 / (CDARCY k_d) over the axes d, with L_d the reservoir's extent,
+/// k_d the harmonic mean and phi the mean over reservoir cells; depletion PV c mu / sum CF over
+/// all wells), c = the deck's Cw (rock incompressible). The AsTyped schedule runs 40 of them.
+double eclipse_relaxation_time_days(const CaseSpec& cs, const PolyMesh& mesh, const MeshGeometry& geo,
+                                    const std::vector<std::vector<std::pair<int32_t, double>>>& well_connections);
 
 /// NAME of the deck: the case name upper-cased.
 std::string eclipse_deck_name(const CaseSpec& cs);
@@ -111,8 +138,9 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
 /// ACTNUM 1 where the mesh has the reservoir cell, 0 where the cavity replaced it.
 WriteStatus write_reservoir_grdecl(const std::string& path, const ReservoirSpec& reservoir, const PolyMesh& mesh);
 
-/// Command-line options for `flow` that make the one-step deck a steady-state solve and make it
-/// converge to the accuracy of its float32 output (docs/export-eclipse.md explains each).
+/// Command-line options for `flow` that make the one-step deck (EclipseSchedule::SingleStep) a
+/// steady-state solve and make it converge to the accuracy of its float32 output
+/// (docs/export-eclipse.md explains each). Optional: the default deck runs as typed.
 std::vector<std::string> flow_steady_state_options();
 
 }  // namespace hm

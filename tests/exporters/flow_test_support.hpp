@@ -1,5 +1,7 @@
 // Running OPM Flow on an exported deck and comparing it with the reference TPFA solve.
 #pragma once
+#include <sys/resource.h>
+
 #include <nlohmann/json.hpp>
 
 #include "exporter_test_support.hpp"
@@ -17,18 +19,38 @@ struct FlowRun {
   CommandResult reader;
   nlohmann::json results;  ///< scripts/validate_flow.py output (null if it failed)
   double seconds = 0;      ///< wall time of the flow run
+  double cpu_seconds = 0;  ///< user + system CPU time of the flow run (children of this process)
+  int newton = -1;         ///< "Overall Newton Iterations" flow printed (-1: not found)
 };
 
-/// Runs flow with the exporter's steady-state options on dir/NAME.DATA (output in dir/out),
-/// then reads the results back with scripts/validate_flow.py.
-inline FlowRun run_flow(const fs::path& dir, const std::string& name, int timeout_s = 900) {
+inline double children_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+enum class FlowInvocation {
+  AsTyped,      ///< `flow NAME.DATA`: no options (the default deck, EclipseSchedule::AsTyped)
+  WithOptions,  ///< `flow <flow_steady_state_options()> NAME.DATA` (for EclipseSchedule::SingleStep)
+};
+
+/// Runs flow on dir/NAME.DATA (output in dir/out; --output-dir only chooses where flow writes),
+/// as a user types it or with the exporter's optional steady-state options, then reads the
+/// results back with scripts/validate_flow.py.
+inline FlowRun run_flow(const fs::path& dir, const std::string& name, FlowInvocation how = FlowInvocation::AsTyped,
+                        int timeout_s = 900) {
   FlowRun r;
   std::string cmd = "cd " + shell_quote(dir.string()) + " && flow";
-  for (const std::string& a : hm::flow_steady_state_options()) cmd += " " + a;
+  if (how == FlowInvocation::WithOptions)
+    for (const std::string& a : hm::flow_steady_state_options()) cmd += " " + a;
   cmd += " --output-dir=out " + shell_quote(name + ".DATA");
   const auto t0 = std::chrono::steady_clock::now();
+  const double c0 = children_cpu_seconds();
   r.flow = run_command(cmd, timeout_s);
+  r.cpu_seconds = children_cpu_seconds() - c0;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const size_t at = r.flow.output.rfind("Overall Newton Iterations:");
+  if (at != std::string::npos) r.newton = std::atoi(r.flow.output.c_str() + at + 26);
   if (r.flow.exit_code != 0) return r;
   r.reader = run_command("/usr/bin/python3 " + shell_quote(std::string(HM_SOURCE_DIR) + "/scripts/validate_flow.py") +
                              " " + shell_quote((dir / "out").string()) + " " + shell_quote(name) + " 2>/dev/null",

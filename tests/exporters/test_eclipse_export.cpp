@@ -418,3 +418,64 @@ TEST(EclipseDeckErrors, InputProblemsAreReportedBeforeWriting) {
 }
 
 }  // namespace
+
+namespace {
+
+// The deck's SCHEDULE (issue 16): as typed, WTEST then `TSTEP first (end - first)` with end =
+// max(1, 40 relaxation times); a compressible case relaxes slower and runs longer; the one-step
+// deck for the optional flow options is unchanged; bad step lengths are refused.
+std::string schedule_of(const std::string& data) { return data.substr(data.find("SCHEDULE")); }
+
+TEST(EclipseDeck, AsTypedScheduleRunsFortyRelaxationTimes) {
+  Fixture fx;
+  TempDir tmp("deck_sched");
+  hm::EclipseDeckInfo info;
+  ASSERT_TRUE(hm::write_eclipse_deck(tmp.str(), fx.cs, fx.mesh, fx.geo, fx.trans, {}, &info).ok);
+  const std::string data = read_text(info.data_file);
+  EXPECT_NE(data.find("-- Run: flow DECK_TEST.DATA"), std::string::npos);
+  const double tau = hm::eclipse_relaxation_time_days(fx.cs, fx.mesh, fx.geo, info.well_connections);
+  EXPECT_GT(tau, 0);
+  EXPECT_EQ(info.relaxation_time_days, tau);
+  EXPECT_EQ(info.end_days, std::max(1.0, 40 * tau));
+  std::istringstream sched(schedule_of(data).substr(schedule_of(data).find("TSTEP\n") + 6));
+  double first = 0, rest = 0;
+  sched >> first >> rest;
+  EXPECT_EQ(first, 0.01);
+  EXPECT_NEAR(first + rest, info.end_days, 1e-12 * info.end_days);
+  EXPECT_NE(schedule_of(data).find("WTEST\n'*' 0.01 'P' /\n/"), std::string::npos);
+
+  // Compressible water: the relaxation time scales with Cw, the run with it (past the 1-day floor).
+  hm::CaseSpec water = fx.cs;
+  water.fluid.compressibility = 1e-3;
+  hm::EclipseDeckInfo winfo;
+  TempDir tmp2("deck_sched_water");
+  ASSERT_TRUE(hm::write_eclipse_deck(tmp2.str(), water, fx.mesh, fx.geo, fx.trans, {}, &winfo).ok);
+  EXPECT_NEAR(winfo.relaxation_time_days / info.relaxation_time_days, 1e-3 / std::max(fx.cs.fluid.compressibility, 1e-8),
+              1e-9 * winfo.relaxation_time_days / info.relaxation_time_days);
+  EXPECT_GT(winfo.end_days, 1.0);
+  EXPECT_EQ(winfo.end_days, 40 * winfo.relaxation_time_days);
+
+  // The one-step deck: one TSTEP of tstep_days, no WTEST, the options in its first lines.
+  hm::EclipseDeckOptions single;
+  single.schedule = hm::EclipseSchedule::SingleStep;
+  TempDir tmp3("deck_sched_single");
+  hm::EclipseDeckInfo sinfo;
+  ASSERT_TRUE(hm::write_eclipse_deck(tmp3.str(), fx.cs, fx.mesh, fx.geo, fx.trans, single, &sinfo).ok);
+  const std::string sdata = read_text(sinfo.data_file);
+  EXPECT_NE(schedule_of(sdata).find("TSTEP\n1e+05 /"), std::string::npos) << schedule_of(sdata);
+  EXPECT_EQ(schedule_of(sdata).find("WTEST"), std::string::npos);
+  EXPECT_NE(sdata.find("-- Run: flow --enable-adaptive-time-stepping=false"), std::string::npos);
+  EXPECT_EQ(sinfo.end_days, 1e5);
+
+  // Refused step lengths.
+  hm::EclipseDeckOptions bad;
+  bad.first_step_days = 0;
+  EXPECT_NE(hm::write_eclipse_deck(tmp.str(), fx.cs, fx.mesh, fx.geo, fx.trans, bad).message.find("first_step_days"),
+            std::string::npos);
+  bad.first_step_days = 0.01;
+  bad.end_days = 0.005;
+  EXPECT_NE(hm::write_eclipse_deck(tmp.str(), fx.cs, fx.mesh, fx.geo, fx.trans, bad).message.find("end_days"),
+            std::string::npos);
+}
+
+}  // namespace

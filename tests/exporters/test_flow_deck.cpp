@@ -22,9 +22,9 @@ hm::CaseSpec two_well_box() {
 
 void report(const char* what, const FlowComparison& c, const FlowRun& run) {
   std::printf("[ figures  ] %s: max rel pressure %.3g, max rel rate %.3g, PORV %.3g, depth %.3g m, "
-              "connections %zu (flow: %zu, %zu of them TRANNNC, max rel %.3g), flow %.2f s\n",
+              "connections %zu (flow: %zu, %zu of them TRANNNC, max rel %.3g), flow %.2f s (CPU %.2f s, %d Newton)\n",
               what, c.max_rel_pressure, c.max_rel_rate, c.max_rel_porv, c.max_depth_diff, c.our_connections,
-              c.flow_connections, c.flow_nnc, c.max_rel_connection, run.seconds);
+              c.flow_connections, c.flow_nnc, c.max_rel_connection, run.seconds, run.cpu_seconds, run.newton);
 }
 
 TEST(FlowDeck, BoxWithTwoVerticalWellsAndGravityMatchesOurSolve) {
@@ -62,6 +62,34 @@ TEST(FlowDeck, BoxWithTwoVerticalWellsAndGravityMatchesOurSolve) {
   EXPECT_LT(c.max_rel_connection, 1e-6);
   EXPECT_EQ(c.flow_connections, c.our_connections);
   EXPECT_EQ(c.dropped_by_flow, c.expected_dropped);
+}
+
+// The optional path: the one-step deck (EclipseSchedule::SingleStep) run with
+// flow_steady_state_options() agrees just as well (docs/export-eclipse.md).
+TEST(FlowDeck, SingleStepDeckWithTheOptionsMatchesOurSolve) {
+  REQUIRE_FLOW();
+  const hm::CaseSpec cs = two_well_box();
+  hm::BuildReport rep;
+  const hm::PolyMesh mesh = build_box_with_vertical_wells(cs, &rep);
+  ASSERT_TRUE(rep.ok);
+  const hm::MeshGeometry geo = hm::compute_geometry(mesh);
+  const hm::Transmissibilities trans = hm::compute_transmissibilities(mesh, geo);
+  const TpfaSolution ours = reference_tpfa_solve(cs, mesh, trans);
+  TempDir tmp("flow_box_single");
+  hm::EclipseDeckOptions opt;
+  opt.schedule = hm::EclipseSchedule::SingleStep;
+  hm::EclipseDeckInfo info;
+  ASSERT_TRUE(hm::write_eclipse_deck(tmp.str(), cs, mesh, geo, trans, opt, &info).ok);
+  EXPECT_EQ(info.end_days, opt.tstep_days);
+  const FlowRun run = run_flow(tmp.path, "TWO_WELLS", FlowInvocation::WithOptions);
+  ASSERT_EQ(run.flow.exit_code, 0) << run.flow.output;
+  ASSERT_EQ(run.reader.exit_code, 0) << run.reader.output;
+  const hm::EclipseConnections conn = hm::make_eclipse_connections(mesh, info.layout, trans);
+  const FlowComparison c = compare_flow(cs, mesh, geo, info, ours, conn, run.results);
+  ASSERT_TRUE(c.problem.empty()) << c.problem;
+  report("two-well box, one-step deck with the options", c, run);
+  EXPECT_LT(c.max_rel_pressure, 1e-5);
+  EXPECT_LT(c.max_rel_rate, 1e-5);
 }
 
 // The fail half of the pair: the same comparison flags a deck whose transmissibilities are not

@@ -122,7 +122,25 @@ void run_example(const hm::CaseSpec& cs, const std::string& label, ExampleRun* r
   ASSERT_TRUE(st.ok) << st.message;
   for (const std::string& w : r->info.warnings) std::printf("[ warning  ] %s\n", w.c_str());
   dump_ours_if_kept(tmp.path, cs, r->info.layout, r->ours);
-  r->run = run_flow(tmp.path, hm::eclipse_deck_name(cs));
+  r->run = run_flow(tmp.path, hm::eclipse_deck_name(cs));  // as typed: no options
+  // Measurement aid (issue 16): HM_FLOW_COMPARE_TUNED=1 also runs the one-step deck with the
+  // optional flow options, right after, and prints both runs' times and Newton iterations.
+  if (std::getenv("HM_FLOW_COMPARE_TUNED") != nullptr) {
+    TempDir tuned_dir("flow_tuned_" + label);
+    hm::EclipseDeckOptions single;
+    single.schedule = hm::EclipseSchedule::SingleStep;
+    hm::EclipseDeckInfo tuned_info;
+    ASSERT_TRUE(hm::write_eclipse_deck(tuned_dir.str(), cs, mesh, geo, trans, single, &tuned_info).ok);
+    const FlowRun tuned = run_flow(tuned_dir.path, hm::eclipse_deck_name(cs), FlowInvocation::WithOptions);
+    ASSERT_EQ(tuned.flow.exit_code, 0) << tuned.flow.output;
+    const FlowComparison tc = compare_flow(cs, mesh, geo, tuned_info, r->ours,
+                                           hm::make_eclipse_connections(mesh, tuned_info.layout, trans), tuned.results);
+    std::printf("[ figures  ] %s: as typed: %.2f s wall, %.2f s CPU, %d Newton, end %.4g days (relaxation %.3g days); "
+                "tuned: %.2f s wall, %.2f s CPU, %d Newton, max rel pressure %.3g, rate %.3g; CPU ratio %.2f\n",
+                label.c_str(), r->run.seconds, r->run.cpu_seconds, r->run.newton, r->info.end_days,
+                r->info.relaxation_time_days, tuned.seconds, tuned.cpu_seconds, tuned.newton, tc.max_rel_pressure,
+                tc.max_rel_rate, r->run.cpu_seconds / tuned.cpu_seconds);
+  }
   ASSERT_FALSE(r->run.flow.timed_out);
   ASSERT_EQ(r->run.flow.exit_code, 0) << r->run.flow.output;
   ASSERT_EQ(r->run.reader.exit_code, 0) << r->run.reader.output;
@@ -132,9 +150,9 @@ void run_example(const hm::CaseSpec& cs, const std::string& label, ExampleRun* r
   const FlowComparison& c = r->c;
   const hm::EclipseLayout& L = r->info.layout;
   std::printf("[ figures  ] %s: %d cells (deck %dx%dx%d, %d extra columns), %d NNC records; mesh %.2f s, deck write "
-              "%.3f s, flow %.2f s\n",
+              "%.3f s, flow as typed %.2f s (CPU %.2f s, %d Newton)\n",
               label.c_str(), mesh.n_cells(), L.deck_nx, L.ny, L.nz, L.extra_columns, r->info.nnc, r->mesh_s, r->write_s,
-              r->run.seconds);
+              r->run.seconds, r->run.cpu_seconds, r->run.newton);
   std::printf("[ figures  ] %s: max rel pressure %.3g, max rel rate %.3g, PORV %.3g, depth %.3g m, connections %zu "
               "(flow %zu, %zu TRANNNC, max rel %.3g; %zu below flow's threshold dropped, sum %.3g)\n",
               label.c_str(), c.max_rel_pressure, c.max_rel_rate, c.max_rel_porv, c.max_depth_diff, c.our_connections,
