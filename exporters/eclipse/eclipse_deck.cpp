@@ -163,7 +163,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       return fail("cell " + std::to_string(c) + " has a non-positive volume " + std::to_string(geo.cell_volume[c]));
   // Flow's calendar ends in 2262 (64-bit nanoseconds); the deck starts in 1900.
   if (!(options.tstep_days > 0 && options.tstep_days <= 130000)) return fail("tstep_days must be in (0, 130000]");
-  if (!(options.first_step_days > 0 && options.first_step_days <= 1)) return fail("first_step_days must be in (0, 1]");
+  if (!(options.first_step_days >= 0 && options.first_step_days <= 1))
+    return fail("first_step_days must be 0 (automatic) or in (0, 1]");
   if (!(options.end_days == 0 || (options.end_days > options.first_step_days && options.end_days <= 130000)))
     return fail("end_days must be 0 (automatic) or in (first_step_days, 130000]");
 
@@ -189,7 +190,10 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
                          " bar: flow shuts it at the start of a transient run (the deck's WTEST re-opens it)");
   // AsTyped: the transient runs 40 relaxation times (at least 1 day), within flow's calendar.
   const double relaxation = eclipse_relaxation_time_days(cs, mesh, geo, wells);
+  const double first_step =
+      options.first_step_days > 0 ? options.first_step_days : std::clamp(0.5 * relaxation, kOneSecondInDays, 1.0);
   double end_days = options.end_days > 0 ? options.end_days : std::max(1.0, 40 * relaxation);
+  if (end_days <= first_step) return fail("end_days must be longer than the first step");
   if (end_days > 130000) {
     warnings.push_back("the estimated relaxation time (" + std::to_string(relaxation) +
                        " days) needs a run beyond flow's calendar: the deck ends at 130000 days");
@@ -378,8 +382,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
         << end_days << " days = 40 x the\n"
         << "-- estimated relaxation time " << relaxation << " days (docs/export-eclipse.md).\n"
         << "-- Re-open any well flow shut because it could not flow at its BHP, as soon as it can:\n"
-        << "WTEST\n'*' " << options.first_step_days << " 'P' /\n/\n\n"
-        << "TSTEP\n" << options.first_step_days << ' ' << end_days - options.first_step_days << " /\n\nEND\n";
+        << "WTEST\n'*' 0.01 'P' /\n/\n\n"
+        << "TSTEP\n" << first_step << ' ' << end_days - first_step << " /\n\nEND\n";
     }
     data_text = std::move(o.text);
   }
@@ -406,6 +410,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     info->well_connections = wells;
     info->warnings = warnings;
     info->relaxation_time_days = relaxation;
+    info->first_step_days = first_step;
     info->end_days = options.schedule == EclipseSchedule::SingleStep ? options.tstep_days : end_days;
   }
   return {};

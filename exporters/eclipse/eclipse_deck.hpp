@@ -24,7 +24,7 @@ namespace hm {
 /// How the deck's SCHEDULE reaches the steady state (docs/export-eclipse.md, "Running as typed").
 enum class EclipseSchedule {
   /// For `flow NAME.DATA` with no options (the default): `WTEST` re-opens every well flow shut
-  /// because it could not flow at its BHP, then `TSTEP first_step_days (end - first_step_days)`:
+  /// because it could not flow at its BHP, then `TSTEP first (end - first)`:
   /// flow's own time stepping (x3 per step, at most 365 days) carries the transient to its
   /// steady state. end = end_days, or automatically max(1, 40 x eclipse_relaxation_time_days).
   AsTyped,
@@ -32,12 +32,17 @@ enum class EclipseSchedule {
   SingleStep,
 };
 
+constexpr double kOneSecondInDays = 1.0 / 86400;
+
 struct EclipseDeckOptions {
   EclipseSchedule schedule = EclipseSchedule::AsTyped;
-  /// AsTyped: the first report step (days). Flow 2022.10 starts its time stepping at
-  /// min(1 day, report step); 0.01 day keeps the first step's Newton error below the distance
-  /// still to go, so a lone producer in a closed box is not shut above its steady state.
-  double first_step_days = 0.01;
+  /// AsTyped: the first report step (days); 0 = automatic, clamp(tau / 2, 1 s, 1 day) with tau =
+  /// eclipse_relaxation_time_days (flow rounds report steps to whole seconds). Flow 2022.10
+  /// starts its time stepping at min(1 day, report step); a first step shorter than the
+  /// relaxation time keeps its Newton error below the distance still to go, so that a lone
+  /// producer in a closed box is not shut by flow before its steady state (not a guarantee:
+  /// docs/export-eclipse.md, accuracy_bent).
+  double first_step_days = 0;
   /// AsTyped: the end of the run (days); 0 = automatic (see EclipseSchedule::AsTyped).
   double end_days = 0;
   /// SingleStep: length of the single report step (days). Long enough that the compressible
@@ -112,6 +117,7 @@ struct EclipseDeckInfo {
   std::vector<std::vector<std::pair<int32_t, double>>> well_connections;  ///< per well: (cell, CF)
   std::vector<std::string> warnings;  ///< e.g. negative transmissibilities written as computed
   double relaxation_time_days = 0;    ///< eclipse_relaxation_time_days of the case
+  double first_step_days = 0;         ///< AsTyped: the first report step (days)
   double end_days = 0;                ///< simulated time of the deck's SCHEDULE (days)
 };
 

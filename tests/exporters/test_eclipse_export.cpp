@@ -422,7 +422,8 @@ TEST(EclipseDeckErrors, InputProblemsAreReportedBeforeWriting) {
 namespace {
 
 // The deck's SCHEDULE (issue 16): as typed, WTEST then `TSTEP first (end - first)` with end =
-// max(1, 40 relaxation times); a compressible case relaxes slower and runs longer; the one-step
+// max(1, 40 relaxation times), first = clamp(tau / 2, 1 s, 1 day); a compressible case relaxes
+// slower and runs longer; the one-step
 // deck for the optional flow options is unchanged; bad step lengths are refused.
 std::string schedule_of(const std::string& data) { return data.substr(data.find("SCHEDULE")); }
 
@@ -440,7 +441,9 @@ TEST(EclipseDeck, AsTypedScheduleRunsFortyRelaxationTimes) {
   std::istringstream sched(schedule_of(data).substr(schedule_of(data).find("TSTEP\n") + 6));
   double first = 0, rest = 0;
   sched >> first >> rest;
-  EXPECT_EQ(first, 0.01);
+  EXPECT_EQ(first, info.first_step_days);
+  EXPECT_EQ(first, std::clamp(0.5 * tau, hm::kOneSecondInDays, 1.0));
+  EXPECT_LT(first, 0.01);  // Cw = 1e-8: tau is far below a day
   EXPECT_NEAR(first + rest, info.end_days, 1e-12 * info.end_days);
   EXPECT_NE(schedule_of(data).find("WTEST\n'*' 0.01 'P' /\n/"), std::string::npos);
 
@@ -454,6 +457,8 @@ TEST(EclipseDeck, AsTypedScheduleRunsFortyRelaxationTimes) {
               1e-9 * winfo.relaxation_time_days / info.relaxation_time_days);
   EXPECT_GT(winfo.end_days, 1.0);
   EXPECT_EQ(winfo.end_days, 40 * winfo.relaxation_time_days);
+  EXPECT_EQ(winfo.first_step_days, std::clamp(0.5 * winfo.relaxation_time_days, hm::kOneSecondInDays, 1.0));
+  EXPECT_GT(winfo.first_step_days, 0.01);
 
   // The one-step deck: one TSTEP of tstep_days, no WTEST, the options in its first lines.
   hm::EclipseDeckOptions single;
@@ -469,11 +474,11 @@ TEST(EclipseDeck, AsTypedScheduleRunsFortyRelaxationTimes) {
 
   // Refused step lengths.
   hm::EclipseDeckOptions bad;
-  bad.first_step_days = 0;
+  bad.first_step_days = -1;
   EXPECT_NE(hm::write_eclipse_deck(tmp.str(), fx.cs, fx.mesh, fx.geo, fx.trans, bad).message.find("first_step_days"),
             std::string::npos);
   bad.first_step_days = 0.01;
-  bad.end_days = 0.005;
+  bad.end_days = 0.005;  // before the end of the first step
   EXPECT_NE(hm::write_eclipse_deck(tmp.str(), fx.cs, fx.mesh, fx.geo, fx.trans, bad).message.find("end_days"),
             std::string::npos);
 }
