@@ -114,6 +114,28 @@ std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& ge
   return q;
 }
 
+std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometry& geo) {
+  std::vector<double> q(m.n_faces(), 0.0);
+  auto angle = [&](int c, Vec3 area, Vec3 d) {
+    const Vec3 k = m.cell_perm[c];
+    const Vec3 kn{k.x * area.x, k.y * area.y, k.z * area.z};
+    return std::atan2(norm(cross(d, kn)), std::fabs(dot(d, kn))) * kDeg;  // accurate near 0
+  };
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const Vec3 a = geo.face_area[f];
+    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+    const Vec3 p1 = m.cell_fv_center[o];
+    const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : geo.face_centroid[f]) - p1;
+    if (!(norm(a) > 0) || !(norm(d) > 0)) {
+      q[f] = 90.0;  // degenerate
+      continue;
+    }
+    q[f] = angle(o, a, d);
+    if (n >= 0) q[f] = std::max(q[f], angle(n, a, d));
+  }
+  return q;
+}
+
 std::vector<double> face_planarity(const PolyMesh& m, const MeshGeometry& geo) {
   std::vector<double> q(m.n_faces(), 0.0);
   for (int f = 0; f < m.n_faces(); ++f) {
