@@ -43,7 +43,8 @@ struct FvReport {
   /// Per cell: max over its faces of the K-non-orthogonality (deg, face_k_nonorthogonality);
   /// empty when a cell has no positive finite permeability.
   std::vector<double> k_angle_cell;
-  Stats k_angle_all;
+  std::vector<double> k_angle_interior_cell;  ///< the same over interior faces only
+  Stats k_angle_all, k_angle_interior_all;
   /// The mesh was built in a permeability frame (metric_scale != 1): the orthogonality check
   /// measures Q_O in the K metric (90 - K-non-orthogonality); q_o_* stay Euclidean.
   bool k_metric = false;

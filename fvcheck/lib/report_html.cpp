@@ -163,12 +163,15 @@ std::string report_html(const FvReport& r) {
       Stats RegionQuality::*member;
       const char* unit;
     };
-    const Row rows[4] = {{"Q_S", "%.2f", r.q_s_all, &RegionQuality::q_s, ""},
+    const Row rows[5] = {{"Q_S", "%.2f", r.q_s_all, &RegionQuality::q_s, ""},
                          {"Q_O", "%.2f", r.q_o_all, &RegionQuality::q_o, "&deg;"},
                          {"Q_P", "%.2f", r.q_p_all, &RegionQuality::q_p, "&deg;"},
-                         {"K-non-orth.", "%.3g", r.k_angle_all, &RegionQuality::k_angle, "&deg;"}};
+                         {"K-non-orth.", "%.3g", r.k_angle_all, &RegionQuality::k_angle, "&deg;"},
+                         {"K-non-orth. (interior faces)", "%.3g", r.k_angle_interior_all, &RegionQuality::k_angle_interior, "&deg;"}};
     for (const Row& row : rows) {
-      if (row.member == &RegionQuality::k_angle && r.k_angle_cell.empty()) continue;
+      if ((row.member == &RegionQuality::k_angle || row.member == &RegionQuality::k_angle_interior) &&
+          r.k_angle_cell.empty())
+        continue;
       const char* what[3] = {"min.", "max.", "average"};
       for (int k = 0; k < 3; ++k) {
         auto pick = [&](const Stats& s) { return k == 0 ? s.min : (k == 1 ? s.max : s.mean); };
