@@ -97,6 +97,8 @@ CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
       scaled_length += norm(divided(d, f.scale));
       radius_sum += l * equivalent_radius(f.scale, d / l, w.radius);
     }
+    // Measured depths stay the physical ones (perforations are given in them).
+    if (w.trajectory_md.empty()) w.trajectory_md = well_measured_depths(w);
     for (Vec3& p : w.trajectory) p = to_scaled(f, p);
     w.radius = radius_sum / length;
     w.drainage_radius = scaled_block_radius(f.scale, w.drainage_radius);

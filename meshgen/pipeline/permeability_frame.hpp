@@ -43,7 +43,8 @@ double scaled_block_radius(Vec3 scale, double R);
 
 /// The case as meshed in frame f: reservoir axes and trajectories scaled; per well, radius =
 /// length-weighted mean over the legs of equivalent_radius, drainage_radius =
-/// scaled_block_radius, segment_length times the scaled/physical trajectory length ratio. The
+/// scaled_block_radius, segment_length times the scaled/physical trajectory length ratio,
+/// trajectory_md the physical measured depths (perforations keep their meaning). The
 /// rock (per cell or uniform) stays physical. Throws InputError when the scaled radius is not
 /// below the scaled drainage radius.
 CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f);

@@ -85,6 +85,25 @@ TEST(PermeabilityFrame, EquivalentRadiusOfADeviatedWellMatchesTheSampledEllipse)
   EXPECT_GT(std::fabs((1 / s.x + 1 / s.y + 1 / s.z) / 3 - 0.5 * (rmin + rmax)), 1e-3);
 }
 
+// The case as meshed keeps the physical measured depths (perforations are given in them) and the
+// physical volumes of its wellbore (det S = 1: only its shape changes).
+TEST(PermeabilityFrame, ScaledCaseKeepsMeasuredDepths) {
+  CaseSpec cs;
+  cs.metric = MeshMetric::Permeability;
+  cs.reservoir.x = cs.reservoir.y = {0, 100};
+  cs.reservoir.z = {1000, 1100};
+  cs.reservoir.permeability = {300, 100, 3};
+  WellSpec w;
+  w.trajectory = {{10, 10, 1010}, {40, 20, 1050}, {80, 20, 1060}};
+  cs.wells.push_back(w);
+  const CaseSpec scaled = scaled_case(cs, permeability_frame(cs));
+  EXPECT_EQ(well_measured_depths(scaled.wells[0]), well_measured_depths(cs.wells[0]));
+  // Fail half: the scaled polyline's own length is not the measured depth.
+  CaseSpec bare = scaled;
+  bare.wells[0].trajectory_md.clear();
+  EXPECT_GT(std::fabs(well_measured_depths(bare.wells[0]).back() - well_measured_depths(cs.wells[0]).back()), 1.0);
+}
+
 namespace {
 
 CaseSpec example(const std::string& name) { return load_case(std::string(HM_SOURCE_DIR) + "/examples/" + name + ".yaml"); }
