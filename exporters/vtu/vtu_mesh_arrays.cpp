@@ -52,6 +52,9 @@ const std::vector<Field>& fields() {
       {"radial_cap_center", 3, false,
        [](const PolyMesh& m, size_t c, int d) { return at(m.cell_radial[c].cap_center, d); },
        [](PolyMesh& m, size_t c, int d, double v) { put(m.cell_radial[c].cap_center, d, v); }},
+      // The mesh's permeability frame (one value per mesh, repeated per cell; docs/anisotropy.md).
+      {"metric_scale", 3, false, [](const PolyMesh& m, size_t, int d) { return at(m.metric_scale, d); },
+       [](PolyMesh& m, size_t, int d, double v) { put(m.metric_scale, d, v); }},
   };
   return f;
 }

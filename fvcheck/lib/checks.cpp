@@ -482,7 +482,13 @@ CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, cons
   CheckResult r;
   r.name = "orthogonality";
   r.id_kind = IdKind::Face;
-  r.values = face_orthogonality(m, geo);
+  const bool k_metric = !(m.metric_scale == Vec3{1, 1, 1});
+  if (k_metric) {
+    r.values = face_k_nonorthogonality(m, geo);
+    for (double& v : r.values) v = 90.0 - v;
+  } else {
+    r.values = face_orthogonality(m, geo);
+  }
   std::vector<int32_t> bad_cells;
   std::vector<char> cell_bad(m.n_cells(), 0);
   for (int f = 0; f < m.n_faces(); ++f)
@@ -493,7 +499,7 @@ CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, cons
     }
   rank_worst(r, false, 90.0);
   r.counts = {{"cells_with_violations", std::count(cell_bad.begin(), cell_bad.end(), 1)}};
-  r.measures = {{"min_deg", r.worst}, {"threshold_deg", opt.min_orthogonality_deg}};
+  r.measures = {{"min_deg", r.worst}, {"threshold_deg", opt.min_orthogonality_deg}, {"k_metric", k_metric ? 1.0 : 0.0}};
   return r;
 }
 

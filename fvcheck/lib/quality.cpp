@@ -33,20 +33,22 @@ std::string region_name(int32_t region) {
 
 std::vector<RegionQuality> quality_by_region(const PolyMesh& m, const std::vector<double>& q_s,
                                              const std::vector<double>& q_o_cell,
-                                             const std::vector<double>& q_p_cell) {
+                                             const std::vector<double>& q_p_cell,
+                                             const std::vector<double>& k_angle_cell,
+                                             const std::vector<double>& k_angle_interior_cell) {
   // One pass with running sums: region codes read from a file may be arbitrary, so no
   // per-region masks of n_cells entries.
   struct Acc {
     int64_t cells = 0;
-    Stats s[3];
-    double sum[3] = {0, 0, 0};
+    Stats s[5];
+    double sum[5] = {0, 0, 0, 0, 0};
   };
   std::map<int32_t, Acc> acc;
-  const std::vector<double>* q[3] = {&q_s, &q_o_cell, &q_p_cell};
+  const std::vector<double>* q[5] = {&q_s, &q_o_cell, &q_p_cell, &k_angle_cell, &k_angle_interior_cell};
   for (int c = 0; c < m.n_cells(); ++c) {
     Acc& a = acc[m.cell_region[c]];
     ++a.cells;
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 5; ++k) {
       if (static_cast<size_t>(c) >= q[k]->size()) continue;
       const double v = (*q[k])[c];
       if (std::isnan(v)) continue;
@@ -59,7 +61,7 @@ std::vector<RegionQuality> quality_by_region(const PolyMesh& m, const std::vecto
   }
   std::vector<RegionQuality> out;
   for (auto& [r, a] : acc) {
-    for (int k = 0; k < 3; ++k)
+    for (int k = 0; k < 5; ++k)
       if (a.s[k].count > 0) a.s[k].mean = a.sum[k] / static_cast<double>(a.s[k].count);
     RegionQuality rq;
     rq.region = r;
@@ -68,6 +70,8 @@ std::vector<RegionQuality> quality_by_region(const PolyMesh& m, const std::vecto
     rq.q_s = a.s[0];
     rq.q_o = a.s[1];
     rq.q_p = a.s[2];
+    rq.k_angle = a.s[3];
+    rq.k_angle_interior = a.s[4];
     out.push_back(rq);
   }
   return out;

@@ -39,7 +39,15 @@ struct FvReport {
   CsrReport structure;                       ///< CSR invariants; when not ok the checks are skipped
   std::vector<CheckResult> checks;           ///< fixed order: convexity, conformity, closure, volume,
                                              ///< orthogonality, auto_centering, planarity
-  std::vector<double> q_s, q_o_cell, q_p_cell;  ///< per cell (empty if skipped)
+  std::vector<double> q_s, q_o_cell, q_p_cell;  ///< per cell (empty if skipped); Q_O Euclidean
+  /// Per cell: max over its faces of the K-non-orthogonality (deg, face_k_nonorthogonality);
+  /// empty when a cell has no positive finite permeability.
+  std::vector<double> k_angle_cell;
+  std::vector<double> k_angle_interior_cell;  ///< the same over interior faces only
+  Stats k_angle_all, k_angle_interior_all;
+  /// The mesh was built in a permeability frame (metric_scale != 1): the orthogonality check
+  /// measures Q_O in the K metric (90 - K-non-orthogonality); q_o_* stay Euclidean.
+  bool k_metric = false;
   std::vector<int32_t> cell_region;          ///< copy of the mesh's regions (histograms per region)
   Stats q_s_all, q_o_all, q_p_all;           ///< over all cells
   std::vector<RegionQuality> by_region;

@@ -163,10 +163,15 @@ std::string report_html(const FvReport& r) {
       Stats RegionQuality::*member;
       const char* unit;
     };
-    const Row rows[3] = {{"Q_S", "%.2f", r.q_s_all, &RegionQuality::q_s, ""},
+    const Row rows[5] = {{"Q_S", "%.2f", r.q_s_all, &RegionQuality::q_s, ""},
                          {"Q_O", "%.2f", r.q_o_all, &RegionQuality::q_o, "&deg;"},
-                         {"Q_P", "%.2f", r.q_p_all, &RegionQuality::q_p, "&deg;"}};
+                         {"Q_P", "%.2f", r.q_p_all, &RegionQuality::q_p, "&deg;"},
+                         {"K-non-orth.", "%.3g", r.k_angle_all, &RegionQuality::k_angle, "&deg;"},
+                         {"K-non-orth. (interior faces)", "%.3g", r.k_angle_interior_all, &RegionQuality::k_angle_interior, "&deg;"}};
     for (const Row& row : rows) {
+      if ((row.member == &RegionQuality::k_angle || row.member == &RegionQuality::k_angle_interior) &&
+          r.k_angle_cell.empty())
+        continue;
       const char* what[3] = {"min.", "max.", "average"};
       for (int k = 0; k < 3; ++k) {
         auto pick = [&](const Stats& s) { return k == 0 ? s.min : (k == 1 ? s.max : s.mean); };
@@ -177,7 +182,10 @@ std::string report_html(const FvReport& r) {
       }
     }
     h << "</table><p class='small'>Cell values: Q_S(V) eq. 7, Q_O(V) = min over faces (eq. 9), "
-         "Q_P(V) = max over faces (eq. 11).</p>\n";
+         "Q_P(V) = max over faces (eq. 11); Q_O is Euclidean; K-non-orth.: max over faces of the angle between "
+         "K n and the centre-to-centre line (docs/fvcheck.md)"
+      << (r.k_metric ? "; this mesh was built in a permeability frame, its orthogonality check is in the K metric" : "")
+      << ".</p>\n";
 
     // Histograms per region (paper Figure 19 style), at most 6 regions.
     h << "<h2>Histograms</h2>";

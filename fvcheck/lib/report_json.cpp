@@ -51,13 +51,23 @@ json report_json(const FvReport& r) {
   q["Q_S"] = stats_json(r.q_s_all);
   q["Q_O"] = stats_json(r.q_o_all);
   q["Q_P"] = stats_json(r.q_p_all);
+  q["metric"] = r.k_metric ? "permeability" : "euclidean";
+  if (!r.k_angle_cell.empty()) {
+    q["K_nonorthogonality_deg"] = stats_json(r.k_angle_all);
+    q["K_nonorthogonality_interior_deg"] = stats_json(r.k_angle_interior_all);
+  }
   q["by_region"] = json::object();
-  for (const RegionQuality& rq : r.by_region)
+  for (const RegionQuality& rq : r.by_region) {
     q["by_region"][rq.name] = {{"region", rq.region},
                                {"cells", rq.cells},
                                {"Q_S", stats_json(rq.q_s)},
                                {"Q_O", stats_json(rq.q_o)},
                                {"Q_P", stats_json(rq.q_p)}};
+    if (!r.k_angle_cell.empty()) {
+      q["by_region"][rq.name]["K_nonorthogonality_deg"] = stats_json(rq.k_angle);
+      q["by_region"][rq.name]["K_nonorthogonality_interior_deg"] = stats_json(rq.k_angle_interior);
+    }
+  }
   j["quality"] = q;
   if (r.transmissibility.present)
     j["transmissibility"] = {{"count", r.transmissibility.count},

@@ -209,8 +209,29 @@ double transverse_permeability(Vec3 k, Vec3 a) {
   return std::sqrt(k.y * k.z * a.x * a.x + k.x * k.z * a.y * a.y + k.x * k.y * a.z * a.z);
 }
 
+PolyMesh in_metric_frame(const PolyMesh& m) {
+  PolyMesh out = m;
+  const Vec3 s = m.metric_scale;
+  const double det = s.x * s.y * s.z;
+  auto down = [&](Vec3 x) { return Vec3{x.x / s.x, x.y / s.y, x.z / s.z}; };
+  for (Vec3& p : out.nodes) p = down(p);
+  for (Vec3& p : out.cell_fv_center) p = down(p);
+  for (RadialCellInfo& r : out.cell_radial)
+    if (r.band >= 0) r.cap_center = down(r.cap_center);
+  // K' = det(S) S^-1 K S^-1: the flux through every face is the same in both frames.
+  for (Vec3& k : out.cell_perm) k = {det * k.x / (s.x * s.x), det * k.y / (s.y * s.y), det * k.z / (s.z * s.z)};
+  out.metric_scale = {1, 1, 1};
+  return out;
+}
+
 Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeometry& g,
                                               const TransmissibilityOptions& opt) {
+  // A mesh built in a permeability frame (docs/anisotropy.md): every formula below is applied
+  // in that frame, where the mesh is orthogonal and its radial data are given.
+  if (!(m.metric_scale == Vec3{1, 1, 1})) {
+    const PolyMesh scaled = in_metric_frame(m);
+    return compute_transmissibilities(scaled, compute_geometry(scaled), opt);
+  }
   const int nf = m.n_faces(), nc = m.n_cells();
   std::vector<RadialSides> radial(nc);
   if (opt.exact_radial)

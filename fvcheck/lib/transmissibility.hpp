@@ -40,7 +40,13 @@ struct Transmissibilities {
 
 constexpr int kMaxListedNegative = 20;
 
-/// Half-transmissibilities, face transmissibilities and wellbore connection factors of every face.
+/// The mesh in its permeability frame x' = S^-1 x (S = diag(mesh.metric_scale)), with
+/// K' = det(S) S^-1 K S^-1 per cell and metric_scale (1, 1, 1): the fluxes of both are the same
+/// (docs/anisotropy.md). A copy of the mesh when it is Euclidean.
+PolyMesh in_metric_frame(const PolyMesh& mesh);
+
+/// Half-transmissibilities, face transmissibilities and wellbore connection factors of every face,
+/// computed in the mesh's permeability frame (in_metric_frame; `geo` is then not used).
 Transmissibilities compute_transmissibilities(const PolyMesh& mesh, const MeshGeometry& geo,
                                               const TransmissibilityOptions& options = {});
 

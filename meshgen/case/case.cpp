@@ -539,12 +539,18 @@ void check_wells(const CaseSpec& cs) {
 
 CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   if (!root.IsMap()) fail("case file", "expected a map with keys name, reservoir, ..., got " + describe(root));
-  const Fields f(root, "", {"name", "reservoir", "wells", "transition", "fluid"});
+  const Fields f(root, "", {"name", "metric", "reservoir", "wells", "transition", "fluid"});
   CaseSpec cs;
   cs.name = read_string(f.required("name"), "name");
   require(matches_name_charset(cs.name), "name", "must match [A-Za-z0-9_-]+");
   require(cs.name.size() <= kMaxCaseNameLength, "name",
           "at most " + std::to_string(kMaxCaseNameLength) + " characters");
+  if (auto m = f.get("metric")) {
+    const std::string s = m->IsScalar() ? m->Scalar() : std::string();
+    if (m->IsScalar() && s == "permeability") cs.metric = MeshMetric::Permeability;
+    else if (m->IsScalar() && s == "euclidean") cs.metric = MeshMetric::Euclidean;
+    else fail("metric", "expected permeability or euclidean, got " + describe(*m));
+  }
   cs.reservoir = read_reservoir(f.required("reservoir"), base_dir);
   if (auto t = f.get("transition")) cs.transition = read_transition(*t);
   if (auto fl = f.get("fluid")) cs.fluid = read_fluid(*fl);

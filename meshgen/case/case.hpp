@@ -109,8 +109,15 @@ struct FluidSpec {
   double compressibility = 1e-8;   ///< 1/bar, >= 0
 };
 
+/// The metric the near-well cells are built orthogonal in (docs/case-format.md, docs/anisotropy.md).
+enum class MeshMetric {
+  Permeability,  ///< K-orthogonal: meshed in coordinates scaled by K^-1/2 (diagonal K)
+  Euclidean,     ///< orthogonal in the Euclidean sense (the mesh before issue 15)
+};
+
 struct CaseSpec {
   std::string name;                ///< [A-Za-z0-9_-]+
+  MeshMetric metric = MeshMetric::Euclidean;  ///< top-level `metric`
   ReservoirSpec reservoir;
   std::vector<WellSpec> wells;     ///< may be empty (then there is no cavity)
   TransitionSpec transition;

@@ -114,6 +114,31 @@ std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& ge
   return q;
 }
 
+std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometry& geo) {
+  std::vector<double> q(m.n_faces(), 0.0);
+  // In the cell's K^-1/2-scaled coordinates (K isotropic there): n_s = K^1/2 n, d_s = K^-1/2 d,
+  // n_s . d_s = n . d; atan2 stays accurate near 0.
+  auto angle = [&](int c, Vec3 area, Vec3 d) {
+    const Vec3 k = m.cell_perm[c];
+    const Vec3 r{std::sqrt(k.x), std::sqrt(k.y), std::sqrt(k.z)};
+    const Vec3 ns{r.x * area.x, r.y * area.y, r.z * area.z}, ds{d.x / r.x, d.y / r.y, d.z / r.z};
+    return std::atan2(norm(cross(ds, ns)), std::fabs(dot(ds, ns))) * kDeg;
+  };
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const Vec3 a = geo.face_area[f];
+    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+    const Vec3 p1 = m.cell_fv_center[o];
+    const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : geo.face_centroid[f]) - p1;
+    if (!(norm(a) > 0) || !(norm(d) > 0)) {
+      q[f] = 90.0;  // degenerate
+      continue;
+    }
+    q[f] = angle(o, a, d);
+    if (n >= 0) q[f] = std::max(q[f], angle(n, a, d));
+  }
+  return q;
+}
+
 std::vector<double> face_planarity(const PolyMesh& m, const MeshGeometry& geo) {
   std::vector<double> q(m.n_faces(), 0.0);
   for (int f = 0; f < m.n_faces(); ++f) {

@@ -16,6 +16,15 @@ namespace hm {
 /// and n the unit face normal. 0 for a degenerate face or coincident points.
 std::vector<double> face_orthogonality(const PolyMesh& mesh, const MeshGeometry& geo);
 
+/// K-non-orthogonality in degrees for every face (docs/anisotropy.md): the angle between K n and
+/// the line d between the FV centres of owner and neighbour (boundary face: owner's FV centre ->
+/// face centroid), measured in the metric of K^-1, i.e. the angle between n and d in coordinates
+/// scaled by K^-1/2 where the cell's K is isotropic (invariant under that scaling, so it equals
+/// the Euclidean non-orthogonality of the mesh in a permeability frame); K the cell's diagonal
+/// permeability, the larger of the owner's and the neighbour's angle. 0 iff K n || d; 90 for a
+/// degenerate face. With isotropic K it is 90 - Q_O(F).
+std::vector<double> face_k_nonorthogonality(const PolyMesh& mesh, const MeshGeometry& geo);
+
 /// Q_P(F) in degrees for every face (eq. 10): the largest angle between the face normal and
 /// the normals of the fan triangles (G, A_i, A_{i+1}), G the mean of the face's nodes.
 /// Fan triangles of area <= 1e-12 * face area have no normal and are skipped; a face of zero

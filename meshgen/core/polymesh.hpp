@@ -68,6 +68,12 @@ struct PolyMesh {
   std::vector<double> cell_porosity;      ///< n_cells, porosity in [0, 1]
   std::vector<RadialCellInfo> cell_radial;  ///< n_cells, radial structure of well cells
 
+  // ---- frame
+  /// Diagonal of the permeability frame S the mesh was built in (case `metric: permeability`,
+  /// docs/anisotropy.md), product 1; (1, 1, 1) for a Euclidean mesh. cell_radial's radii and
+  /// lengths are those of the scaled frame x' = S^-1 x, where the transmissibilities are computed.
+  Vec3 metric_scale{1, 1, 1};
+
   int n_nodes() const { return static_cast<int>(nodes.size()); }
   int n_faces() const { return static_cast<int>(face_owner.size()); }
   int n_cells() const { return static_cast<int>(cell_region.size()); }

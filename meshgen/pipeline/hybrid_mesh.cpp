@@ -163,7 +163,7 @@ std::string caps_hint(const CaseSpec& cs, const std::vector<int>& wells) {
 // cavity's transition is built again, with those cells deactivated (a local dilation), at most
 // kMaxEnlargements times; then its auto-capped wells get flat ends and only its transition is
 // built again. The other cavities keep their transitions.
-HybridMesh build_hybrid_mesh(const CaseSpec& input, const PipelineOptions& opts) {
+HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOptions& opts) {
   HybridMesh out;
   StageTimer timer(&out.timings_s);
   CaseSpec cs = input;  // end caps as meshed

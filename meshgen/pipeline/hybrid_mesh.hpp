@@ -13,6 +13,7 @@
 #include "meshgen/grids/reservoir_grid.hpp"
 #include "fvcheck/lib/quality.hpp"
 #include "meshgen/grids/well_block.hpp"
+#include "meshgen/pipeline/permeability_frame.hpp"
 #include "meshgen/pipeline/self_check.hpp"
 #include "meshgen/transition/transition.hpp"
 
@@ -57,6 +58,9 @@ struct HybridMesh {
   SelfCheck self_check;              ///< the checks of the finished mesh (ok, or the job threw)
   std::vector<std::string> notes;    ///< every automatic change made to the input (sectors, dilation, ...)
   std::vector<std::pair<std::string, double>> timings_s;  ///< stage name -> seconds, in stage order
+  /// The permeability frame the mesh was built in (identity: Euclidean). Every position above is
+  /// physical; the quality figures, the self-check and the radial data are the scaled frame's.
+  PermeabilityFrame frame;
 };
 
 /// A failure the input did not cause (exit 1): the stage ("cavity", "transition", "assembly",
@@ -73,6 +77,10 @@ class MeshingError : public std::runtime_error {
 /// Runs the job in the case's own frame (meshgen moves the case to a local frame first,
 /// local_frame.hpp). Throws InputError for bad input, MeshingError for a meshing failure,
 /// including a mesh that fails the self-check (self_check.hpp) that ends the job.
+/// With `metric: permeability` and anisotropic rock the job meshes scaled_case(cs, frame) and
+/// maps the mesh back (permeability_frame.hpp, docs/anisotropy.md).
 HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts = {});
+/// The job in the case's own coordinates, orthogonal in the Euclidean sense.
+HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& cs, const PipelineOptions& opts = {});
 
 }  // namespace hm

@@ -56,6 +56,9 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
                      {"end_caps", b.hemisphere_caps ? "hemisphere" : "flat"}});
   j["wells"] = wells;
   j["notes"] = h.notes;
+  j["metric"] = {{"frame", h.frame.identity() ? "euclidean" : "permeability"},
+                 {"scale", {h.frame.scale.x, h.frame.scale.y, h.frame.scale.z}},
+                 {"permeability", {h.frame.k.x, h.frame.k.y, h.frame.k.z}}};
   if (!h.transition_reports.empty()) {
     nlohmann::json t;
     t["before"] = to_json(h.transition_before);

@@ -65,9 +65,10 @@ py::object json_to_python(const nlohmann::json& j) {
       j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
-/// The case with each well's end caps as meshed (auto may have fallen back to flat ends).
+/// The case with each well's end caps as meshed (auto may have fallen back to flat ends), in the
+/// mesh's permeability frame (docs/anisotropy.md; volumes are the physical ones).
 hm::CaseSpec case_as_meshed(const Mesh& m) {
-  hm::CaseSpec cs = m.cs;
+  hm::CaseSpec cs = hm::scaled_case(m.cs, m.result.frame);
   for (const hm::WellBlock& b : m.result.blocks)
     cs.wells.at(b.well).end_caps = b.hemisphere_caps ? hm::EndCaps::Hemisphere : hm::EndCaps::Flat;
   return cs;

@@ -305,7 +305,7 @@ TEST(CaseErrors, UnknownKeyInTransition) {
 
 TEST(CaseErrors, UnknownKeyAtEveryLevel) {
   EXPECT_EQ(error_of(kBase + "wellz: []\n"),
-            "wellz: unknown key (expected one of: name, reservoir, wells, transition, fluid)");
+            "wellz: unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
   EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  poro: 0.2\n")),
             "reservoir.poro: unknown key (expected one of: x, y, z, grdecl, permeability, porosity, initial_pressure)");
   EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "    bhp: 250\n    skin: 0\n")),
@@ -315,10 +315,21 @@ TEST(CaseErrors, UnknownKeyAtEveryLevel) {
             "fluid.mu: unknown key (expected one of: viscosity, density, compressibility)");
 }
 
+TEST(CaseValid, MetricKey) {
+  EXPECT_EQ(parse_case(kBase).metric, MeshMetric::Euclidean);
+  EXPECT_EQ(parse_case("metric: permeability\n" + kBase).metric, MeshMetric::Permeability);
+  EXPECT_EQ(parse_case("metric: euclidean\n" + kBase).metric, MeshMetric::Euclidean);
+}
+
+TEST(CaseErrors, MetricKey) {
+  EXPECT_EQ(error_of("metric: riemann\n" + kBase), "metric: expected permeability or euclidean, got 'riemann'");
+  EXPECT_EQ(error_of("metric: [permeability]\n" + kBase), "metric: expected permeability or euclidean, got a list");
+}
+
 // Found by fuzz_case: an empty key name must still give "key.path: reason".
 TEST(CaseErrors, EmptyKeyIsNamed) {
   EXPECT_EQ(error_of(kBase + "\"\": 1\n"),
-            "\"\": unknown key (expected one of: name, reservoir, wells, transition, fluid)");
+            "\"\": unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
   EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  \"\": 0.2\n")).rfind("reservoir.\"\": unknown key", 0), 0u);
 }
 
@@ -721,7 +732,7 @@ TEST(CaseRobustness, MalformedDocumentsGiveOneLineInputErrors) {
 
 TEST(CaseRobustness, UserTextIsEchoedOnOneLine) {
   EXPECT_EQ(error_of("\"na\\nme\": a\n"),
-            "na\\nme: unknown key (expected one of: name, reservoir, wells, transition, fluid)");
+            "na\\nme: unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
   EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: \"a\\tb\\x01\"")),
             "reservoir.porosity: expected a number, got 'a\\tb\\x01'");
   EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: " + std::string(100, 'q'))),

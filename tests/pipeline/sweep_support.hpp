@@ -38,11 +38,13 @@ struct CaseResult {
   std::vector<std::string> notes;  ///< the mesher's notes (in-process runs only)
 };
 
-/// Total volume of the box minus the exact wellbore holes (end caps as requested).
+/// Total volume of the box minus the exact wellbore holes (end caps as requested) of the case as
+/// meshed (its permeability frame's, whose volumes are the physical ones: det S = 1).
 inline double box_minus_holes(const CaseSpec& cs, const HybridMesh& h) {
   const ReservoirSpec& r = cs.reservoir;
   double v = (r.x.back() - r.x.front()) * (r.y.back() - r.y.front()) * (r.z.back() - r.z.front());
-  for (const WellBlock& b : h.blocks) v -= exact_wellbore_hole_volume(cs, b.well, b.sectors);
+  const CaseSpec meshed = scaled_case(cs, h.frame);
+  for (const WellBlock& b : h.blocks) v -= exact_wellbore_hole_volume(meshed, b.well, b.sectors);
   return v;
 }
 

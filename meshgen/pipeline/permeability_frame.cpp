@@ -1,0 +1,140 @@
+#include "permeability_frame.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace hm {
+
+Vec3 frame_scale(Vec3 k) {
+  if (k.x == k.y && k.y == k.z) return {1, 1, 1};
+  const double k0 = std::cbrt(k.x * k.y * k.z);
+  return {std::sqrt(k.x / k0), std::sqrt(k.y / k0), std::sqrt(k.z / k0)};
+}
+
+PermeabilityFrame permeability_frame(const CaseSpec& cs) {
+  PermeabilityFrame f;
+  const ReservoirSpec& r = cs.reservoir;
+  f.origin = {r.x.front(), r.y.front(), r.z.front()};
+  f.k = r.permeability;
+  if (cs.metric != MeshMetric::Permeability) return f;
+  if (!r.cell_permx.empty()) {
+    // Geometric mean over the cells the trajectories pass through (each sample once per cell).
+    std::vector<int> cells;
+    for (const WellSpec& w : cs.wells)
+      for (size_t i = 0; i + 1 < w.trajectory.size(); ++i) {
+        const Vec3 a = w.trajectory[i], b = w.trajectory[i + 1];
+        const int n = std::max(1, static_cast<int>(std::ceil(4 * norm(b - a) / w.segment_length)));
+        for (int s = 0; s <= n; ++s) cells.push_back(reservoir_cell_at(r, a + (static_cast<double>(s) / n) * (b - a)));
+      }
+    if (cells.empty())
+      for (size_t c = 0; c < r.cell_permx.size(); ++c) cells.push_back(static_cast<int>(c));
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    Vec3 log_sum;
+    for (int c : cells) {
+      const Vec3 k = reservoir_permeability(r, c);
+      log_sum += Vec3{std::log(k.x), std::log(k.y), std::log(k.z)};
+    }
+    const double n = static_cast<double>(cells.size());
+    f.k = {std::exp(log_sum.x / n), std::exp(log_sum.y / n), std::exp(log_sum.z / n)};
+  }
+  f.scale = frame_scale(f.k);
+  return f;
+}
+
+Vec3 to_scaled(const PermeabilityFrame& f, Vec3 x) {
+  return {f.origin.x + (x.x - f.origin.x) / f.scale.x, f.origin.y + (x.y - f.origin.y) / f.scale.y,
+          f.origin.z + (x.z - f.origin.z) / f.scale.z};
+}
+
+Vec3 to_physical(const PermeabilityFrame& f, Vec3 x) {
+  return {f.origin.x + (x.x - f.origin.x) * f.scale.x, f.origin.y + (x.y - f.origin.y) * f.scale.y,
+          f.origin.z + (x.z - f.origin.z) * f.scale.z};
+}
+
+namespace {
+
+Vec3 divided(Vec3 v, Vec3 s) { return {v.x / s.x, v.y / s.y, v.z / s.z}; }
+
+// Two unit vectors completing the unit axis t to an orthonormal basis.
+void complete_basis(Vec3 t, Vec3* u, Vec3* w) {
+  const Vec3 helper = std::fabs(t.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  *u = normalized(cross(t, helper));
+  *w = cross(t, *u);
+}
+
+}  // namespace
+
+double equivalent_radius(Vec3 scale, Vec3 t, double r) {
+  Vec3 u, w;
+  complete_basis(t, &u, &w);
+  const Vec3 ts = normalized(divided(t, scale));
+  auto project = [&](Vec3 v) { return v - dot(v, ts) * ts; };
+  // Semi-axes of the scaled cross-section: the singular values of [P S^-1 u, P S^-1 w].
+  const Vec3 a = project(divided(u, scale)), b = project(divided(w, scale));
+  const double g11 = dot(a, a), g22 = dot(b, b), g12 = dot(a, b);
+  const double sum = std::sqrt(g11 + g22 + 2 * std::sqrt(std::max(0.0, g11 * g22 - g12 * g12)));
+  return 0.5 * r * sum;
+}
+
+double scaled_block_radius(Vec3 scale, double R) { return R / std::max({scale.x, scale.y, scale.z}); }
+
+CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
+  CaseSpec out = cs;
+  if (f.identity()) return out;
+  ReservoirSpec& r = out.reservoir;
+  for (double& v : r.x) v = f.origin.x + (v - f.origin.x) / f.scale.x;
+  for (double& v : r.y) v = f.origin.y + (v - f.origin.y) / f.scale.y;
+  for (double& v : r.z) v = f.origin.z + (v - f.origin.z) / f.scale.z;
+  for (size_t i = 0; i < out.wells.size(); ++i) {
+    WellSpec& w = out.wells[i];
+    double length = 0, scaled_length = 0, radius_sum = 0;
+    for (size_t j = 0; j + 1 < w.trajectory.size(); ++j) {
+      const Vec3 d = w.trajectory[j + 1] - w.trajectory[j];
+      const double l = norm(d);
+      length += l;
+      scaled_length += norm(divided(d, f.scale));
+      radius_sum += l * equivalent_radius(f.scale, d / l, w.radius);
+    }
+    // Measured depths stay the physical ones (perforations are given in them).
+    if (w.trajectory_md.empty()) w.trajectory_md = well_measured_depths(w);
+    for (Vec3& p : w.trajectory) p = to_scaled(f, p);
+    w.radius = radius_sum / length;
+    w.drainage_radius = scaled_block_radius(f.scale, w.drainage_radius);
+    w.segment_length *= scaled_length / length;
+    if (!(w.radius < w.drainage_radius))
+      throw InputError("wells[" + std::to_string(i) + "].drainage_radius: too small for this anisotropy (metric: " +
+                       "permeability): the scaled wellbore radius " + std::to_string(w.radius) +
+                       " m is not below the scaled block radius " + std::to_string(w.drainage_radius) +
+                       " m (docs/anisotropy.md)");
+  }
+  return out;
+}
+
+FrameUnmapper::FrameUnmapper(const PermeabilityFrame& f, const ReservoirSpec& phys) : frame(f), physical(&phys) {
+  const std::vector<double>* axes[3] = {&phys.x, &phys.y, &phys.z};
+  for (int d = 0; d < 3; ++d)
+    for (double v : *axes[d]) scaled_axis[d].push_back(frame.origin[d] + (v - frame.origin[d]) / frame.scale[d]);
+}
+
+Vec3 FrameUnmapper::operator()(Vec3 xs) const {
+  Vec3 x = to_physical(frame, xs);
+  const std::vector<double>* axes[3] = {&physical->x, &physical->y, &physical->z};
+  for (int d = 0; d < 3; ++d) {
+    const std::vector<double>& a = scaled_axis[d];
+    const auto it = std::lower_bound(a.begin(), a.end(), xs[d]);
+    if (it != a.end() && *it == xs[d]) x[d] = (*axes[d])[it - a.begin()];
+  }
+  return x;
+}
+
+void unscale_mesh(PolyMesh& m, const FrameUnmapper& unmap) {
+  for (Vec3& p : m.nodes) p = unmap(p);
+  for (Vec3& p : m.cell_fv_center) p = unmap(p);
+  for (RadialCellInfo& r : m.cell_radial)
+    if (r.band >= 0) r.cap_center = unmap(r.cap_center);
+  m.metric_scale = unmap.frame.scale;
+}
+
+}  // namespace hm

@@ -1,0 +1,68 @@
+// The permeability frame (case `metric: permeability`, docs/anisotropy.md). For a diagonal
+// K = diag(kx, ky, kz) the job meshes in scaled coordinates x' = o + S^-1 (x - o), with
+// S = diag(sqrt(kx/k0), sqrt(ky/k0), sqrt(kz/k0)), k0 = cbrt(kx ky kz) (det S = 1: volumes are
+// preserved; K is isotropic, k0, in the scaled frame). A power diagram orthogonal there is
+// K-orthogonal once mapped back (x = o + S (x' - o), affine: planar faces stay planar, convex
+// cells convex). build_hybrid_mesh applies it, so meshgen, solver_demo, Python and the tests
+// all get the same mesh.
+#pragma once
+#include "meshgen/case/case.hpp"
+#include "meshgen/core/polymesh.hpp"
+
+namespace hm {
+
+struct PermeabilityFrame {
+  Vec3 scale{1, 1, 1};  ///< diagonal of S; product 1
+  Vec3 origin;          ///< fixed point of the map: the reservoir's min corner
+  Vec3 k{0, 0, 0};      ///< the K the frame is built for (geometric means, mD)
+  bool identity() const { return scale == Vec3{1, 1, 1}; }
+};
+
+/// diag(S) for a diagonal K: (sqrt(kx/k0), sqrt(ky/k0), sqrt(kz/k0)), k0 = cbrt(kx ky kz);
+/// exactly (1, 1, 1) when kx == ky == kz.
+Vec3 frame_scale(Vec3 k);
+
+/// The case's frame: identity for `metric: euclidean` or isotropic rock; else one frame per case
+/// from the geometric mean of kx, ky, kz over the reservoir cells the wells' trajectories pass
+/// through (sampled every segment_length / 4), the whole grid when there are no wells.
+PermeabilityFrame permeability_frame(const CaseSpec& cs);
+
+Vec3 to_scaled(const PermeabilityFrame& f, Vec3 x);
+Vec3 to_physical(const PermeabilityFrame& f, Vec3 x_scaled);
+
+/// Equivalent radius (a + b) / 2 of the scaled cross-section (normal to the scaled axis) of a
+/// circular cylinder of radius r about the physical unit axis; for a vertical axis and
+/// kz = sqrt(kx ky) this is Peaceman's anisotropic r_w' = r/2 [(ky/kx)^1/4 + (kx/ky)^1/4].
+double equivalent_radius(Vec3 scale, Vec3 unit_axis, double r);
+
+/// Radius in the scaled frame of a block whose physical image lies within distance R of its
+/// physical axis in every direction: R / max(scale) (the physical block is an elliptic
+/// cylinder inside the user's cylinder of radius R, so the case's checks against the box and
+/// the other wells still hold).
+double scaled_block_radius(Vec3 scale, double R);
+
+/// The case as meshed in frame f: reservoir axes and trajectories scaled; per well, radius =
+/// length-weighted mean over the legs of equivalent_radius, drainage_radius =
+/// scaled_block_radius, segment_length times the scaled/physical trajectory length ratio,
+/// trajectory_md the physical measured depths (perforations keep their meaning). The
+/// rock (per cell or uniform) stays physical. Throws InputError when the scaled radius is not
+/// below the scaled drainage radius.
+CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f);
+
+/// Maps a position of the scaled frame back; a coordinate equal to a scaled reservoir node
+/// coordinate gets the user's coordinate of that node exactly (the reservoir's planes stay the
+/// user's planes, not x' * s off by ulps).
+struct FrameUnmapper {
+  FrameUnmapper(const PermeabilityFrame& f, const ReservoirSpec& physical);
+  Vec3 operator()(Vec3 x_scaled) const;
+  PermeabilityFrame frame;
+  const ReservoirSpec* physical;
+  std::vector<double> scaled_axis[3];
+};
+
+/// Moves a mesh built in frame f to physical coordinates (nodes, FV centres, cap centres) and
+/// records the frame in mesh.metric_scale. The radial data (radii, lengths) stay those of the
+/// scaled frame, where the transmissibilities are computed (docs/mesh-layout.md).
+void unscale_mesh(PolyMesh& mesh, const FrameUnmapper& unmap);
+
+}  // namespace hm
