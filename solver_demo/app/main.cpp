@@ -1,10 +1,11 @@
 // solver_demo CASE.yaml -o OUTDIR [--mesh MESH.vtu]
 //   Builds the hybrid mesh (or reads it from MESH.vtu, as meshgen wrote it: no re-meshing), solves the steady single-phase problem the exported deck poses (wells
 //   at their BHP, no-flow outer boundary, gravity) and writes solution.json and pressure.vtu.
-// solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N]
+// solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N] [--kv-kh R] [--kx-ky Q]
 //   The near-well accuracy study (docs/accuracy.md): accuracy.json and accuracy.svg.
 // Exit codes: 0 success, 1 failure (meshing, solver), 2 bad input or arguments.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
@@ -28,9 +29,12 @@ namespace {
 constexpr const char* kUsage =
     "usage: solver_demo CASE.yaml -o OUTDIR [--mesh MESH.vtu]\n"
     "         (--mesh: solve on the mesh file meshgen wrote for CASE.yaml instead of meshing again)\n"
-    "       solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N] [--source-to-tips]\n"
+    "       solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N] [--source-to-tips] [--kv-kh R] [--kx-ky Q]\n"
+    "                [--compare-metrics]\n"
     "         (N refinement levels, default 3; --source-to-tips: the line source runs to the well's end\n"
-    "          points, singular on the end caps, instead of stopping r_w short of them)\n";
+    "          points, singular on the end caps, instead of stopping r_w short of them; --kv-kh, --kx-ky:\n"
+    "          the case's permeability made anisotropic keeping kh = sqrt(kx ky), kz = R kh, kx / ky = Q;\n"
+    "          --compare-metrics: the hybrid mesh with metric: permeability and with metric: euclidean)\n";
 
 int usage(const std::string& why) {
   std::cerr << "solver_demo: " << why << "\n" << kUsage;
@@ -170,17 +174,36 @@ int run_accuracy(const hm::CaseSpec& cs, const fs::path& out, int levels, const 
     std::cout << "  x" << lv.factor << ": hybrid (" << lv.hybrid_cells << " cells) rate " << percent(lv.hybrid.rate_rel_error)
               << ", near-well " << percent(lv.hybrid.near_well_pressure_rel_error) << "; Cartesian + Peaceman ("
               << lv.cartesian_cells << " cells) rate " << percent(lv.peaceman.rate_rel_error) << ", near-well "
-              << percent(lv.peaceman.near_well_pressure_rel_error) << "\n";
+              << percent(lv.peaceman.near_well_pressure_rel_error)
+              << (lv.has_euclidean ? "; Euclidean hybrid (" + std::to_string(lv.hybrid_euclidean_cells) + " cells) rate " +
+                                         percent(lv.hybrid_euclidean.rate_rel_error) + ", near-well " +
+                                         percent(lv.hybrid_euclidean.near_well_pressure_rel_error)
+                                   : std::string())
+              << "\n";
   std::cout << "  wrote " << (out / "accuracy.json").string() << "\n  wrote " << (out / "accuracy.svg").string() << "\n";
   return 0;
+}
+
+// A positive finite number, or a usage message naming the flag.
+std::string parse_ratio(const std::string& flag, const char* text, double* out) {
+  try {
+    size_t used = 0;
+    *out = std::stod(text, &used);
+    if (used != std::string(text).size()) throw std::invalid_argument("trailing characters");
+  } catch (const std::exception&) {
+    return flag + ": not a number: '" + text + "'";
+  }
+  if (!(*out > 0) || !std::isfinite(*out)) return flag + ": must be a positive number";
+  return {};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string case_path, out_dir, mesh_file;
-  bool accuracy = false;
+  bool accuracy = false, anisotropy = false;
   int levels = 3;
+  double kv_kh = 1, kx_ky = 1;
   hm::AccuracyOptions acc_opt;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -192,6 +215,13 @@ int main(int argc, char** argv) {
       mesh_file = argv[i];
     } else if (a == "--accuracy") {
       accuracy = true;
+    } else if (a == "--kv-kh" || a == "--kx-ky") {
+      if (++i >= argc) return usage(a + " needs a number");
+      if (const std::string why = parse_ratio(a, argv[i], a == "--kv-kh" ? &kv_kh : &kx_ky); !why.empty())
+        return usage(why);
+      anisotropy = true;
+    } else if (a == "--compare-metrics") {
+      acc_opt.compare_metrics = true;
     } else if (a == "--source-to-tips") {
       acc_opt.source_to_tips = true;
     } else if (a == "--levels") {
@@ -212,6 +242,8 @@ int main(int argc, char** argv) {
     }
   }
   if (const std::string why = hm::check_case_and_output(case_path, out_dir); !why.empty()) return usage(why);
+  if ((anisotropy || acc_opt.compare_metrics) && !accuracy)
+    return usage("--kv-kh, --kx-ky and --compare-metrics go with --accuracy");
 
   hm::CaseSpec cs;
   try {
@@ -225,5 +257,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (accuracy && !mesh_file.empty()) return usage("--mesh and --accuracy exclude each other (the study meshes each level)");
+  if (anisotropy && !cs.reservoir.cell_permx.empty())
+    return usage("--kv-kh / --kx-ky: the case has per-cell permeability (reservoir.grdecl)");
+  if (anisotropy) cs = hm::anisotropic_case(cs, kv_kh, kx_ky);
   return accuracy ? run_accuracy(cs, out_dir, levels, acc_opt) : run_flow(cs, out_dir, mesh_file);
 }

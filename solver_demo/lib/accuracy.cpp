@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
+#include <string>
 
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/grids/well_block.hpp"
@@ -18,16 +20,19 @@ constexpr double kPi = 3.14159265358979323846;
 AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& opt) {
   if (cs.wells.size() != 1)
     throw InputError("wells: the accuracy study needs exactly one well (got " + std::to_string(cs.wells.size()) + ")");
+  if (!cs.reservoir.cell_permx.empty())
+    throw InputError("reservoir.grdecl: the accuracy study needs a uniform permeability (reservoir.permeability), "
+                     "not per-cell values");
   const Vec3 k = cs.reservoir.permeability;
-  if (!(k.x == k.y && k.y == k.z))
-    throw InputError("reservoir.permeability: the accuracy study needs isotropic permeability (kx = ky = kz)");
   const WellSpec& ws = cs.wells[0];
   if (ws.bhp == cs.reservoir.initial_pressure)
     throw InputError("wells[0].bhp: must differ from reservoir.initial_pressure (the study's drawdown)");
   AccuracySetup s;
   s.near_radius = 3 * ws.drainage_radius;
   s.viscosity = cs.fluid.viscosity;
-  s.permeability = k.x;
+  s.permeability_tensor = k;
+  const Vec3 scale = permeability_scale(k);
+  s.permeability = k.x == k.y && k.y == k.z ? k.x : std::cbrt(k.x * k.y * k.z);
   s.p_w = ws.bhp;
   s.drawdown = std::fabs(cs.reservoir.initial_pressure - ws.bhp);
   s.source_inset = opt.source_to_tips ? 0.0 : ws.radius;
@@ -35,10 +40,12 @@ AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& opt
   // exact solution's source follows that axis (the trajectory itself for straight wells).
   const std::vector<Vec3> axis = meshed_axis(make_well_block(cs, 0, ws.sectors));  // independent of sectors
   s.field = make_line_source_field(axis, ws.radius, ws.bhp, cs.reservoir.initial_pressure, s.near_radius,
-                                   s.source_inset);
+                                   s.source_inset, scale);
   s.reference = field_reference(axis);
+  s.equivalent_radius = scaled_wellbore_radius(scale, s.reference.direction, ws.radius);
+  // q' per unit of scaled source length; the rate is the same in both frames (det S = 1).
   const double q_per_length = 4 * kPi * kDarcyMetric * s.permeability * s.field.coefficient / s.viscosity;
-  s.exact_rate = q_per_length * s.field.source_length();
+  s.exact_rate = q_per_length * s.field.scaled_source_length();
   const double leg = norm(axis[s.reference.leg + 1] - axis[s.reference.leg]);
   s.slab_half_width = std::max(0.1 * leg, ws.segment_length);
   return s;
@@ -55,7 +62,13 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
   pb.gravity = false;  // the manufactured solution has no gravity term
   pb.connections = connections;
   pb.outer_dirichlet = [&](Vec3 x) { return field.pressure(x); };
-  pb.wellbore_pressure = [&](Vec3 x) { return field.wellbore_pressure(x); };
+  // Wellbore faces (hybrid): the exact p on the mesh's own wellbore surface, the Dirichlet data
+  // of the manufactured problem. Connections (Peaceman): the pressure of a real well of radius
+  // r_w as the line source sees it, p at the equivalent radius (docs/accuracy.md).
+  if (connections.empty())
+    pb.wellbore_pressure = [&](Vec3 x) { return field.wellbore_pressure(x); };
+  else
+    pb.wellbore_pressure = [&](Vec3 x) { return field.equivalent_wellbore_pressure(x); };
   const Transmissibilities tr = compute_transmissibilities(mesh, geo);
   const FlowSolution sol = solve_tpfa(pb, tr);
 
@@ -99,6 +112,7 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
     if (samples) {
       PressureSample s;
       s.distance = cp.distance;
+      s.scaled_distance = field.scaled_distance(x);
       s.pressure = sol.pressure[c];
       s.exact = exact;
       s.region = mesh.cell_region[c];
@@ -109,6 +123,26 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
   e.l2_pressure_rel_error = sum_v > 0 ? std::sqrt(sum_ve2 / sum_v) : 0.0;
   if (pressure_out) *pressure_out = sol.pressure;
   return e;
+}
+
+CaseSpec anisotropic_case(const CaseSpec& cs, double kv_kh, double kx_ky) {
+  if (!(kv_kh > 0) || !std::isfinite(kv_kh)) throw InputError("--kv-kh: must be a positive number");
+  if (!(kx_ky > 0) || !std::isfinite(kx_ky)) throw InputError("--kx-ky: must be a positive number");
+  CaseSpec out = cs;
+  if (kv_kh == 1 && kx_ky == 1) return out;
+  const Vec3 k = cs.reservoir.permeability;
+  const double kh = std::sqrt(k.x * k.y);
+  out.reservoir.permeability = {kh * std::sqrt(kx_ky), kh / std::sqrt(kx_ky), kv_kh * kh};
+  auto tag = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    std::string t = buf;
+    for (char& ch : t)
+      if (ch == '.') ch = 'p';
+    return t;
+  };
+  out.name = cs.name + "_kvkh" + tag(kv_kh) + "_kxky" + tag(kx_ky);
+  return out;
 }
 
 CaseSpec refine_case(const CaseSpec& cs, int factor) {
@@ -135,9 +169,14 @@ CaseSpec refine_case(const CaseSpec& cs, int factor) {
 AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyOptions& opt) {
   AccuracyStudy st;
   st.case_name = cs.name;
-  st.setup = make_accuracy_setup(cs, opt);
+  CaseSpec main_case = cs, euclidean_case = cs;
+  if (opt.compare_metrics) main_case.metric = MeshMetric::Permeability;
+  euclidean_case.metric = MeshMetric::Euclidean;
+  st.metric = main_case.metric;
+  st.setup = make_accuracy_setup(main_case, opt);
+  if (opt.compare_metrics) st.setup_euclidean = make_accuracy_setup(euclidean_case, opt);
   for (int f = 1; f <= std::max(1, levels); ++f) {
-    const CaseSpec level_case = refine_case(cs, f);
+    const CaseSpec level_case = refine_case(main_case, f);
     RefinementLevel lv;
     lv.factor = f;
     // Each level's exact solution follows that level's meshed axis (the bend wedges are
@@ -148,6 +187,14 @@ AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyO
       if (f == 1) st.notes = hm.notes;
       lv.hybrid_cells = hm.mesh.n_cells();
       lv.hybrid = measure_accuracy(hm.mesh, hm.geometry, {}, setup, nullptr, f == 1 ? &st.hybrid_samples : nullptr);
+    }
+    if (opt.compare_metrics) {
+      const CaseSpec e_case = refine_case(euclidean_case, f);
+      const AccuracySetup e_setup = f == 1 ? st.setup_euclidean : make_accuracy_setup(e_case, opt);
+      const HybridMesh hm = build_hybrid_mesh(e_case);
+      lv.has_euclidean = true;
+      lv.hybrid_euclidean_cells = hm.mesh.n_cells();
+      lv.hybrid_euclidean = measure_accuracy(hm.mesh, hm.geometry, {}, e_setup);
     }
     {
       const CartesianMesh cm = make_cartesian_mesh(level_case.reservoir);

@@ -19,24 +19,35 @@ struct AccuracyOptions {
   /// the wellbore, so the exact p is smooth on the whole flow domain. true: the source runs to the
   /// trajectory's end points, which lie on the end caps: p is singular (log) at the cap centres.
   bool source_to_tips = false;
+  /// Also build the hybrid mesh with the other metric: `hybrid` is then the K-orthogonal mesh
+  /// (metric: permeability) and `hybrid_euclidean` today's Euclidean-orthogonal one, whatever
+  /// the case's `metric` key (solver_demo --accuracy --compare-metrics).
+  bool compare_metrics = false;
 };
 
-/// Everything the error measures need, derived from a one-well case with isotropic k.
+/// Everything the error measures need, derived from a one-well case with a uniform diagonal k.
 struct AccuracySetup {
   LineSourceField field;
   FieldReference reference;   ///< longest leg's midpoint and perpendicular (where p_w and the drawdown are taken)
-  double p_w = 0;             ///< exact p on the wellbore circle at the reference point (= case bhp)
+  double p_w = 0;             ///< exact p on the (equivalent) wellbore at the reference point (= case bhp)
   double drawdown = 0;        ///< |p_exact(reference point at near_radius) - p_w| (= |initial_pressure - bhp|)
   double near_radius = 0;     ///< 3 x drainage radius: the near-well region
   double viscosity = 1;       ///< cP
-  double permeability = 0;    ///< mD (isotropic)
-  double exact_rate = 0;      ///< rm3/day, q' x trajectory length (> 0 produced)
+  double permeability = 0;    ///< mD: k0 = cbrt(kx ky kz), the isotropic k of the scaled frame
+  Vec3 permeability_tensor;   ///< mD: the case's (kx, ky, kz)
+  double equivalent_radius = 0;  ///< m, scaled frame: the wellbore's equivalent radius at the reference point (r_w if isotropic)
+  double exact_rate = 0;      ///< rm3/day, q' x scaled source length (> 0 produced)
   double slab_half_width = 0; ///< plot: cells projecting within this of the reference midpoint
   double source_inset = 0;    ///< m removed from each end of the trajectory to get the source
 };
 
-/// Throws InputError when the study does not apply: not exactly one well, anisotropic k.
+/// Throws InputError when the study does not apply: not exactly one well, per-cell permeability.
 AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& options = {});
+
+/// The case with its permeability made anisotropic, keeping kh = sqrt(kx ky): kx = kh sqrt(kx_ky),
+/// ky = kh / sqrt(kx_ky), kz = kv_kh kh (solver_demo --accuracy --kv-kh R --kx-ky Q). The name
+/// gets a suffix `_kvkh<R>_kxky<Q>` when either ratio is not 1. InputError unless both are > 0.
+CaseSpec anisotropic_case(const CaseSpec& cs, double kv_kh, double kx_ky);
 
 struct AccuracyErrors {
   double rate_rel_error = 0;                ///< (q - q_exact) / q_exact, signed
@@ -59,6 +70,7 @@ struct AccuracyErrors {
 /// One cell's pressure against the exact one (plots).
 struct PressureSample {
   double distance = 0;  ///< FV centre to the trajectory (m)
+  double scaled_distance = 0;  ///< the same in the scaled frame x / s (= distance when isotropic)
   double pressure = 0, exact = 0;
   int region = 0;
   bool in_slab = false;  ///< projects onto the reference leg within slab_half_width of its midpoint
@@ -81,11 +93,16 @@ struct RefinementLevel {
   int factor = 1;
   int hybrid_cells = 0, cartesian_cells = 0;
   AccuracyErrors hybrid, peaceman;
+  bool has_euclidean = false;  ///< compare_metrics: the Euclidean-orthogonal hybrid mesh too
+  int hybrid_euclidean_cells = 0;
+  AccuracyErrors hybrid_euclidean;
 };
 
 struct AccuracyStudy {
   std::string case_name;
-  AccuracySetup setup;
+  MeshMetric metric = MeshMetric::Euclidean;  ///< the metric of `hybrid`'s mesh
+  AccuracySetup setup;                        ///< of `hybrid` and the Peaceman model
+  AccuracySetup setup_euclidean;              ///< of `hybrid_euclidean` (compare_metrics)
   AccuracyErrors hybrid, peaceman;
   std::vector<PressureSample> hybrid_samples, peaceman_samples;
   std::vector<RefinementLevel> refinement;  ///< factors 1..levels (factor 1 = the case itself)

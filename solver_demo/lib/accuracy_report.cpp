@@ -75,7 +75,8 @@ double nice_step(double span, int n) {
   return 10 * mag;
 }
 
-void axes(std::ostringstream& s, const Panel& p, const std::string& ylabel, const std::string& title) {
+void axes(std::ostringstream& s, const Panel& p, const std::string& xlabel, const std::string& ylabel,
+          const std::string& title) {
   s << "<rect x='" << p.x0 << "' y='" << p.y0 << "' width='" << p.w << "' height='" << p.h
     << "' fill='none' stroke='#000'/>\n";
   for (int e = static_cast<int>(std::floor(std::log10(p.dmin))); e <= static_cast<int>(std::ceil(std::log10(p.dmax))); ++e)
@@ -97,7 +98,7 @@ void axes(std::ostringstream& s, const Panel& p, const std::string& ylabel, cons
       << fmt(std::fabs(v) < 1e-12 * step ? 0.0 : v) << "</text>\n";
   }
   s << "<text x='" << p.x0 + p.w / 2 << "' y='" << p.y0 + p.h + 34
-    << "' font-size='13' text-anchor='middle'>distance from the well trajectory (m, log scale)</text>\n";
+    << "' font-size='13' text-anchor='middle'>" << xlabel << "</text>\n";
   s << "<text x='" << p.x0 - 52 << "' y='" << p.y0 + p.h / 2 << "' font-size='13' text-anchor='middle' transform='rotate(-90 "
     << p.x0 - 52 << ' ' << p.y0 + p.h / 2 << ")'>" << ylabel << "</text>\n";
   s << "<text x='" << p.x0 + p.w / 2 << "' y='" << p.y0 - 10 << "' font-size='14' text-anchor='middle'>" << title
@@ -135,6 +136,7 @@ void legend(std::ostringstream& s, double x, double y) {
 WriteStatus write_accuracy_json(const std::string& path, const AccuracyStudy& st) {
   nlohmann::json j;
   j["case"] = st.case_name;
+  j["metric"] = st.metric == MeshMetric::Permeability ? "permeability" : "euclidean";
   const AccuracySetup& s = st.setup;
   j["setup"] = {{"exact_solution", "uniform line source on the trajectory (finite-segment potentials summed)"},
                 {"source_inset_m", s.source_inset},
@@ -143,24 +145,52 @@ WriteStatus write_accuracy_json(const std::string& path, const AccuracyStudy& st
                 {"near_well_radius_m", s.near_radius},
                 {"exact_rate_m3_per_day", s.exact_rate},
                 {"rate_per_length_m3_per_day_per_m", s.exact_rate / s.field.source_length()},
+                {"permeability_md", {s.permeability_tensor.x, s.permeability_tensor.y, s.permeability_tensor.z}},
+                {"scaled_frame_permeability_md", s.permeability},
+                {"scale", {s.field.scale.x, s.field.scale.y, s.field.scale.z}},
+                {"equivalent_wellbore_radius_m", s.equivalent_radius},
+                {"wellbore_frame_scale", {s.field.wellbore_scale.x, s.field.wellbore_scale.y, s.field.wellbore_scale.z}},
+                {"wellbore_frame_radius_m", s.field.wellbore_radius},
                 {"reference_point", {s.reference.mid.x, s.reference.mid.y, s.reference.mid.z}},
                 {"reference_normal", {s.reference.normal.x, s.reference.normal.y, s.reference.normal.z}}};
   j["hybrid"] = errors_json(st.hybrid);
   j["cartesian_peaceman"] = errors_json(st.peaceman);
   j["refinement"] = nlohmann::json::array();
-  for (const RefinementLevel& lv : st.refinement)
-    j["refinement"].push_back({{"factor", lv.factor},
-                               {"hybrid_cells", lv.hybrid_cells},
-                               {"cartesian_cells", lv.cartesian_cells},
-                               {"hybrid", errors_json(lv.hybrid)},
-                               {"cartesian_peaceman", errors_json(lv.peaceman)}});
+  for (const RefinementLevel& lv : st.refinement) {
+    nlohmann::json l = {{"factor", lv.factor},
+                        {"hybrid_cells", lv.hybrid_cells},
+                        {"cartesian_cells", lv.cartesian_cells},
+                        {"hybrid", errors_json(lv.hybrid)},
+                        {"cartesian_peaceman", errors_json(lv.peaceman)}};
+    if (lv.has_euclidean) {
+      l["hybrid_euclidean_cells"] = lv.hybrid_euclidean_cells;
+      l["hybrid_euclidean"] = errors_json(lv.hybrid_euclidean);
+    }
+    j["refinement"].push_back(l);
+  }
+  if (!st.refinement.empty() && st.refinement[0].has_euclidean) {
+    j["hybrid_euclidean"] = errors_json(st.refinement[0].hybrid_euclidean);
+    j["setup_euclidean"] = {{"exact_rate_m3_per_day", st.setup_euclidean.exact_rate},
+                            {"wellbore_frame_scale", {st.setup_euclidean.field.wellbore_scale.x,
+                                                      st.setup_euclidean.field.wellbore_scale.y,
+                                                      st.setup_euclidean.field.wellbore_scale.z}},
+                            {"wellbore_frame_radius_m", st.setup_euclidean.field.wellbore_radius}};
+  }
   j["notes"] = st.notes;
   return write_text(path, j.dump(2) + "\n");
 }
 
 WriteStatus write_accuracy_svg(const std::string& path, const AccuracyStudy& st) {
   const AccuracySetup& s = st.setup;
-  const double dmin = s.field.r_w, dmax = s.near_radius;
+  // Anisotropic k: the abscissa is the distance in the scaled frame x / s, where the exact field
+  // is the radial law whatever the direction (docs/accuracy.md).
+  const Vec3 sc = s.field.scale;
+  const bool scaled = !(sc.x == 1 && sc.y == 1 && sc.z == 1);
+  const double dmin = scaled ? s.equivalent_radius : s.field.r_w;
+  const double dmax = scaled ? s.field.scaled_distance(s.reference.mid + s.near_radius * s.reference.normal) : s.near_radius;
+  const std::string xlabel = scaled ? "distance from the well in the scaled frame x / sqrt(k / k0) (m, log scale)"
+                                    : "distance from the well trajectory (m, log scale)";
+  auto dist = [&](const PressureSample& p) { return scaled ? p.scaled_distance : p.distance; };
   const double sign = s.field.coefficient >= 0 ? 1.0 : -1.0;  // producer: p rises away from the well
   const double p_far = s.p_w + sign * s.drawdown;
   Panel top{90, 50, 640, 330, dmin, dmax, std::min(s.p_w, p_far), std::max(s.p_w, p_far)};
@@ -176,28 +206,29 @@ WriteStatus write_accuracy_svg(const std::string& path, const AccuracyStudy& st)
   std::ostringstream o;
   o << "<?xml version='1.0' encoding='UTF-8'?>\n<svg xmlns='http://www.w3.org/2000/svg' width='800' height='860' "
        "font-family='sans-serif'>\n<rect width='100%' height='100%' fill='#fff'/>\n";
-  axes(o, top, "pressure (bar)",
+  axes(o, top, xlabel, "pressure (bar)",
        st.case_name + ": cells within " + fmt(s.slab_half_width, 3) + " m of the reference cross-section");
-  axes(o, bottom, "(p - p_exact) / drawdown (%)", "error of every cell within 3 drainage radii");
+  axes(o, bottom, xlabel, "(p - p_exact) / drawdown (%)", "error of every cell within 3 drainage radii");
   for (const Panel* p : {&top, &bottom}) {
-    vline(o, *p, s.near_radius / 3, "drainage radius");
+    if (!scaled) vline(o, *p, s.near_radius / 3, "drainage radius");
   }
-  // Exact curve along the reference perpendicular.
+  // Exact curve along the reference perpendicular (of the scaled leg when anisotropic).
+  const Vec3 mid_s = to_scaled(s.reference.mid, sc), normal_s = perpendicular_unit(to_scaled(s.reference.direction, sc));
   o << "<polyline fill='none' stroke='#000' stroke-width='1.5' points='";
   for (int i = 0; i <= 200; ++i) {
     const double d = dmin * std::pow(dmax / dmin, i / 200.0);
-    o << fmt(top.px(d), 6) << ',' << fmt(top.py(s.field.pressure(s.reference.mid + d * s.reference.normal)), 6) << ' ';
+    o << fmt(top.px(d), 6) << ',' << fmt(top.py(s.field.pressure(from_scaled(mid_s + d * normal_s, sc))), 6) << ' ';
   }
   o << "'/>\n";
   o << "<line x1='" << bottom.x0 << "' y1='" << bottom.py(0) << "' x2='" << bottom.x0 + bottom.w << "' y2='"
     << bottom.py(0) << "' stroke='#000' stroke-width='1.5'/>\n";
   for (const PressureSample& p : st.peaceman_samples) {
-    if (p.in_slab) marker(o, top, p.distance, p.pressure, false);
-    marker(o, bottom, p.distance, (p.pressure - p.exact) / s.drawdown * 100, false);
+    if (p.in_slab) marker(o, top, dist(p), p.pressure, false);
+    marker(o, bottom, dist(p), (p.pressure - p.exact) / s.drawdown * 100, false);
   }
   for (const PressureSample& p : st.hybrid_samples) {
-    if (p.in_slab) marker(o, top, p.distance, p.pressure, true);
-    marker(o, bottom, p.distance, (p.pressure - p.exact) / s.drawdown * 100, true);
+    if (p.in_slab) marker(o, top, dist(p), p.pressure, true);
+    marker(o, bottom, dist(p), (p.pressure - p.exact) / s.drawdown * 100, true);
   }
   legend(o, top.x0 + 20, top.y0 + 20);
   o << "<text x='90' y='830' font-size='12'>hybrid mesh: rate error " << fmt(st.hybrid.rate_rel_error * 100, 3)

@@ -74,40 +74,90 @@ Vec3 perpendicular_unit(Vec3 d) {
   return normalized(cross(u, Vec3{0, 0, 1}));
 }
 
+Vec3 permeability_scale(Vec3 k) {
+  if (k.x == k.y && k.y == k.z) return {1, 1, 1};  // exactly 1, not cbrt round-off
+  const double k0 = std::cbrt(k.x * k.y * k.z);
+  return {std::sqrt(k.x / k0), std::sqrt(k.y / k0), std::sqrt(k.z / k0)};
+}
+
+double scaled_wellbore_radius(Vec3 s, Vec3 d, double r_w) {
+  if (s.x == 1 && s.y == 1 && s.z == 1) return r_w;
+  const Vec3 dn = normalized(d);
+  const Vec3 e = normalized(to_scaled(dn, s));
+  const Vec3 u = perpendicular_unit(e), v = normalized(cross(e, u));
+  // A scaled displacement y perpendicular to e lies on the image of the circle when its physical
+  // image S y, less its component along d, has length r_w: y^T M y = r_w^2 on span(u, v).
+  auto across = [&](Vec3 y) {
+    const Vec3 x = from_scaled(y, s);
+    return x - dot(x, dn) * dn;
+  };
+  const Vec3 pu = across(u), pv = across(v);
+  const double a = dot(pu, pu), b = dot(pu, pv), c = dot(pv, pv);
+  const double l1 = 0.5 * (a + c) + std::hypot(0.5 * (a - c), b);  // eigenvalues of M
+  const double l2 = (a * c - b * b) / l1;
+  return 0.5 * r_w * (1 / std::sqrt(l1) + 1 / std::sqrt(l2));  // (a + b) / 2 of the ellipse
+}
+
 double LineSourceField::source_length() const {
   double len = 0;
   for (size_t k = 0; k + 1 < source.size(); ++k) len += norm(source[k + 1] - source[k]);
   return len;
 }
 
+double LineSourceField::scaled_source_length() const {
+  double len = 0;
+  for (size_t k = 0; k + 1 < scaled_source.size(); ++k) len += norm(scaled_source[k + 1] - scaled_source[k]);
+  return len;
+}
+
+double LineSourceField::scaled_distance(Vec3 x) const {
+  std::vector<Vec3> axis;
+  for (Vec3 p : polyline) axis.push_back(to_scaled(p, scale));
+  return closest_on_polyline(to_scaled(x, scale), axis).distance;
+}
+
 double LineSourceField::cap_mean_pressure(int end) const {
   const size_t n = polyline.size();
-  const Vec3 e = end == 0 ? polyline[0] : polyline[n - 1];
-  const Vec3 d = end == 0 ? polyline[1] - polyline[0] : polyline[n - 1] - polyline[n - 2];
+  const Vec3 w = wellbore_scale;
+  const Vec3 e = to_scaled(end == 0 ? polyline[0] : polyline[n - 1], w);
+  const Vec3 d = to_scaled(end == 0 ? polyline[1] - polyline[0] : polyline[n - 1] - polyline[n - 2], w);
   const Vec3 u = perpendicular_unit(d), v = normalized(cross(normalized(d), u));
-  // rho = r_w s^2 (drho = 2 r_w s ds) smooths rho ln(rho) near the centre; midpoint rules in s and theta.
+  const double r = wellbore_radius;
+  // rho = r s^2 (drho = 2 r s ds) smooths rho ln(rho) near the centre; midpoint rules in s and theta.
   const int ns = 64, nt = 32;
   double sum = 0, weight = 0;
   for (int i = 0; i < ns; ++i) {
-    const double s = (i + 0.5) / ns, rho = r_w * s * s, w = rho * 2 * r_w * s;
+    const double s = (i + 0.5) / ns, rho = r * s * s, wt = rho * 2 * r * s;
     for (int j = 0; j < nt; ++j) {
       const double th = 2 * kPi * (j + 0.5) / nt;
-      sum += w * pressure(e + rho * (std::cos(th) * u + std::sin(th) * v));
-      weight += w;
+      sum += wt * pressure(from_scaled(e + rho * (std::cos(th) * u + std::sin(th) * v), w));
+      weight += wt;
     }
   }
   return sum / weight;
 }
 
 double LineSourceField::wellbore_pressure(Vec3 x) const {
-  const PolylinePoint cp = closest_on_polyline(x, polyline);
-  const int last_leg = static_cast<int>(polyline.size()) - 2;
-  if (cp.distance <= 1e-9 * r_w) {
+  const Vec3 w = wellbore_scale;
+  std::vector<Vec3> axis;
+  for (Vec3 p : polyline) axis.push_back(to_scaled(p, w));
+  const Vec3 xw = to_scaled(x, w);
+  const PolylinePoint cp = closest_on_polyline(xw, axis);
+  const int last_leg = static_cast<int>(axis.size()) - 2;
+  const double r = wellbore_radius;
+  if (cp.distance <= 1e-9 * r) {
     if (cp.leg == 0 && cp.t == 0.0) return cap_mean_pressure(0);
     if (cp.leg == last_leg && cp.t == 1.0) return cap_mean_pressure(1);
-    return pressure(cp.point + r_w * perpendicular_unit(polyline[cp.leg + 1] - polyline[cp.leg]));
+    return pressure(from_scaled(cp.point + r * perpendicular_unit(axis[cp.leg + 1] - axis[cp.leg]), w));
   }
-  return pressure(cp.point + (r_w / cp.distance) * (x - cp.point));
+  return pressure(from_scaled(cp.point + (r / cp.distance) * (xw - cp.point), w));
+}
+
+double LineSourceField::equivalent_wellbore_pressure(Vec3 x) const {
+  const PolylinePoint cp = closest_on_polyline(x, polyline);
+  const Vec3 d = polyline[cp.leg + 1] - polyline[cp.leg];
+  const Vec3 n = perpendicular_unit(to_scaled(d, scale));
+  return pressure(from_scaled(to_scaled(cp.point, scale) + scaled_wellbore_radius(scale, d, r_w) * n, scale));
 }
 
 FieldReference field_reference(const std::vector<Vec3>& poly) {
@@ -124,7 +174,7 @@ FieldReference field_reference(const std::vector<Vec3>& poly) {
 }
 
 LineSourceField make_line_source_field(const std::vector<Vec3>& poly, double r_w, double p_w, double p_outer,
-                                       double outer_distance, double inset) {
+                                       double outer_distance, double inset, Vec3 scale) {
   LineSourceField f;
   f.polyline = poly;
   f.source = poly;
@@ -132,9 +182,15 @@ LineSourceField make_line_source_field(const std::vector<Vec3>& poly, double r_w
   f.source[0] = poly[0] + inset * normalized(poly[1] - poly[0]);
   f.source[n - 1] = poly[n - 1] - inset * normalized(poly[n - 1] - poly[n - 2]);
   f.r_w = r_w;
+  f.scale = scale;
+  for (Vec3 p : f.source) f.scaled_source.push_back(to_scaled(p, scale));
+  f.wellbore_radius = r_w;
   const FieldReference ref = field_reference(poly);
-  const double phi_w = polyline_potential(ref.mid + r_w * ref.normal, f.source);
-  const double phi_o = polyline_potential(ref.mid + outer_distance * ref.normal, f.source);
+  // The equivalent wellbore at the reference point (the physical circle r_w when isotropic).
+  const Vec3 w = to_scaled(ref.mid, scale) + scaled_wellbore_radius(scale, ref.direction, r_w) *
+                                                 perpendicular_unit(to_scaled(ref.direction, scale));
+  const double phi_w = polyline_potential(w, f.scaled_source);
+  const double phi_o = polyline_potential(to_scaled(ref.mid + outer_distance * ref.normal, scale), f.scaled_source);
   // p = p_ref - c phi with p(phi_w) = p_w and p(phi_o) = p_outer.
   f.coefficient = (p_outer - p_w) / (phi_w - phi_o);
   f.p_ref = p_w + f.coefficient * phi_w;

@@ -1,6 +1,8 @@
 // Exact solutions for the near-well accuracy study (docs/accuracy.md): the potential of a
 // uniform line source on a polyline (a sum of finite-segment potentials), harmonic away from
-// the polyline, and the radial / infinite-line special cases.
+// the polyline, and the radial / infinite-line special cases. For a diagonal permeability the
+// field is that potential in the scaled coordinates x' = x / s, s_i = sqrt(k_i / k0),
+// k0 = cbrt(kx ky kz) (det S = 1), where the permeability is the isotropic k0.
 #pragma once
 #include <vector>
 
@@ -32,34 +34,76 @@ PolylinePoint closest_on_polyline(Vec3 x, const std::vector<Vec3>& polyline);
 /// A unit vector perpendicular to d: horizontal (d x z) unless d is nearly vertical, then x-like.
 Vec3 perpendicular_unit(Vec3 d);
 
+/// s_i = sqrt(k_i / k0), k0 = cbrt(kx ky kz): the diagonal of S (det S = 1) with x = S x' the map
+/// from the coordinates where the permeability is the isotropic k0. (1, 1, 1) when isotropic.
+Vec3 permeability_scale(Vec3 k);
+/// x' = S^-1 x and back (component-wise).
+inline Vec3 to_scaled(Vec3 x, Vec3 s) { return {x.x / s.x, x.y / s.y, x.z / s.z}; }
+inline Vec3 from_scaled(Vec3 x, Vec3 s) { return {x.x * s.x, x.y * s.y, x.z * s.z}; }
+
+/// The equivalent radius, in the scaled coordinates x' = x / s, of a circular wellbore of radius
+/// r_w about a (physical) axis of direction d. The circle cylinder maps to a cylinder about
+/// S^-1 d with an elliptic cross-section (semi-axes a, b); (a + b) / 2, the ellipse's logarithmic
+/// capacity, is the radius of the circle with the same far field (the exterior of the ellipse maps
+/// conformally onto the exterior of that circle, identity at infinity). For a well along z this
+/// is r_w (1/s_x + 1/s_y) / 2, the equivalent wellbore of Peaceman's (1983) anisotropic index;
+/// r_w when s = (1, 1, 1).
+double scaled_wellbore_radius(Vec3 s, Vec3 d, double r_w);
+
 /// The manufactured pressure field p(x) = p_ref - coefficient * polyline_potential(x) of a uniform
 /// line source on `polyline` (pressure in bar when coefficient = q' mu / (4 pi CDARCY k)).
 /// Near the middle of a long segment p ~ p_ref' + (q' mu / (2 pi CDARCY k)) ln(d): the radial law.
+///
+/// Anisotropic (scale s != 1): p(x) = p_ref - coefficient * polyline_potential(S^-1 x, S^-1 source),
+/// harmonic for div(K grad p) (K = k0 S^2); q' is then the rate per unit of scaled source length
+/// (fluxes are the same in both frames: det S = 1).
 struct LineSourceField {
-  std::vector<Vec3> polyline;  ///< the well trajectory (axis of the wellbore)
+  std::vector<Vec3> polyline;  ///< the well trajectory (axis of the wellbore), physical
   std::vector<Vec3> source;    ///< where the source lies: the trajectory, possibly shortened at its ends
   double r_w = 0.1;
   double p_ref = 0;
-  double coefficient = 0;  ///< bar per unit of potential; q' = 4 pi CDARCY k coefficient / mu
+  double coefficient = 0;  ///< bar per unit of potential; q' = 4 pi CDARCY k0 coefficient / mu
+  Vec3 scale{1, 1, 1};     ///< s = permeability_scale(K): the field is a line source in x' = x / s
+  std::vector<Vec3> scaled_source;  ///< source / s
+  /// The frame the mesh's wellbore is a circle in: x_w = x / wellbore_scale ((1, 1, 1): the
+  /// physical circle of radius r_w of a Euclidean mesh), and its radius there.
+  Vec3 wellbore_scale{1, 1, 1};
+  double wellbore_radius = 0.1;
 
-  double pressure(Vec3 x) const { return p_ref - coefficient * polyline_potential(x, source); }
-  Vec3 pressure_gradient(Vec3 x) const { return -coefficient * polyline_potential_gradient(x, source); }
-  /// The pressure the wellbore face with centroid x sees: the exact p on the wellbore circle
-  /// (x moved along its perpendicular from the polyline to distance r_w); at a trajectory end
-  /// point (the centroid of an end cap) the mean of p over the cap disc of radius r_w.
+  double pressure(Vec3 x) const { return p_ref - coefficient * polyline_potential(to_scaled(x, scale), scaled_source); }
+  Vec3 pressure_gradient(Vec3 x) const {
+    return -coefficient * to_scaled(polyline_potential_gradient(to_scaled(x, scale), scaled_source), scale);
+  }
+  /// The pressure the wellbore face with centroid x sees: the exact p on the mesh's wellbore
+  /// (in the wellbore frame, x moved along its perpendicular from the polyline to distance
+  /// wellbore_radius); at a trajectory end point (the centroid of a flat end cap) the mean of p
+  /// over the cap disc.
   double wellbore_pressure(Vec3 x) const;
-  /// Mean of p over the disc of radius r_w centred at trajectory end `end` (0 first, 1 last),
-  /// normal to the end leg (quadrature in polar coordinates: the log singularity is integrable).
+  /// The pressure of a real well (constant on its physical circle of radius r_w) at the
+  /// trajectory point closest to x, as the line source sees it: p at the equivalent radius
+  /// scaled_wellbore_radius in the scaled frame (p on the circle r_w when isotropic). The
+  /// wellbore pressure of a Peaceman connection.
+  double equivalent_wellbore_pressure(Vec3 x) const;
+  /// Mean of p over the disc of radius wellbore_radius (wellbore frame) centred at trajectory end
+  /// `end` (0 first, 1 last), normal to the end leg (polar quadrature: the log singularity is integrable).
   double cap_mean_pressure(int end) const;
-  double source_length() const;  ///< the exact rate is q' x source_length()
+  double source_length() const;         ///< physical length of the source
+  double scaled_source_length() const;  ///< the exact rate is q' x scaled_source_length()
+  /// Distance from x to the scaled source polyline, in the scaled frame (the radial law's variable).
+  double scaled_distance(Vec3 x) const;
 };
 
 /// Builds the field whose pressure is p_w at distance r_w and p_outer at distance `outer_distance`
 /// from the midpoint of the longest leg (both along perpendicular_unit of that leg). The source is
 /// the trajectory with `inset` (m) removed at both ends (0: the whole trajectory; inset = r_w keeps
 /// the source strictly inside the wellbore, so that p is smooth up to the end caps).
+/// Anisotropic (scale != 1): the field is a line source in x' = x / scale; p = p_w at the
+/// equivalent wellbore (scaled_wellbore_radius from the scaled midpoint, perpendicular to the
+/// scaled leg) and p = p_outer at the physical point outer_distance from the midpoint along the
+/// physical perpendicular. The wellbore frame is left Euclidean (set wellbore_scale /
+/// wellbore_radius for a mesh built in another frame).
 LineSourceField make_line_source_field(const std::vector<Vec3>& polyline, double r_w, double p_w, double p_outer,
-                                       double outer_distance, double inset = 0);
+                                       double outer_distance, double inset = 0, Vec3 scale = {1, 1, 1});
 
 /// Reference points of such a field: the longest leg's midpoint and its perpendicular.
 struct FieldReference {

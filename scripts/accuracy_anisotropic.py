@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""The anisotropic near-well accuracy sweep of docs/accuracy.md ("Anisotropic permeability").
+
+Runs `solver_demo --accuracy --compare-metrics` on the four shipped accuracy cases at kv/kh = 1, 0.1
+and 0.01 (and kx/ky = 3 at kv/kh = 0.1 for the horizontal well), levels 1..L, one run at a time
+under `nice`, each into OUT/<case>_kvkh<R>_kxky<Q>/, then prints the markdown tables of the doc
+(from the accuracy.json files; a run whose accuracy.json exists is not repeated, so the sweep can
+be resumed, and --table-only only tabulates what is there).
+
+Usage: accuracy_anisotropic.py [--solver BUILD/bin/solver_demo] [--out DIR] [--levels L]
+                               [--cases vertical,deviated45,...] [--table-only] [--markdown FILE]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CASES = ["vertical", "deviated45", "horizontal", "bent"]
+RATIOS = [(1.0, 1.0), (0.1, 1.0), (0.01, 1.0)]
+EXTRA = {"horizontal": [(0.1, 3.0)]}
+
+
+def tag(v):
+    return ("%g" % v).replace(".", "p")
+
+
+def run_dir(out, case, kv, kxky):
+    return os.path.join(out, "%s_kvkh%s_kxky%s" % (case, tag(kv), tag(kxky)))
+
+
+def pct(v, signed=False):
+    if v is None:
+        return "-"
+    return ("%+.3f %%" if signed else "%.3f %%") % (100 * v)
+
+
+def model_cells(m):
+    if m is None:
+        return "-", "-", "-"
+    return pct(m["rate_rel_error"], True), pct(m["near_well_pressure_rel_error"]), pct(m["l2_pressure_rel_error"])
+
+
+def where(m):
+    if m is None:
+        return "-"
+    w = m["worst_cell"]
+    d = m["near_well_diagnostics"]
+    side = "tip" if d["max_beyond_ends"] >= d["max_lateral"] else "lateral"
+    return "%s, %s, %.2f m" % (w["region"], side, w["distance_to_trajectory"])
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--solver", default=os.path.join(ROOT, "build", "bin", "solver_demo"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "accuracy_anisotropic"))
+    ap.add_argument("--levels", type=int, default=2)
+    ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--table-only", action="store_true")
+    ap.add_argument("--markdown", default="")
+    a = ap.parse_args()
+    runs = []
+    for case in a.cases.split(","):
+        for kv, kxky in RATIOS + EXTRA.get(case, []):
+            runs.append((case, kv, kxky))
+    if not a.table_only:
+        for case, kv, kxky in runs:
+            d = run_dir(a.out, case, kv, kxky)
+            if os.path.exists(os.path.join(d, "accuracy.json")):
+                continue
+            cmd = ["nice", a.solver, "--accuracy", os.path.join(ROOT, "examples", "accuracy_%s.yaml" % case), "-o", d,
+                   "--levels", str(a.levels), "--compare-metrics", "--kv-kh", "%g" % kv, "--kx-ky", "%g" % kxky]
+            t0 = time.time()
+            r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            print("%s kv/kh=%g kx/ky=%g: exit %d, %.0f s" % (case, kv, kxky, r.returncode, time.time() - t0), flush=True)
+            if r.returncode != 0:
+                print(r.stdout, file=sys.stderr)
+    lines = ["| case | kv/kh | kx/ky | level | K-orth rate | K-orth near-well | K-orth L2 | Euclidean rate | "
+             "Euclidean near-well | Euclidean L2 | Peaceman rate | Peaceman near-well | Peaceman L2 | cells (K-orth / Eucl. / Cart.) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    diag = ["| case | kv/kh | kx/ky | level | K-orth worst (region, side, distance) | Euclidean worst |",
+            "|---|---|---|---|---|---|"]
+    for case, kv, kxky in runs:
+        f = os.path.join(run_dir(a.out, case, kv, kxky), "accuracy.json")
+        if not os.path.exists(f):
+            continue
+        j = json.load(open(f))
+        for lv in j["refinement"]:
+            ko, eu, pc = lv["hybrid"], lv.get("hybrid_euclidean"), lv["cartesian_peaceman"]
+            cells = "%d / %s / %d" % (lv["hybrid_cells"], lv.get("hybrid_euclidean_cells", "-"), lv["cartesian_cells"])
+            lines.append("| %s | %g | %g | %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                (case, kv, kxky, lv["factor"]) + model_cells(ko) + model_cells(eu) + model_cells(pc) + (cells,)))
+            diag.append("| %s | %g | %g | %d | %s | %s |" % (case, kv, kxky, lv["factor"], where(ko), where(eu)))
+    text = "\n".join(lines) + "\n\n" + "\n".join(diag) + "\n"
+    print(text)
+    if a.markdown:
+        open(a.markdown, "w").write(text)
+
+
+if __name__ == "__main__":
+    main()
