@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """The anisotropic near-well accuracy sweep of docs/accuracy.md ("Anisotropic permeability").
 
-Runs `solver_demo --accuracy --compare-metrics` on the four shipped accuracy cases at kv/kh = 1, 0.1
+Runs `solver_demo --accuracy --metric M` on the four shipped accuracy cases at kv/kh = 1, 0.1
 and 0.01 (and kx/ky = 3 at kv/kh = 0.1 for the horizontal well), levels 1..L, one run at a time
-under `nice`, each into OUT/<case>_kvkh<R>_kxky<Q>/, then prints the markdown tables of the doc
-(from the accuracy.json files; a run whose accuracy.json exists is not repeated, so the sweep can
-be resumed, and --table-only only tabulates what is there).
+under `nice`, each into OUT/<M>/<case>_kvkh<R>_kxky<Q>/ (M = euclidean: today's mesh and the
+Cartesian + Peaceman model; M = permeability: the K-orthogonal mesh), then prints the markdown
+tables of the doc from the accuracy.json files. A run whose accuracy.json exists is not repeated
+(the sweep can be resumed); --table-only only tabulates what is there.
 
 Usage: accuracy_anisotropic.py [--solver BUILD/bin/solver_demo] [--out DIR] [--levels L]
-                               [--cases vertical,deviated45,...] [--table-only] [--markdown FILE]
+                               [--metrics euclidean,permeability] [--cases vertical,deviated45,...]
+                               [--table-only] [--markdown FILE]
 """
 import argparse
 import json
@@ -27,8 +29,13 @@ def tag(v):
     return ("%g" % v).replace(".", "p")
 
 
-def run_dir(out, case, kv, kxky):
-    return os.path.join(out, "%s_kvkh%s_kxky%s" % (case, tag(kv), tag(kxky)))
+def run_dir(out, metric, case, kv, kxky):
+    return os.path.join(out, metric, "%s_kvkh%s_kxky%s" % (case, tag(kv), tag(kxky)))
+
+
+def load(out, metric, case, kv, kxky):
+    f = os.path.join(run_dir(out, metric, case, kv, kxky), "accuracy.json")
+    return json.load(open(f)) if os.path.exists(f) else None
 
 
 def pct(v, signed=False):
@@ -58,6 +65,7 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "accuracy_anisotropic"))
     ap.add_argument("--levels", type=int, default=2)
     ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--metrics", default="euclidean,permeability")
     ap.add_argument("--table-only", action="store_true")
     ap.add_argument("--markdown", default="")
     a = ap.parse_args()
@@ -66,33 +74,46 @@ def main():
         for kv, kxky in RATIOS + EXTRA.get(case, []):
             runs.append((case, kv, kxky))
     if not a.table_only:
-        for case, kv, kxky in runs:
-            d = run_dir(a.out, case, kv, kxky)
-            if os.path.exists(os.path.join(d, "accuracy.json")):
-                continue
-            cmd = ["nice", a.solver, "--accuracy", os.path.join(ROOT, "examples", "accuracy_%s.yaml" % case), "-o", d,
-                   "--levels", str(a.levels), "--compare-metrics", "--kv-kh", "%g" % kv, "--kx-ky", "%g" % kxky]
-            t0 = time.time()
-            r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            print("%s kv/kh=%g kx/ky=%g: exit %d, %.0f s" % (case, kv, kxky, r.returncode, time.time() - t0), flush=True)
-            if r.returncode != 0:
-                print(r.stdout, file=sys.stderr)
+        for metric in a.metrics.split(","):
+            for case, kv, kxky in runs:
+                if metric == "permeability" and kv == 1 and kxky == 1:
+                    continue  # isotropic: the permeability frame is the identity, the mesh is the Euclidean one
+                d = run_dir(a.out, metric, case, kv, kxky)
+                if os.path.exists(os.path.join(d, "accuracy.json")):
+                    continue
+                cmd = ["nice", a.solver, "--accuracy", os.path.join(ROOT, "examples", "accuracy_%s.yaml" % case),
+                       "-o", d, "--levels", str(a.levels), "--metric", metric, "--kv-kh", "%g" % kv,
+                       "--kx-ky", "%g" % kxky]
+                t0 = time.time()
+                r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                print("%s %s kv/kh=%g kx/ky=%g: exit %d, %.0f s" % (metric, case, kv, kxky, r.returncode,
+                                                                    time.time() - t0), flush=True)
+                if r.returncode != 0:
+                    print(r.stdout, file=sys.stderr, flush=True)
     lines = ["| case | kv/kh | kx/ky | level | K-orth rate | K-orth near-well | K-orth L2 | Euclidean rate | "
              "Euclidean near-well | Euclidean L2 | Peaceman rate | Peaceman near-well | Peaceman L2 | cells (K-orth / Eucl. / Cart.) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     diag = ["| case | kv/kh | kx/ky | level | K-orth worst (region, side, distance) | Euclidean worst |",
             "|---|---|---|---|---|---|"]
     for case, kv, kxky in runs:
-        f = os.path.join(run_dir(a.out, case, kv, kxky), "accuracy.json")
-        if not os.path.exists(f):
+        je, jk = load(a.out, "euclidean", case, kv, kxky), load(a.out, "permeability", case, kv, kxky)
+        if kv == 1 and kxky == 1:
+            jk = je  # identity frame: the same mesh
+        if je is None and jk is None:
             continue
-        j = json.load(open(f))
-        for lv in j["refinement"]:
-            ko, eu, pc = lv["hybrid"], lv.get("hybrid_euclidean"), lv["cartesian_peaceman"]
-            cells = "%d / %s / %d" % (lv["hybrid_cells"], lv.get("hybrid_euclidean_cells", "-"), lv["cartesian_cells"])
+        nlev = max(len(j["refinement"]) for j in (je, jk) if j is not None)
+        for i in range(nlev):
+            le = je["refinement"][i] if je is not None and i < len(je["refinement"]) else None
+            lk = jk["refinement"][i] if jk is not None and i < len(jk["refinement"]) else None
+            ko = lk["hybrid"] if lk else None
+            eu = le["hybrid"] if le else None
+            pc = (le or lk)["cartesian_peaceman"]
+            factor = (le or lk)["factor"]
+            cells = "%s / %s / %d" % (lk["hybrid_cells"] if lk else "-", le["hybrid_cells"] if le else "-",
+                                      (le or lk)["cartesian_cells"])
             lines.append("| %s | %g | %g | %d | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                (case, kv, kxky, lv["factor"]) + model_cells(ko) + model_cells(eu) + model_cells(pc) + (cells,)))
-            diag.append("| %s | %g | %g | %d | %s | %s |" % (case, kv, kxky, lv["factor"], where(ko), where(eu)))
+                (case, kv, kxky, factor) + model_cells(ko) + model_cells(eu) + model_cells(pc) + (cells,)))
+            diag.append("| %s | %g | %g | %d | %s | %s |" % (case, kv, kxky, factor, where(ko), where(eu)))
     text = "\n".join(lines) + "\n\n" + "\n".join(diag) + "\n"
     print(text)
     if a.markdown:

@@ -30,11 +30,12 @@ constexpr const char* kUsage =
     "usage: solver_demo CASE.yaml -o OUTDIR [--mesh MESH.vtu]\n"
     "         (--mesh: solve on the mesh file meshgen wrote for CASE.yaml instead of meshing again)\n"
     "       solver_demo --accuracy CASE.yaml -o OUTDIR [--levels N] [--source-to-tips] [--kv-kh R] [--kx-ky Q]\n"
-    "                [--compare-metrics]\n"
+    "                [--metric permeability|euclidean | --compare-metrics]\n"
     "         (N refinement levels, default 3; --source-to-tips: the line source runs to the well's end\n"
     "          points, singular on the end caps, instead of stopping r_w short of them; --kv-kh, --kx-ky:\n"
     "          the case's permeability made anisotropic keeping kh = sqrt(kx ky), kz = R kh, kx / ky = Q;\n"
-    "          --compare-metrics: the hybrid mesh with metric: permeability and with metric: euclidean)\n";
+    "          --metric: overrides the case's metric key; --compare-metrics: the hybrid mesh with\n"
+    "          metric: permeability and with metric: euclidean)\n";
 
 int usage(const std::string& why) {
   std::cerr << "solver_demo: " << why << "\n" << kUsage;
@@ -204,6 +205,7 @@ int main(int argc, char** argv) {
   bool accuracy = false, anisotropy = false;
   int levels = 3;
   double kv_kh = 1, kx_ky = 1;
+  std::string metric;  // empty: the case's
   hm::AccuracyOptions acc_opt;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -220,6 +222,11 @@ int main(int argc, char** argv) {
       if (const std::string why = parse_ratio(a, argv[i], a == "--kv-kh" ? &kv_kh : &kx_ky); !why.empty())
         return usage(why);
       anisotropy = true;
+    } else if (a == "--metric") {
+      if (++i >= argc) return usage("--metric needs permeability or euclidean");
+      const std::string m = argv[i];
+      if (m != "permeability" && m != "euclidean") return usage("--metric: expected permeability or euclidean, got '" + m + "'");
+      metric = m;
     } else if (a == "--compare-metrics") {
       acc_opt.compare_metrics = true;
     } else if (a == "--source-to-tips") {
@@ -242,8 +249,9 @@ int main(int argc, char** argv) {
     }
   }
   if (const std::string why = hm::check_case_and_output(case_path, out_dir); !why.empty()) return usage(why);
-  if ((anisotropy || acc_opt.compare_metrics) && !accuracy)
-    return usage("--kv-kh, --kx-ky and --compare-metrics go with --accuracy");
+  if ((anisotropy || acc_opt.compare_metrics || !metric.empty()) && !accuracy)
+    return usage("--kv-kh, --kx-ky, --metric and --compare-metrics go with --accuracy");
+  if (acc_opt.compare_metrics && !metric.empty()) return usage("--metric and --compare-metrics exclude each other");
 
   hm::CaseSpec cs;
   try {
@@ -260,5 +268,6 @@ int main(int argc, char** argv) {
   if (anisotropy && !cs.reservoir.cell_permx.empty())
     return usage("--kv-kh / --kx-ky: the case has per-cell permeability (reservoir.grdecl)");
   if (anisotropy) cs = hm::anisotropic_case(cs, kv_kh, kx_ky);
+  if (!metric.empty()) cs.metric = metric == "permeability" ? hm::MeshMetric::Permeability : hm::MeshMetric::Euclidean;
   return accuracy ? run_accuracy(cs, out_dir, levels, acc_opt) : run_flow(cs, out_dir, mesh_file);
 }

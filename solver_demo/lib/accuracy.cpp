@@ -9,6 +9,7 @@
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/permeability_frame.hpp"
 #include "peaceman.hpp"
 
 namespace hm {
@@ -31,18 +32,26 @@ AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& opt
   s.near_radius = 3 * ws.drainage_radius;
   s.viscosity = cs.fluid.viscosity;
   s.permeability_tensor = k;
-  const Vec3 scale = permeability_scale(k);
+  // The exact field is a line source in x' = S^-1 x whatever the mesh's metric; the metric
+  // decides where the mesh's wellbore is (the frame it is a circle in, and its radius there).
+  const Vec3 scale = frame_scale(k);
   s.permeability = k.x == k.y && k.y == k.z ? k.x : std::cbrt(k.x * k.y * k.z);
+  const PermeabilityFrame frame = permeability_frame(cs);  // identity unless metric: permeability
   s.p_w = ws.bhp;
   s.drawdown = std::fabs(cs.reservoir.initial_pressure - ws.bhp);
   s.source_inset = opt.source_to_tips ? 0.0 : ws.radius;
   // The well as meshed: the block cuts each bend's corner along its fillet wedges, so the
   // exact solution's source follows that axis (the trajectory itself for straight wells).
-  const std::vector<Vec3> axis = meshed_axis(make_well_block(cs, 0, ws.sectors));  // independent of sectors
+  // A K-orthogonal block is planned in the scaled frame (its fillet too): its axis mapped back.
+  const CaseSpec meshed = scaled_case(cs, frame);
+  std::vector<Vec3> axis = meshed_axis(make_well_block(meshed, 0, ws.sectors));  // independent of sectors
+  for (Vec3& p : axis) p = to_physical(frame, p);
   s.field = make_line_source_field(axis, ws.radius, ws.bhp, cs.reservoir.initial_pressure, s.near_radius,
                                    s.source_inset, scale);
+  s.field.wellbore_scale = frame.scale;
+  s.field.wellbore_radius = meshed.wells[0].radius;  // r_w, or the mean equivalent radius of the scaled block
   s.reference = field_reference(axis);
-  s.equivalent_radius = scaled_wellbore_radius(scale, s.reference.direction, ws.radius);
+  s.equivalent_radius = equivalent_wellbore_radius(scale, s.reference.direction, ws.radius);
   // q' per unit of scaled source length; the rate is the same in both frames (det S = 1).
   const double q_per_length = 4 * kPi * kDarcyMetric * s.permeability * s.field.coefficient / s.viscosity;
   s.exact_rate = q_per_length * s.field.scaled_source_length();

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "meshgen/pipeline/permeability_frame.hpp"
+
 namespace hm {
 
 namespace {
@@ -74,28 +76,9 @@ Vec3 perpendicular_unit(Vec3 d) {
   return normalized(cross(u, Vec3{0, 0, 1}));
 }
 
-Vec3 permeability_scale(Vec3 k) {
-  if (k.x == k.y && k.y == k.z) return {1, 1, 1};  // exactly 1, not cbrt round-off
-  const double k0 = std::cbrt(k.x * k.y * k.z);
-  return {std::sqrt(k.x / k0), std::sqrt(k.y / k0), std::sqrt(k.z / k0)};
-}
-
-double scaled_wellbore_radius(Vec3 s, Vec3 d, double r_w) {
+double equivalent_wellbore_radius(Vec3 s, Vec3 d, double r_w) {
   if (s.x == 1 && s.y == 1 && s.z == 1) return r_w;
-  const Vec3 dn = normalized(d);
-  const Vec3 e = normalized(to_scaled(dn, s));
-  const Vec3 u = perpendicular_unit(e), v = normalized(cross(e, u));
-  // A scaled displacement y perpendicular to e lies on the image of the circle when its physical
-  // image S y, less its component along d, has length r_w: y^T M y = r_w^2 on span(u, v).
-  auto across = [&](Vec3 y) {
-    const Vec3 x = from_scaled(y, s);
-    return x - dot(x, dn) * dn;
-  };
-  const Vec3 pu = across(u), pv = across(v);
-  const double a = dot(pu, pu), b = dot(pu, pv), c = dot(pv, pv);
-  const double l1 = 0.5 * (a + c) + std::hypot(0.5 * (a - c), b);  // eigenvalues of M
-  const double l2 = (a * c - b * b) / l1;
-  return 0.5 * r_w * (1 / std::sqrt(l1) + 1 / std::sqrt(l2));  // (a + b) / 2 of the ellipse
+  return equivalent_radius(s, normalized(d), r_w);
 }
 
 double LineSourceField::source_length() const {
@@ -157,7 +140,7 @@ double LineSourceField::equivalent_wellbore_pressure(Vec3 x) const {
   const PolylinePoint cp = closest_on_polyline(x, polyline);
   const Vec3 d = polyline[cp.leg + 1] - polyline[cp.leg];
   const Vec3 n = perpendicular_unit(to_scaled(d, scale));
-  return pressure(from_scaled(to_scaled(cp.point, scale) + scaled_wellbore_radius(scale, d, r_w) * n, scale));
+  return pressure(from_scaled(to_scaled(cp.point, scale) + equivalent_wellbore_radius(scale, d, r_w) * n, scale));
 }
 
 FieldReference field_reference(const std::vector<Vec3>& poly) {
@@ -187,7 +170,7 @@ LineSourceField make_line_source_field(const std::vector<Vec3>& poly, double r_w
   f.wellbore_radius = r_w;
   const FieldReference ref = field_reference(poly);
   // The equivalent wellbore at the reference point (the physical circle r_w when isotropic).
-  const Vec3 w = to_scaled(ref.mid, scale) + scaled_wellbore_radius(scale, ref.direction, r_w) *
+  const Vec3 w = to_scaled(ref.mid, scale) + equivalent_wellbore_radius(scale, ref.direction, r_w) *
                                                  perpendicular_unit(to_scaled(ref.direction, scale));
   const double phi_w = polyline_potential(w, f.scaled_source);
   const double phi_o = polyline_potential(to_scaled(ref.mid + outer_distance * ref.normal, scale), f.scaled_source);

@@ -34,21 +34,13 @@ PolylinePoint closest_on_polyline(Vec3 x, const std::vector<Vec3>& polyline);
 /// A unit vector perpendicular to d: horizontal (d x z) unless d is nearly vertical, then x-like.
 Vec3 perpendicular_unit(Vec3 d);
 
-/// s_i = sqrt(k_i / k0), k0 = cbrt(kx ky kz): the diagonal of S (det S = 1) with x = S x' the map
-/// from the coordinates where the permeability is the isotropic k0. (1, 1, 1) when isotropic.
-Vec3 permeability_scale(Vec3 k);
-/// x' = S^-1 x and back (component-wise).
+/// x' = S^-1 x and back (component-wise; s = frame_scale(K), meshgen/pipeline/permeability_frame.hpp).
+/// The field is translation invariant, so the frame's origin does not matter here.
 inline Vec3 to_scaled(Vec3 x, Vec3 s) { return {x.x / s.x, x.y / s.y, x.z / s.z}; }
 inline Vec3 from_scaled(Vec3 x, Vec3 s) { return {x.x * s.x, x.y * s.y, x.z * s.z}; }
-
-/// The equivalent radius, in the scaled coordinates x' = x / s, of a circular wellbore of radius
-/// r_w about a (physical) axis of direction d. The circle cylinder maps to a cylinder about
-/// S^-1 d with an elliptic cross-section (semi-axes a, b); (a + b) / 2, the ellipse's logarithmic
-/// capacity, is the radius of the circle with the same far field (the exterior of the ellipse maps
-/// conformally onto the exterior of that circle, identity at infinity). For a well along z this
-/// is r_w (1/s_x + 1/s_y) / 2, the equivalent wellbore of Peaceman's (1983) anisotropic index;
-/// r_w when s = (1, 1, 1).
-double scaled_wellbore_radius(Vec3 s, Vec3 d, double r_w);
+/// equivalent_radius (permeability_frame.hpp) of a wellbore of radius r_w about direction d in
+/// the frame of scale s, exactly r_w when s = (1, 1, 1).
+double equivalent_wellbore_radius(Vec3 s, Vec3 d, double r_w);
 
 /// The manufactured pressure field p(x) = p_ref - coefficient * polyline_potential(x) of a uniform
 /// line source on `polyline` (pressure in bar when coefficient = q' mu / (4 pi CDARCY k)).
@@ -63,7 +55,7 @@ struct LineSourceField {
   double r_w = 0.1;
   double p_ref = 0;
   double coefficient = 0;  ///< bar per unit of potential; q' = 4 pi CDARCY k0 coefficient / mu
-  Vec3 scale{1, 1, 1};     ///< s = permeability_scale(K): the field is a line source in x' = x / s
+  Vec3 scale{1, 1, 1};     ///< s = frame_scale(K): the field is a line source in x' = x / s
   std::vector<Vec3> scaled_source;  ///< source / s
   /// The frame the mesh's wellbore is a circle in: x_w = x / wellbore_scale ((1, 1, 1): the
   /// physical circle of radius r_w of a Euclidean mesh), and its radius there.
@@ -81,8 +73,10 @@ struct LineSourceField {
   double wellbore_pressure(Vec3 x) const;
   /// The pressure of a real well (constant on its physical circle of radius r_w) at the
   /// trajectory point closest to x, as the line source sees it: p at the equivalent radius
-  /// scaled_wellbore_radius in the scaled frame (p on the circle r_w when isotropic). The
-  /// wellbore pressure of a Peaceman connection.
+  /// (a + b) / 2 of the wellbore's elliptic image in the scaled frame (equivalent_radius of
+  /// permeability_frame.hpp: the circle with the same far field; for a well along z Peaceman's
+  /// (1983) r_w (1/s_x + 1/s_y) / 2), perpendicular to the scaled leg; p on the circle r_w when
+  /// isotropic. The wellbore pressure of a Peaceman connection.
   double equivalent_wellbore_pressure(Vec3 x) const;
   /// Mean of p over the disc of radius wellbore_radius (wellbore frame) centred at trajectory end
   /// `end` (0 first, 1 last), normal to the end leg (polar quadrature: the log singularity is integrable).
@@ -98,7 +92,7 @@ struct LineSourceField {
 /// the trajectory with `inset` (m) removed at both ends (0: the whole trajectory; inset = r_w keeps
 /// the source strictly inside the wellbore, so that p is smooth up to the end caps).
 /// Anisotropic (scale != 1): the field is a line source in x' = x / scale; p = p_w at the
-/// equivalent wellbore (scaled_wellbore_radius from the scaled midpoint, perpendicular to the
+/// equivalent wellbore (the equivalent radius from the scaled midpoint, perpendicular to the
 /// scaled leg) and p = p_outer at the physical point outer_distance from the midpoint along the
 /// physical perpendicular. The wellbore frame is left Euclidean (set wellbore_scale /
 /// wellbore_radius for a mesh built in another frame).
