@@ -38,6 +38,17 @@ def load(out, metric, case, kv, kxky):
     return json.load(open(f)) if os.path.exists(f) else None
 
 
+def failures(out, metric, case, kv, kxky):
+    """level -> the first line of the solver's message, for the levels whose mesh failed."""
+    f = os.path.join(run_dir(out, metric, case, kv, kxky), "failure.txt")
+    got = {}
+    if os.path.exists(f):
+        for line in open(f):
+            head, _, msg = line.partition(": ")
+            got[int(head.split()[1])] = msg.strip()
+    return got
+
+
 def pct(v, signed=False):
     if v is None:
         return "-"
@@ -81,24 +92,38 @@ def main():
                 d = run_dir(a.out, metric, case, kv, kxky)
                 if os.path.exists(os.path.join(d, "accuracy.json")):
                     continue
-                cmd = ["nice", a.solver, "--accuracy", os.path.join(ROOT, "examples", "accuracy_%s.yaml" % case),
-                       "-o", d, "--levels", str(a.levels), "--metric", metric, "--kv-kh", "%g" % kv,
-                       "--kx-ky", "%g" % kxky]
-                t0 = time.time()
-                r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-                print("%s %s kv/kh=%g kx/ky=%g: exit %d, %.0f s" % (metric, case, kv, kxky, r.returncode,
-                                                                    time.time() - t0), flush=True)
-                if r.returncode != 0:
-                    print(r.stdout, file=sys.stderr, flush=True)
+                # A level whose mesh fails ends the run: the message goes to failure.txt and the
+                # lower levels are run again without it.
+                known = failures(a.out, metric, case, kv, kxky)  # a resumed sweep does not repeat them
+                top = min([a.levels] + [lvl - 1 for lvl in known])
+                for levels in range(top, 0, -1):
+                    cmd = ["nice", a.solver, "--accuracy", os.path.join(ROOT, "examples", "accuracy_%s.yaml" % case),
+                           "-o", d, "--levels", str(levels), "--metric", metric, "--kv-kh", "%g" % kv,
+                           "--kx-ky", "%g" % kxky]
+                    t0 = time.time()
+                    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                    print("%s %s kv/kh=%g kx/ky=%g levels %d: exit %d, %.0f s" % (
+                        metric, case, kv, kxky, levels, r.returncode, time.time() - t0), flush=True)
+                    if r.returncode == 0:
+                        break
+                    os.makedirs(d, exist_ok=True)
+                    with open(os.path.join(d, "failure.txt"), "a") as f:
+                        f.write("level %d: %s\n" % (levels, r.stdout.strip().splitlines()[0] if r.stdout.strip() else "?"))
     lines = ["| case | kv/kh | kx/ky | level | K-orth rate | K-orth near-well | K-orth L2 | Euclidean rate | "
              "Euclidean near-well | Euclidean L2 | Peaceman rate | Peaceman near-well | Peaceman L2 | cells (K-orth / Eucl. / Cart.) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     diag = ["| case | kv/kh | kx/ky | level | K-orth worst (region, side, distance) | Euclidean worst |",
             "|---|---|---|---|---|---|"]
+    failed = []
     for case, kv, kxky in runs:
         je, jk = load(a.out, "euclidean", case, kv, kxky), load(a.out, "permeability", case, kv, kxky)
+        fe, fk = failures(a.out, "euclidean", case, kv, kxky), failures(a.out, "permeability", case, kv, kxky)
         if kv == 1 and kxky == 1:
-            jk = je  # identity frame: the same mesh
+            jk, fk = je, fe  # identity frame: the same mesh
+        for lvl, msg in sorted(fk.items()):
+            failed.append("- %s, kv/kh %g, kx/ky %g, level %d, K-orthogonal: %s" % (case, kv, kxky, lvl, msg))
+        for lvl, msg in sorted(fe.items()):
+            failed.append("- %s, kv/kh %g, kx/ky %g, level %d, Euclidean: %s" % (case, kv, kxky, lvl, msg))
         if je is None and jk is None:
             continue
         nlev = max(len(j["refinement"]) for j in (je, jk) if j is not None)
@@ -115,6 +140,8 @@ def main():
                 (case, kv, kxky, factor) + model_cells(ko) + model_cells(eu) + model_cells(pc) + (cells,)))
             diag.append("| %s | %g | %g | %d | %s | %s |" % (case, kv, kxky, factor, where(ko), where(eu)))
     text = "\n".join(lines) + "\n\n" + "\n".join(diag) + "\n"
+    if failed:
+        text += "\nMesh failures (no row or a '-' where they are):\n\n" + "\n".join(failed) + "\n"
     print(text)
     if a.markdown:
         open(a.markdown, "w").write(text)
