@@ -7,10 +7,9 @@
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
-
-#include "meshgen/core/progress.hpp"
 #include <tbb/task_arena.h>
 
+#include "meshgen/core/progress.hpp"
 #include "perforations.hpp"
 
 namespace hm {
