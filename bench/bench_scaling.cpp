@@ -1,9 +1,10 @@
 // Scaling of the whole meshing job: a 2240 x 2240 x 100 m reservoir of 20 layers with 10
 // deviated wells, at three lateral resolutions (about 10k, 100k and 1M cells; the same wells).
 // Each case runs in a child process (its own peak memory) and prints one row: the stages'
-// seconds, peak resident memory (getrusage), cells per second, and the transition stage beside
-// raw CGAL Regular_triangulation_3 + power cells on the same weighted sites (the internal sites
-// of every cavity), in the same run. Usage: bench_scaling [LATERAL_CELLS ...] (default 22 71 224).
+// seconds (wall and CPU), peak resident memory of each stage, cells per second, the transition
+// stage beside raw CGAL Regular_triangulation_3 + power cells on the same weighted sites (the
+// internal sites of every cavity) in the same run, and fvcheck (the executable) on the written
+// VTU. Usage: bench_scaling [LATERAL_CELLS ...] (default 22 70 224: about 10k, 100k, 1M cells).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Regular_triangulation_3.h>
 #include <sys/resource.h>
@@ -13,12 +14,12 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "exporters/vtu/vtu_writer.hpp"
-#include "fvcheck/lib/checks.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 
 namespace {
@@ -81,38 +82,108 @@ double raw_cgal_seconds(const std::vector<std::pair<hm::Vec3, double>>& sites, l
   return since(t0);
 }
 
+// Resources of the stage that just ended: wall, CPU (user + system, every thread) and peak
+// resident memory. The peak is VmHWM, reset at each stage end (write "5" to
+// /proc/self/clear_refs), so each stage gets its own peak.
+struct StageUse {
+  std::string stage;
+  double wall = 0, cpu = 0, peak_mb = 0;
+};
+
+double cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+double peak_mb_and_reset() {
+  double kb = 0;
+  if (FILE* f = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    while (std::fgets(line, sizeof line, f))
+      if (std::strncmp(line, "VmHWM:", 6) == 0) kb = std::atof(line + 6);
+    std::fclose(f);
+  }
+  if (FILE* f = std::fopen("/proc/self/clear_refs", "w")) {
+    std::fputs("5", f);
+    std::fclose(f);
+  }
+  return kb / 1024.0;
+}
+
+class StageMeter {
+ public:
+  StageMeter() { peak_mb_and_reset(); }
+  void mark(const std::string& stage) {
+    const Clock::time_point now = Clock::now();
+    const double cpu = cpu_seconds();
+    uses.push_back({stage, std::chrono::duration<double>(now - wall_).count(), cpu - cpu_, peak_mb_and_reset()});
+    wall_ = Clock::now();
+    cpu_ = cpu_seconds();
+  }
+  std::vector<StageUse> uses;
+
+ private:
+  Clock::time_point wall_ = Clock::now();
+  double cpu_ = cpu_seconds();
+};
+
+// fvcheck on the written file, as its own process: wall seconds, CPU and peak memory (wait4).
+StageUse run_fvcheck_binary(const std::string& vtu, bool* ok) {
+  StageUse u{"fvcheck (own process)"};
+  const Clock::time_point t0 = Clock::now();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (!std::freopen("/dev/null", "w", stdout)) std::_Exit(3);
+    execl(HM_FVCHECK, HM_FVCHECK, vtu.c_str(), static_cast<char*>(nullptr));
+    std::_Exit(127);
+  }
+  int status = 0;
+  rusage ru{};
+  wait4(pid, &status, 0, &ru);
+  u.wall = since(t0);
+  u.cpu = ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  u.peak_mb = static_cast<double>(ru.ru_maxrss) / 1024.0;
+  *ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  return u;
+}
+
 void run_case(int lateral) {
   const hm::CaseSpec cs = scaling_case(lateral);
+  StageMeter meter;
+  hm::PipelineOptions opts;
+  opts.on_stage = [&](const std::string& stage) { meter.mark(stage); };
   const Clock::time_point t0 = Clock::now();
+  const double cpu0 = cpu_seconds();
   hm::HybridMesh h;
   try {
-    h = hm::build_hybrid_mesh(cs);
+    h = hm::build_hybrid_mesh(cs, opts);  // its last stage is the self-check
   } catch (const std::exception& e) {
     std::printf("%-8d failed: %s\n", lateral, e.what());
     return;
   }
   const double mesh_s = since(t0);
   Clock::time_point t1 = Clock::now();
-  // The checks fvcheck runs (the self-check of a written mesh).
-  bool ok = true;
-  for (const hm::CheckResult& r :
-       {hm::check_convexity(h.mesh, h.geometry), hm::check_conformity(h.mesh, h.geometry, {}, &h.build_report),
-        hm::check_closure(h.mesh, h.geometry), hm::check_volume(h.mesh, h.geometry),
-        hm::check_orthogonality(h.mesh, h.geometry), hm::check_auto_centering(h.mesh, h.geometry),
-        hm::check_planarity(h.mesh, h.geometry)})
-    ok = ok && r.ok();
-  const double check_s = since(t1);
-  t1 = Clock::now();
   const std::string vtu = (std::filesystem::temp_directory_path() / ("hm_bench_" + std::to_string(getpid()) + ".vtu")).string();
   const hm::WriteStatus st = hm::write_vtu(vtu, h.mesh);
   const double vtu_s = since(t1);
+  meter.mark("write_vtu");
+  const double total = mesh_s + vtu_s, total_cpu = cpu_seconds() - cpu0;
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  const double peak = static_cast<double>(ru.ru_maxrss) / 1024.0;  // whole job: mesh + self-check + VTU
   std::error_code ec;
   const double vtu_mb = static_cast<double>(std::filesystem::file_size(vtu, ec)) / 1e6;
-  std::filesystem::remove(vtu, ec);
-  double transition_s = 0, optimize_s = 0;
+  bool fv_ok = false;
+  const StageUse fv = run_fvcheck_binary(vtu, &fv_ok);
+  if (std::getenv("HM_BENCH_KEEP_VTU")) std::printf("         kept %s\n", vtu.c_str());  // for profiling fvcheck
+  else std::filesystem::remove(vtu, ec);
+  double transition_s = 0, optimize_s = 0, check_s = 0;
   int tcells = 0;
   for (const hm::TransitionReport& r : h.transition_reports)
     transition_s += r.seconds_delaunay + r.seconds_sites + r.seconds_power, optimize_s += r.seconds_optimize;
+  for (const auto& [stage, s] : h.timings_s)
+    if (stage == "self_check") check_s = s;
   // The same sites again (the transition meshes are deterministic) for raw CGAL.
   std::vector<std::pair<hm::Vec3, double>> sites;
   for (const hm::Cavity& cav : h.cavities.cavities) {
@@ -123,14 +194,16 @@ void run_case(int lateral) {
   }
   long raw_faces = 0;
   const double raw_s = raw_cgal_seconds(sites, &raw_faces);
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  const double total = mesh_s + check_s + vtu_s;
-  std::printf("%-8d %9d %6d %8.2f %8.2f %8.2f %8.2f %8.2f %7.2f %7.2f %8.2f %8.0f %9.0f %8.3f %s%s\n", lateral,
-              h.mesh.n_cells(), tcells, mesh_s, transition_s, optimize_s, check_s, vtu_s, vtu_mb / 1e3, total,
-              static_cast<double>(ru.ru_maxrss) / 1024.0, h.mesh.n_cells() / total, static_cast<double>(sites.size()),
-              raw_s, ok ? "" : "checks FAILED ", st.ok ? "" : st.message.c_str());
-  for (const auto& [stage, s] : h.timings_s) std::printf("         stage %-26s %8.2f s\n", stage.c_str(), s);
+  std::printf("%-8d %9d %6d %8.2f %8.2f %8.2f %8.2f %8.2f %7.3f %7.2f %7.2f %8.0f %9.0f %6.0f %8.3f %7.2f %7.0f %s%s%s\n",
+              lateral, h.mesh.n_cells(), tcells, mesh_s, transition_s, optimize_s, check_s, vtu_s, vtu_mb / 1e3,
+              total, total_cpu, peak, h.mesh.n_cells() / total, static_cast<double>(sites.size()), raw_s, fv.wall,
+              fv.peak_mb, st.ok ? "" : st.message.c_str(), fv_ok ? "" : " fvcheck FAILED",
+              raw_faces < 0 ? " raw CGAL: no faces" : "");
+  for (const StageUse& u : meter.uses)
+    std::printf("         stage %-26s wall %7.2f s  cpu %7.2f s  peak %7.0f MB\n", u.stage.c_str(), u.wall, u.cpu,
+                u.peak_mb);
+  std::printf("         stage %-26s wall %7.2f s  cpu %7.2f s  peak %7.0f MB\n", fv.stage.c_str(), fv.wall, fv.cpu,
+              fv.peak_mb);
   std::fflush(stdout);
 }
 
@@ -139,12 +212,16 @@ void run_case(int lateral) {
 int main(int argc, char** argv) {
   std::vector<int> laterals;
   for (int i = 1; i < argc; ++i) laterals.push_back(std::atoi(argv[i]));
-  if (laterals.empty()) laterals = {22, 71, 224};
-  std::printf("2240 x 2240 x 100 m, 20 layers, 10 deviated wells (R 6 m, 12 sectors, 6 rings); wall seconds; "
-              "transition/optimise: summed over cavities (run in parallel)\n");
-  std::printf("%-8s %9s %6s %8s %8s %8s %8s %8s %7s %7s %8s %8s %9s %8s\n", "lateral", "cells", "trans", "mesh_s",
-              "trans_s", "optim_s", "check_s", "vtu_s", "vtu_GB", "total_s", "peak_MB", "cells/s", "rawsites",
-              "rawCGAL_s");
+  if (laterals.empty()) laterals = {22, 70, 224};
+  double load[3] = {0, 0, 0};
+  getloadavg(load, 3);
+  std::printf("2240 x 2240 x 100 m, 20 layers, 10 deviated wells (R 6 m, 12 sectors, 6 rings); %ld cores, load "
+              "average %.1f %.1f %.1f\nwall seconds unless cpu; mesh_s = the whole pipeline incl. its self-check; "
+              "trans_s/optim_s: summed over cavities (run in parallel); total = mesh + VTU\n",
+              sysconf(_SC_NPROCESSORS_ONLN), load[0], load[1], load[2]);
+  std::printf("%-8s %9s %6s %8s %8s %8s %8s %8s %7s %7s %7s %8s %8s %6s %8s %7s %7s\n", "lateral", "cells", "trans",
+              "mesh_s", "trans_s", "optim_s", "check_s", "vtu_s", "vtu_GB", "total_s", "cpu_s", "peak_MB", "cells/s",
+              "sites", "rawCGAL", "fvchk_s", "fvch_MB");
   std::fflush(stdout);
   for (int n : laterals) {
     const pid_t pid = fork();

@@ -356,11 +356,21 @@ int64_t end_from_offsets(const Array& offsets, bool allow_minus_one, const char*
   return end;
 }
 
-using RawCell = std::vector<std::vector<int32_t>>;
+// The file's cells, flat (no vector per face): cell c's faces are face ids
+// [cell_ptr[c], cell_ptr[c + 1]), face f's point ids nodes[face_ptr[f] .. face_ptr[f + 1]).
+struct RawCells {
+  std::vector<int32_t> nodes;
+  std::vector<int64_t> face_ptr{0};
+  std::vector<int64_t> cell_ptr{0};
+  int64_t size() const { return static_cast<int64_t>(cell_ptr.size()) - 1; }
+  int64_t faces() const { return static_cast<int64_t>(face_ptr.size()) - 1; }
+  void end_face() { face_ptr.push_back(static_cast<int64_t>(nodes.size())); }
+  void end_cell() { cell_ptr.push_back(faces()); }
+};
 
 struct Parsed {
   std::vector<Vec3> points;
-  std::vector<RawCell> cells;
+  RawCells cells;
   std::vector<Array> cell_data;
   std::vector<int32_t> face_patch;
   bool has_face_patch = false;
@@ -399,51 +409,50 @@ void read_piece(const Source& src, vtkXMLDataElement* piece, Parsed& out) {
     }
     int64_t conn_begin = 0, face_begin = 0;
     for (int64_t c = 0; c < nc; ++c) {
-      const int64_t cid = static_cast<int64_t>(out.cells.size());
-      const std::string where = "cell " + std::to_string(cid) + ": ";
+      const int64_t cid = out.cells.size();
+      const std::string where_prefix = "cell ";
+      auto where = [&] { return where_prefix + std::to_string(cid) + ": "; };
       auto point_id = [&](int64_t v) {
         if (v < 0 || v >= np)
-          fail(where + "point id " + std::to_string(v) + " out of range [0, " + std::to_string(np) + ")");
+          fail(where() + "point id " + std::to_string(v) + " out of range [0, " + std::to_string(np) + ")");
         return static_cast<int32_t>(base + v);
       };
       const int64_t conn_end = offsets.i[c];
-      RawCell rc;
+      RawCells& rc = out.cells;
       const int64_t t = types.i[c];
       if (t == 42) {
         const int64_t face_end = faceoffsets.i[c];
-        if (face_end < face_begin) fail(where + "polyhedron without a face stream");
+        if (face_end < face_begin) fail(where() + "polyhedron without a face stream");
         int64_t p = face_begin;
         auto next = [&]() {
-          if (p >= face_end) fail(where + "face stream ends early");
+          if (p >= face_end) fail(where() + "face stream ends early");
           return faces.i[p++];
         };
         const int64_t nfaces = next();
-        if (nfaces < 1 || nfaces > face_end - p) fail(where + "bad number of faces " + std::to_string(nfaces));
+        if (nfaces < 1 || nfaces > face_end - p) fail(where() + "bad number of faces " + std::to_string(nfaces));
         for (int64_t k = 0; k < nfaces; ++k) {
           const int64_t nv = next();
-          if (nv < 0 || nv > face_end - p) fail(where + "bad face size " + std::to_string(nv));
-          std::vector<int32_t> fv;
-          for (int64_t q = 0; q < nv; ++q) fv.push_back(point_id(next()));
-          rc.push_back(std::move(fv));
+          if (nv < 0 || nv > face_end - p) fail(where() + "bad face size " + std::to_string(nv));
+          for (int64_t q = 0; q < nv; ++q) rc.nodes.push_back(point_id(next()));
+          rc.end_face();
         }
-        if (p != face_end) fail(where + "faces stream has " + std::to_string(face_end - p) + " extra entries");
+        if (p != face_end) fail(where() + "faces stream has " + std::to_string(face_end - p) + " extra entries");
         face_begin = face_end;
       } else {
         int npts = 0;
         const std::vector<std::vector<int>>* tmpl =
             standard_faces(static_cast<int>(std::clamp<int64_t>(t, -1, 1000)), &npts);
-        if (!tmpl) fail(where + "unsupported VTK cell type " + std::to_string(t));
+        if (!tmpl) fail(where() + "unsupported VTK cell type " + std::to_string(t));
         if (conn_end - conn_begin != npts)
-          fail(where + "type " + std::to_string(t) + " needs " + std::to_string(npts) + " points, got " +
+          fail(where() + "type " + std::to_string(t) + " needs " + std::to_string(npts) + " points, got " +
                std::to_string(conn_end - conn_begin));
         for (const auto& lf : *tmpl) {
-          std::vector<int32_t> fv;
-          for (int k : lf) fv.push_back(point_id(conn.i[conn_begin + k]));
-          rc.push_back(std::move(fv));
+          for (int k : lf) rc.nodes.push_back(point_id(conn.i[conn_begin + k]));
+          rc.end_face();
         }
       }
       conn_begin = conn_end;
-      out.cells.push_back(std::move(rc));
+      rc.end_cell();
     }
   }
   // Cell data of this piece, appended to the previous pieces' arrays of the same name.
@@ -505,9 +514,8 @@ Parsed parse_document(Source& src) {
     read_piece(src, e, out);
   }
   if (pieces == 0) fail("no <Piece> element");
-  if (out.cells.empty()) fail("the file has no cells");
-  int64_t total_faces = 0;
-  for (const RawCell& rc : out.cells) total_faces += static_cast<int64_t>(rc.size());
+  if (out.cells.size() == 0) fail("the file has no cells");
+  const int64_t total_faces = out.cells.faces();
   if (vtkXMLDataElement* fp = data_array(child(grid, "FieldData"), "face_patch")) {
     const int64_t n = count_attr(fp, "NumberOfTuples", kMaxIds);
     if (n == total_faces && pieces == 1) {
@@ -531,30 +539,38 @@ ReadResult convert(Parsed&& in) {
   ReadResult res;
   res.has_face_patch = in.has_face_patch;
   res.warnings = std::move(in.warnings);
+  const RawCells& cells = in.cells;
+  std::vector<int32_t> f;  // one face's point ids
+  auto load_face = [&](int64_t q) {
+    f.assign(cells.nodes.begin() + cells.face_ptr[q], cells.nodes.begin() + cells.face_ptr[q + 1]);
+  };
   std::map<std::vector<int32_t>, int> uses;
   if (!res.has_face_patch)
-    for (const RawCell& faces : in.cells)
-      for (const auto& f : faces)
-        if (f.size() >= 3) ++uses[canonical_cycle(f, nullptr)];
+    for (int64_t q = 0; q < cells.faces(); ++q) {
+      load_face(q);
+      if (f.size() >= 3) ++uses[canonical_cycle(f, nullptr)];
+    }
   MeshBuilder mb;
   for (const Vec3& p : in.points) mb.add_node(p);
-  size_t k = 0;
-  for (const RawCell& faces : in.cells) {
-    std::vector<CellFace> cf;
-    for (const auto& f : faces) {
-      CellFace face;
-      face.nodes = f;
+  in.points = {};
+  std::vector<CellFace> cf;  // reused from cell to cell
+  for (int64_t c = 0; c < cells.size(); ++c) {
+    cf.resize(static_cast<size_t>(cells.cell_ptr[c + 1] - cells.cell_ptr[c]));
+    for (int64_t q = cells.cell_ptr[c]; q < cells.cell_ptr[c + 1]; ++q) {
+      load_face(q);
+      CellFace& face = cf[static_cast<size_t>(q - cells.cell_ptr[c])];
+      face.nodes.assign(f.begin(), f.end());
       if (res.has_face_patch) {
-        face.patch = in.face_patch[k];
+        face.patch = in.face_patch[q];
       } else {
         auto it = f.size() >= 3 ? uses.find(canonical_cycle(f, nullptr)) : uses.end();
         face.patch = it != uses.end() && it->second >= 2 ? kInteriorFace : kOuterBoundary;
       }
-      ++k;
-      cf.push_back(std::move(face));
     }
     mb.add_cell(cf, CellAttributes{});
   }
+  in.cells = RawCells{};
+  in.face_patch = {};
   res.mesh = mb.finish(&res.build);
   PolyMesh& m = res.mesh;
   for (const Array& a : in.cell_data) {

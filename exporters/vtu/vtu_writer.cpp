@@ -26,12 +26,14 @@ bool host_is_little_endian() {
   return b == 1;
 }
 
-// One appended block: the DataArray header line and the raw bytes (without the UInt64 count).
+// One appended block: the DataArray header line and a view of the raw bytes (without the
+// UInt64 count); the bytes stay in the arrays they come from (no copy of the mesh).
 struct Block {
   std::string type, name;
   int components = 1;
   int64_t tuples = -1;  // NumberOfTuples (field data only)
-  std::string bytes;
+  const char* data = nullptr;
+  size_t size = 0;
 };
 
 template <class T>
@@ -40,7 +42,8 @@ Block make_block(const std::string& type, const std::string& name, int component
   b.type = type;
   b.name = name;
   b.components = components;
-  b.bytes.assign(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  b.data = reinterpret_cast<const char*>(v.data());
+  b.size = v.size() * sizeof(T);
   return b;
 }
 
@@ -54,21 +57,35 @@ void header_line(std::ostringstream& xml, const Block& b, uint64_t offset, const
 // VTK_HEXAHEDRON's faces as local point indices, outward (vtkHexahedron's face order).
 constexpr int kHexFaces[6][4] = {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}};
 
+// The canonical form of a quadrilateral cycle (canonical_cycle on 4 ids, without allocation).
+std::array<int32_t, 4> canonical_quad(const int32_t* q, bool* reversed) {
+  const int k = static_cast<int>(std::min_element(q, q + 4) - q);
+  const bool rev = q[(k + 3) % 4] < q[(k + 1) % 4];
+  std::array<int32_t, 4> out;
+  for (int i = 0; i < 4; ++i) out[i] = rev ? q[(k + 4 - i) % 4] : q[(k + i) % 4];
+  *reversed = rev;
+  return out;
+}
+
 // A cell whose six outward quadrilaterals are, cycle for cycle and orientation for orientation,
 // the faces of a VTK_HEXAHEDRON on 8 distinct nodes: returns true with the 8 point ids in VTK
 // order and, for each VTK face k, the cell-local index of the face it is (`which[k]`).
 // Combinatorial only: the geometry (planar or not) is the same whichever type is written.
-bool as_hexahedron(const std::vector<std::vector<int32_t>>& faces, std::array<int32_t, 8>* pts,
+// The cell's outward cycles are nodes[off[i] .. off[i + 1]) for i < n_faces.
+bool as_hexahedron(const std::vector<int32_t>& nodes, const std::vector<int>& off, std::array<int32_t, 8>* pts,
                    std::array<int, 6>* which) {
-  if (faces.size() != 6) return false;
-  for (const auto& f : faces)
-    if (f.size() != 4) return false;
+  const int n_faces = static_cast<int>(off.size()) - 1;
+  if (n_faces != 6) return false;
+  for (int q = 0; q < 6; ++q)
+    if (off[q + 1] - off[q] != 4) return false;
+  auto face = [&](int q) { return nodes.data() + off[q]; };
   // Bottom: the first face, whose outward cycle is VTK's (0, 3, 2, 1).
-  const auto& b = faces[0];
+  const int32_t* b = face(0);
   std::array<int32_t, 8> p{b[0], b[3], b[2], b[1], -1, -1, -1, -1};
   for (int i = 0; i < 4; ++i) {
     // p[i + 4]: the one node joined to p[i] by an edge that is not on the bottom face.
-    for (const auto& f : faces)
+    for (int q = 0; q < 6; ++q) {
+      const int32_t* f = face(q);
       for (int e = 0; e < 4; ++e) {
         const int32_t u = f[e], v = f[(e + 1) % 4];
         const int32_t other = u == p[i] ? v : v == p[i] ? u : -1;
@@ -76,24 +93,28 @@ bool as_hexahedron(const std::vector<std::vector<int32_t>>& faces, std::array<in
         if (p[i + 4] >= 0 && p[i + 4] != other) return false;
         p[i + 4] = other;
       }
+    }
     if (p[i + 4] < 0) return false;
   }
   std::array<int32_t, 8> sorted = p;
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;
-  std::vector<std::pair<std::vector<int32_t>, bool>> keys;
-  for (const auto& f : faces) {
+  std::array<std::array<int32_t, 4>, 6> keys;
+  std::array<bool, 6> revs;
+  for (int q = 0; q < 6; ++q) {
     bool rev = false;
-    std::vector<int32_t> k = canonical_cycle(f, &rev);
-    keys.emplace_back(std::move(k), rev);
+    keys[q] = canonical_quad(face(q), &rev);
+    revs[q] = rev;
   }
   for (int k = 0; k < 6; ++k) {
     bool rev = false;
-    const std::vector<int32_t> key =
-        canonical_cycle({p[kHexFaces[k][0]], p[kHexFaces[k][1]], p[kHexFaces[k][2]], p[kHexFaces[k][3]]}, &rev);
-    const auto it = std::find(keys.begin(), keys.end(), std::make_pair(key, rev));
-    if (it == keys.end()) return false;
-    (*which)[k] = static_cast<int>(it - keys.begin());
+    const int32_t quad[4] = {p[kHexFaces[k][0]], p[kHexFaces[k][1]], p[kHexFaces[k][2]], p[kHexFaces[k][3]]};
+    const std::array<int32_t, 4> key = canonical_quad(quad, &rev);
+    int found = -1;
+    for (int q = 0; q < 6 && found < 0; ++q)
+      if (keys[q] == key && revs[q] == rev) found = q;
+    if (found < 0) return false;
+    (*which)[k] = found;
   }
   *pts = p;
   return true;
@@ -126,35 +147,43 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   std::vector<uint8_t> types(nc, 42);
   std::vector<int32_t> face_patch;
   std::vector<int64_t> stamp(m.nodes.size(), -1);
-  std::vector<std::vector<int32_t>> local;
+  // The cell's outward cycles, flat (reused from cell to cell).
+  std::vector<int32_t> local;
+  std::vector<int> local_off;
   std::vector<int32_t> local_patch;
   bool any_polyhedron = false;
+  connectivity.reserve(8 * nc);
+  offsets.reserve(nc);
+  faceoffsets.reserve(nc);
+  face_patch.reserve(m.cell_faces.size());
   for (size_t c = 0; c < nc; ++c) {
     const int ci = static_cast<int>(c);
     local.clear();
+    local_off.assign(1, 0);
     local_patch.clear();
     for (const int32_t* fp = m.cell_begin(ci); fp != m.cell_end(ci); ++fp) {
       const int f = *fp, k = m.face_size(f);
       const int32_t* v = m.face_begin(f);
       const bool own = m.face_owner[f] == ci;
-      std::vector<int32_t> cyc(k);
       // The neighbour sees the face reversed: v0, v_{k-1}, ..., v1.
-      for (int i = 0; i < k; ++i) cyc[i] = own ? v[i] : v[(k - i) % k];
-      local.push_back(std::move(cyc));
+      for (int i = 0; i < k; ++i) local.push_back(own ? v[i] : v[(k - i) % k]);
+      local_off.push_back(static_cast<int>(local.size()));
       local_patch.push_back(m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f]);
     }
     std::array<int32_t, 8> hex{};
     std::array<int, 6> which{};
-    if (as_hexahedron(local, &hex, &which)) {
+    if (as_hexahedron(local, local_off, &hex, &which)) {
       types[c] = 12;
       connectivity.insert(connectivity.end(), hex.begin(), hex.end());
       for (int k = 0; k < 6; ++k) face_patch.push_back(local_patch[which[k]]);
     } else {
       any_polyhedron = true;
-      faces.push_back(static_cast<int64_t>(local.size()));
-      for (size_t q = 0; q < local.size(); ++q) {
-        faces.push_back(static_cast<int64_t>(local[q].size()));
-        for (int32_t id : local[q]) {
+      const size_t n_local = local_off.size() - 1;
+      faces.push_back(static_cast<int64_t>(n_local));
+      for (size_t q = 0; q < n_local; ++q) {
+        faces.push_back(static_cast<int64_t>(local_off[q + 1] - local_off[q]));
+        for (int i = local_off[q]; i < local_off[q + 1]; ++i) {
+          const int32_t id = local[i];
           faces.push_back(id);
           if (stamp[id] != static_cast<int64_t>(c)) {
             stamp[id] = static_cast<int64_t>(c);
@@ -168,6 +197,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
     // VTK's faceoffsets: end of the cell's face stream, -1 for a cell that is not a polyhedron.
     faceoffsets.push_back(types[c] == 42 ? static_cast<int64_t>(faces.size()) : -1);
   }
+  stamp = {};
   std::vector<double> points(3 * m.nodes.size());
   for (size_t i = 0; i < m.nodes.size(); ++i) {
     points[3 * i] = m.nodes[i].x;
@@ -184,7 +214,8 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
     cell_blocks.push_back(make_block("Int64", "faceoffsets", 1, faceoffsets));
   }
   std::vector<Block> data_blocks;
-  for (const VtuCellArray& a : mesh_cell_arrays(m))
+  const std::vector<VtuCellArray> own_arrays = mesh_cell_arrays(m);
+  for (const VtuCellArray& a : own_arrays)
     data_blocks.push_back(a.integer ? make_block("Int32", a.name, a.components, a.ints)
                                     : make_block("Float64", a.name, a.components, a.values));
   for (const VtuCellArray& a : extra)
@@ -196,7 +227,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   uint64_t offset = 0;
   auto place = [&](const Block& b, const char* indent) {
     header_line(xml, b, offset, indent);
-    offset += sizeof(uint64_t) + b.bytes.size();
+    offset += sizeof(uint64_t) + b.size;
   };
   xml << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\""
       << (host_is_little_endian() ? "LittleEndian" : "BigEndian") << "\" header_type=\"UInt64\">\n";
@@ -217,9 +248,9 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   const std::string head = xml.str();
   out.write(head.data(), static_cast<std::streamsize>(head.size()));
   auto emit = [&](const Block& b) {
-    const uint64_t n = b.bytes.size();
+    const uint64_t n = b.size;
     out.write(reinterpret_cast<const char*>(&n), sizeof n);
-    out.write(b.bytes.data(), static_cast<std::streamsize>(b.bytes.size()));
+    out.write(b.data, static_cast<std::streamsize>(b.size));
   };
   emit(field);
   for (const Block& b : point_blocks) emit(b);

@@ -1,10 +1,12 @@
 // fvcheck MESH.vtu [--json REPORT.json] [--html REPORT.html [--png]] [--min-orthogonality DEG] [--max-planarity DEG]
+//         [-j N] [--quiet]
 // Checks the finite-volume properties of a mesh (docs/fvcheck.md).
 // Exit codes: 0 every check holds, 1 a check fails, 2 unreadable input or bad arguments.
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "exporters/png/mesh_pictures.hpp"
@@ -13,12 +15,14 @@
 #include "fvcheck/lib/report.hpp"
 #include "fvcheck/lib/report_json.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/parallel.hpp"
+#include "meshgen/core/progress.hpp"
 
 namespace {
 
 const char* kUsage =
     "usage: fvcheck MESH.vtu [--json REPORT.json] [--html REPORT.html [--png]] [--min-orthogonality DEG] "
-    "[--max-planarity DEG]";
+    "[--max-planarity DEG] [-j THREADS] [--quiet]";
 // --help only (an error stays one line): what --png does.
 const char* kPicturesHelp =
     "  the HTML report shows the pictures meshgen --png wrote beside the mesh (when not older than it);\n"
@@ -43,6 +47,8 @@ int main(int argc, char** argv) {
   std::string mesh_path, json_path, html_path;
   bool render_pictures = false;
   hm::CheckOptions opt;
+  int threads = 0;
+  bool quiet = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](std::string* out) {
@@ -66,6 +72,14 @@ int main(int argc, char** argv) {
     } else if (a == "--max-planarity") {
       if (!value(&v) || !parse_degrees(v, &opt.max_planarity_deg))
         return usage_error("--max-planarity needs an angle in [0, 90] degrees");
+    } else if (a == "-j" || a == "--jobs") {
+      char* end = nullptr;
+      const long j = value(&v) ? std::strtol(v.c_str(), &end, 10) : 0;
+      if (v.empty() || !end || *end != '\0' || j < 1 || j > 1024)
+        return usage_error("-j needs a number of threads in [1, 1024]");
+      threads = static_cast<int>(j);
+    } else if (a == "-q" || a == "--quiet") {
+      quiet = true;
     } else if (!a.empty() && a[0] == '-') {
       return usage_error("unknown option " + a);
     } else if (mesh_path.empty()) {
@@ -83,8 +97,12 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  hm::set_progress_output(hm::progress_wanted(quiet), "fvcheck");
+  const hm::ThreadLimit thread_limit(threads);  // 0: every core
 
+  std::optional<hm::Progress> reading(std::in_place, "reading " + mesh_path);
   hm::ReadResult in = hm::read_vtu(mesh_path);
+  reading.reset();
   if (!in.ok) {
     std::cerr << "fvcheck: " << in.error << "\n";
     return 2;
@@ -107,6 +125,7 @@ int main(int argc, char** argv) {
       for (hm::Vec3& k : in.mesh.cell_perm) k = {1, 1, 1};
       report.notes.push_back("no permeability array: transmissibilities computed with k = 1 mD (geometric part)");
     }
+    const hm::Progress progress("transmissibilities");
     const hm::MeshGeometry geo = hm::compute_geometry(in.mesh);
     const hm::Transmissibilities t = hm::compute_transmissibilities(in.mesh, geo);
     report.transmissibility = hm::summarize_transmissibilities(t.face);

@@ -1,11 +1,14 @@
 #include "checks.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <numeric>
 
+#include "meshgen/core/parallel.hpp"
 #include "quality.hpp"
 
 namespace hm {
@@ -106,55 +109,92 @@ double point_triangle_distance(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
   return norm(p - (a + v * ab + w * ac));
 }
 
-// Static k-d tree over a subset of nodes, for box queries (hanging-node search).
-class NodeTree {
+// Uniform grid of a subset of nodes, for box queries (hanging-node search): buckets of side
+// `cell` (the median face extent, so that a face's box meets a few buckets), nodes sorted by
+// (bucket, id), a bucket's range found through an open-addressing hash of its index. A k-d
+// tree split at medians visits both sides of every tie, and a reservoir lattice is all ties.
+class NodeGrid {
  public:
-  NodeTree(const std::vector<Vec3>& pts, std::vector<int32_t> ids) : pts_(pts), idx_(std::move(ids)) {
-    axis_.assign(idx_.size(), 0);
-    build(0, static_cast<int>(idx_.size()));
+  NodeGrid(const std::vector<Vec3>& pts, const std::vector<int32_t>& ids, double cell) : pts_(pts) {
+    lo_ = {DBL_MAX, DBL_MAX, DBL_MAX};
+    Vec3 hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (int32_t v : ids)
+      for (int a = 0; a < 3; ++a) lo_[a] = std::min(lo_[a], pts[v][a]), hi[a] = std::max(hi[a], pts[v][a]);
+    if (ids.empty()) return;
+    const double extent = std::max({hi.x - lo_.x, hi.y - lo_.y, hi.z - lo_.z});
+    cell_ = std::isfinite(cell) && cell > 0 ? cell : 1.0;
+    if (extent / cell_ > kMaxDim - 1) cell_ = extent / (kMaxDim - 1);
+    if (!(cell_ > 0)) cell_ = 1.0;
+    for (int a = 0; a < 3; ++a) dim_[a] = std::min<int64_t>(kMaxDim, static_cast<int64_t>((hi[a] - lo_[a]) / cell_) + 1);
+    std::vector<std::pair<uint64_t, int32_t>> keyed;
+    keyed.reserve(ids.size());
+    for (int32_t v : ids) keyed.emplace_back(key_of(pts[v]), v);
+    std::sort(keyed.begin(), keyed.end());
+    ids_.resize(keyed.size());
+    for (size_t i = 0; i < keyed.size(); ++i) ids_[i] = keyed[i].second;
+    for (size_t i = 0; i < keyed.size(); ++i)
+      if (i == 0 || keyed[i].first != keyed[i - 1].first) keys_.push_back(keyed[i].first), begin_.push_back(i);
+    begin_.push_back(keyed.size());
+    size_t size = 16;
+    while (size < 2 * keys_.size()) size *= 2;
+    table_.assign(size, -1);
+    for (size_t b = 0; b < keys_.size(); ++b) {
+      size_t h = slot(keys_[b]);
+      while (table_[h] >= 0) h = (h + 1) & (table_.size() - 1);
+      table_[h] = static_cast<int64_t>(b);
+    }
   }
+  // Visits every node inside the box [lo, hi], bucket by bucket (z, y, x order), by id within one.
   template <class Visit>
   void query(Vec3 lo, Vec3 hi, Visit visit) const {
-    std::vector<std::pair<int, int>> stack{{0, static_cast<int>(idx_.size())}};
-    while (!stack.empty()) {
-      auto [b, e] = stack.back();
-      stack.pop_back();
-      if (b >= e) continue;
-      const int m = b + (e - b) / 2;
-      const Vec3 p = pts_[idx_[m]];
-      if (p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z) visit(idx_[m]);
-      const int a = axis_[m];
-      if (lo[a] <= p[a]) stack.emplace_back(b, m);
-      if (hi[a] >= p[a]) stack.emplace_back(m + 1, e);
+    if (ids_.empty()) return;
+    int64_t i0[3], i1[3];
+    for (int a = 0; a < 3; ++a) i0[a] = index(lo[a], a), i1[a] = index(hi[a], a);
+    auto inside = [&](Vec3 p) {
+      return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+    };
+    const double buckets = static_cast<double>(i1[0] - i0[0] + 1) * (i1[1] - i0[1] + 1) * (i1[2] - i0[2] + 1);
+    if (buckets > static_cast<double>(keys_.size())) {  // a box larger than the occupied grid: scan it all
+      for (size_t b = 0; b < keys_.size(); ++b)
+        for (size_t i = begin_[b]; i < begin_[b + 1]; ++i)
+          if (inside(pts_[ids_[i]])) visit(ids_[i]);
+      return;
     }
+    for (int64_t z = i0[2]; z <= i1[2]; ++z)
+      for (int64_t y = i0[1]; y <= i1[1]; ++y)
+        for (int64_t x = i0[0]; x <= i1[0]; ++x) {
+          const int64_t b = find(static_cast<uint64_t>((z * dim_[1] + y) * dim_[0] + x));
+          if (b < 0) continue;
+          for (size_t i = begin_[b]; i < begin_[b + 1]; ++i)
+            if (inside(pts_[ids_[i]])) visit(ids_[i]);
+        }
   }
 
  private:
-  void build(int b, int e) {
-    std::vector<std::pair<int, int>> stack{{b, e}};
-    while (!stack.empty()) {
-      auto [lo_i, hi_i] = stack.back();
-      stack.pop_back();
-      if (hi_i - lo_i <= 1) continue;
-      Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
-      for (int i = lo_i; i < hi_i; ++i)
-        for (int k = 0; k < 3; ++k) {
-          lo[k] = std::min(lo[k], pts_[idx_[i]][k]);
-          hi[k] = std::max(hi[k], pts_[idx_[i]][k]);
-        }
-      const Vec3 ext = hi - lo;
-      const int a = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-      const int m = lo_i + (hi_i - lo_i) / 2;
-      std::nth_element(idx_.begin() + lo_i, idx_.begin() + m, idx_.begin() + hi_i,
-                       [&](int32_t u, int32_t v) { return pts_[u][a] < pts_[v][a]; });
-      axis_[m] = static_cast<int8_t>(a);
-      stack.emplace_back(lo_i, m);
-      stack.emplace_back(m + 1, hi_i);
+  static constexpr int64_t kMaxDim = int64_t(1) << 20;
+  int64_t index(double x, int a) const {
+    const double t = std::floor((x - lo_[a]) / cell_);
+    if (!(t > 0)) return 0;  // also NaN
+    return std::min<int64_t>(dim_[a] - 1, static_cast<int64_t>(std::min(t, static_cast<double>(kMaxDim))));
+  }
+  uint64_t key_of(Vec3 p) const {
+    return static_cast<uint64_t>((index(p.z, 2) * dim_[1] + index(p.y, 1)) * dim_[0] + index(p.x, 0));
+  }
+  size_t slot(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 17) & (table_.size() - 1); }
+  int64_t find(uint64_t key) const {
+    for (size_t h = slot(key);; h = (h + 1) & (table_.size() - 1)) {
+      const int64_t b = table_[h];
+      if (b < 0 || keys_[b] == key) return b;
     }
   }
   const std::vector<Vec3>& pts_;
-  std::vector<int32_t> idx_;
-  std::vector<int8_t> axis_;
+  Vec3 lo_;
+  double cell_ = 1.0;
+  int64_t dim_[3] = {1, 1, 1};
+  std::vector<int32_t> ids_;      // sorted by (bucket, id)
+  std::vector<uint64_t> keys_;    // occupied buckets, ascending
+  std::vector<size_t> begin_;     // bucket b: ids_[begin_[b] .. begin_[b + 1])
+  std::vector<int64_t> table_;    // hash slot -> bucket, -1 empty
 };
 
 double cross2(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
@@ -183,19 +223,26 @@ CellScales compute_cell_scales(const PolyMesh& m, double rel_tol) {
   CellScales s;
   s.length.assign(m.n_cells(), 0.0);
   s.tol.assign(m.n_cells(), 0.0);
-  std::vector<int32_t> ids;
-  for (int c = 0; c < m.n_cells(); ++c) {
-    ids = cell_node_ids(m, c);
-    scale_of(m.nodes, ids.data(), ids.data() + ids.size(), rel_tol, &s.length[c], &s.tol[c]);
-  }
+  parallel_ranges(m.n_cells(), [&](int64_t b, int64_t e) {
+    std::vector<int32_t> ids;
+    for (int c = static_cast<int>(b); c < e; ++c) {
+      cell_node_ids_into(m, c, &ids);
+      scale_of(m.nodes, ids.data(), ids.data() + ids.size(), rel_tol, &s.length[c], &s.tol[c]);
+    }
+  });
   return s;
+}
+
+void cell_node_ids_into(const PolyMesh& m, int c, std::vector<int32_t>* ids) {
+  ids->clear();
+  for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) ids->insert(ids->end(), m.face_begin(*f), m.face_end(*f));
+  std::sort(ids->begin(), ids->end());
+  ids->erase(std::unique(ids->begin(), ids->end()), ids->end());
 }
 
 std::vector<int32_t> cell_node_ids(const PolyMesh& m, int c) {
   std::vector<int32_t> ids;
-  for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) ids.insert(ids.end(), m.face_begin(*f), m.face_end(*f));
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  cell_node_ids_into(m, c, &ids);
   return ids;
 }
 
@@ -253,39 +300,50 @@ CheckResult check_convexity(const PolyMesh& m, const MeshGeometry& geo, const Ch
   r.values.assign(m.n_cells(), 0.0);
   const CellScales sc = compute_cell_scales(m, opt.rel_tol);
   std::vector<int> defect(m.n_faces());
+  parallel_ranges(m.n_faces(), [&](int64_t b, int64_t e) {
+    for (int f = static_cast<int>(b); f < e; ++f)
+      defect[f] = face_polygon_defect(m.nodes, m.face_begin(f), m.face_end(f), opt.rel_tol);
+  });
   int64_t reflex = 0, non_simple = 0, degenerate = 0;
   std::vector<int32_t> ex_reflex, ex_non_simple, ex_degenerate, ex_outside;
   for (int f = 0; f < m.n_faces(); ++f) {
-    defect[f] = face_polygon_defect(m.nodes, m.face_begin(f), m.face_end(f), opt.rel_tol);
     if (defect[f] == 1) ++reflex, push_example(ex_reflex, f);
     if (defect[f] == 2) ++non_simple, push_example(ex_non_simple, f);
     if (defect[f] == 3) ++degenerate, push_example(ex_degenerate, f);
   }
+  // Per cell (in parallel): its value and 1 = a node outside a face plane, 2 = a bad face.
+  std::vector<char> flags(m.n_cells(), 0);
+  parallel_ranges(m.n_cells(), [&](int64_t cb, int64_t ce) {
+    std::vector<int32_t> ids;
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      cell_node_ids_into(m, c, &ids);
+      const double L = sc.length[c];
+      double worst = -std::numeric_limits<double>::infinity();
+      bool bad_face = false;
+      for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+        const int f = *fp;
+        if (defect[f] != 0) bad_face = true;
+        const Vec3 a = m.face_sign(f, c) * geo.face_area[f];
+        const double an = norm(a);
+        if (!(an > 0)) continue;  // degenerate face: already flagged
+        const Vec3 n = a / an;
+        for (int32_t v : ids) {
+          if (std::find(m.face_begin(f), m.face_end(f), v) != m.face_end(f)) continue;
+          worst = std::max(worst, dot(m.nodes[v] - geo.face_centroid[f], n));
+        }
+      }
+      const bool outside = worst > sc.tol[c];
+      double value = L > 0 && std::isfinite(worst) ? worst / L : (std::isfinite(worst) ? 0.0 : -1.0);
+      if (std::isnan(worst)) value = 1.0;
+      if (bad_face) value = std::max(value, 1.0);
+      r.values[c] = value;
+      flags[c] = static_cast<char>((outside ? 1 : 0) | (bad_face ? 2 : 0));
+    }
+  });
   int64_t outside_cells = 0;
   for (int c = 0; c < m.n_cells(); ++c) {
-    const std::vector<int32_t> ids = cell_node_ids(m, c);
-    const double L = sc.length[c];
-    double worst = -std::numeric_limits<double>::infinity();
-    bool bad_face = false;
-    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
-      const int f = *fp;
-      if (defect[f] != 0) bad_face = true;
-      const Vec3 a = m.face_sign(f, c) * geo.face_area[f];
-      const double an = norm(a);
-      if (!(an > 0)) continue;  // degenerate face: already flagged
-      const Vec3 n = a / an;
-      for (int32_t v : ids) {
-        if (std::find(m.face_begin(f), m.face_end(f), v) != m.face_end(f)) continue;
-        worst = std::max(worst, dot(m.nodes[v] - geo.face_centroid[f], n));
-      }
-    }
-    const bool outside = worst > sc.tol[c];
-    double value = L > 0 && std::isfinite(worst) ? worst / L : (std::isfinite(worst) ? 0.0 : -1.0);
-    if (std::isnan(worst)) value = 1.0;
-    if (bad_face) value = std::max(value, 1.0);
-    r.values[c] = value;
-    if (outside) ++outside_cells, push_example(ex_outside, c);
-    if (outside || bad_face) ++r.violations;
+    if (flags[c] & 1) ++outside_cells, push_example(ex_outside, c);
+    if (flags[c]) ++r.violations;
   }
   rank_worst(r, true);
   r.counts = {{"cells_with_node_outside_face_plane", outside_cells},
@@ -319,11 +377,13 @@ CheckResult check_conformity(const PolyMesh& m, const MeshGeometry& geo, const C
 
   // (b) Two face records over the same node set: a face used by more than two cells.
   std::vector<int32_t> sorted_ptr(nf + 1, 0), sorted_nodes(m.face_nodes.size());
-  for (int f = 0; f < nf; ++f) {
-    sorted_ptr[f + 1] = m.face_node_ptr[f + 1];
-    std::copy(m.face_begin(f), m.face_end(f), sorted_nodes.begin() + m.face_node_ptr[f]);
-    std::sort(sorted_nodes.begin() + m.face_node_ptr[f], sorted_nodes.begin() + m.face_node_ptr[f + 1]);
-  }
+  parallel_ranges(nf, [&](int64_t b, int64_t e) {
+    for (int f = static_cast<int>(b); f < e; ++f) {
+      sorted_ptr[f + 1] = m.face_node_ptr[f + 1];
+      std::copy(m.face_begin(f), m.face_end(f), sorted_nodes.begin() + m.face_node_ptr[f]);
+      std::sort(sorted_nodes.begin() + m.face_node_ptr[f], sorted_nodes.begin() + m.face_node_ptr[f + 1]);
+    }
+  });
   auto key_less = [&](int32_t a, int32_t b) {
     return std::lexicographical_compare(sorted_nodes.begin() + sorted_ptr[a], sorted_nodes.begin() + sorted_ptr[a + 1],
                                         sorted_nodes.begin() + sorted_ptr[b], sorted_nodes.begin() + sorted_ptr[b + 1]);
@@ -348,72 +408,111 @@ CheckResult check_conformity(const PolyMesh& m, const MeshGeometry& geo, const C
     int32_t lo, hi;
     bool forward;  // traversed lo -> hi
   };
-  std::vector<DirEdge> edges;
-  for (int c = 0; c < nc; ++c) {
-    edges.clear();
-    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
-      const int f = *fp, k = m.face_size(f);
-      const int32_t* v = m.face_begin(f);
-      const bool own = m.face_sign(f, c) > 0;
-      for (int i = 0; i < k; ++i) {
-        int32_t a = v[i], b = v[(i + 1) % k];
-        if (!own) std::swap(a, b);
-        edges.push_back(a < b ? DirEdge{a, b, true} : DirEdge{b, a, false});
+  std::vector<char> surface(nc, 0);  // 1: open, 2: misoriented
+  parallel_ranges(nc, [&](int64_t cb, int64_t ce) {
+    std::vector<DirEdge> edges;
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      edges.clear();
+      for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+        const int f = *fp, k = m.face_size(f);
+        const int32_t* v = m.face_begin(f);
+        const bool own = m.face_sign(f, c) > 0;
+        for (int i = 0; i < k; ++i) {
+          int32_t a = v[i], b = v[(i + 1) % k];
+          if (!own) std::swap(a, b);
+          edges.push_back(a < b ? DirEdge{a, b, true} : DirEdge{b, a, false});
+        }
       }
+      std::sort(edges.begin(), edges.end(), [](const DirEdge& x, const DirEdge& y) {
+        return x.lo != y.lo ? x.lo < y.lo : (x.hi != y.hi ? x.hi < y.hi : x.forward < y.forward);
+      });
+      bool open = false, misoriented = false;
+      for (size_t i = 0; i < edges.size();) {
+        size_t j = i;
+        while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+        if (j - i != 2) open = true;
+        else if (edges[i].forward == edges[i + 1].forward) misoriented = true;
+        i = j;
+      }
+      surface[c] = static_cast<char>((open ? 1 : 0) | (misoriented ? 2 : 0));
     }
-    std::sort(edges.begin(), edges.end(), [](const DirEdge& x, const DirEdge& y) {
-      return x.lo != y.lo ? x.lo < y.lo : (x.hi != y.hi ? x.hi < y.hi : x.forward < y.forward);
-    });
-    bool open = false, misoriented = false;
-    for (size_t i = 0; i < edges.size();) {
-      size_t j = i;
-      while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
-      if (j - i != 2) open = true;
-      else if (edges[i].forward == edges[i + 1].forward) misoriented = true;
-      i = j;
-    }
-    if (open) ++open_cells, push_example(ex_open, c), r.values[c] += 1;
-    if (misoriented) ++misoriented_cells, push_example(ex_misoriented, c), r.values[c] += 1;
+  });
+  for (int c = 0; c < nc; ++c) {
+    if (surface[c] & 1) ++open_cells, push_example(ex_open, c), r.values[c] += 1;
+    if (surface[c] & 2) ++misoriented_cells, push_example(ex_misoriented, c), r.values[c] += 1;
   }
 
   // (d) Hanging nodes: a node (referenced by some face) lying on a face's fan triangles within
-  // tol_F while not one of its vertices. This also catches duplicated nodes.
+  // tol_F while not one of its vertices. This also catches duplicated nodes. Candidates: the
+  // nodes in the face's bounding box padded by tol_F (NodeGrid).
   std::vector<char> used(m.n_nodes(), 0);
   for (int32_t v : m.face_nodes) used[v] = 1;
   std::vector<int32_t> used_ids;
   for (int v = 0; v < m.n_nodes(); ++v)
     if (used[v]) used_ids.push_back(v);
-  NodeTree tree(m.nodes, std::move(used_ids));
+  // Bucket side: the median extent (bounding-box diagonal) of the faces.
+  std::vector<double> extent(nf, 0.0);
+  parallel_ranges(nf, [&](int64_t b, int64_t e) {
+    for (int f = static_cast<int>(b); f < e; ++f) {
+      double tol = 0;
+      scale_of(m.nodes, m.face_begin(f), m.face_end(f), opt.rel_tol, &extent[f], &tol);
+    }
+  });
+  double median_extent = 0;
+  if (nf > 0) {
+    std::nth_element(extent.begin(), extent.begin() + nf / 2, extent.end());
+    median_extent = extent[nf / 2];
+  }
+  extent = {};
+  const NodeGrid tree(m.nodes, used_ids, median_extent);
+  used_ids = {};
   std::vector<char> hanging(m.n_nodes(), 0);
   int64_t hanging_pairs = 0;
   std::vector<int32_t> ex_hanging;
-  for (int f = 0; f < nf; ++f) {
-    const int k = m.face_size(f);
-    const int32_t* v = m.face_begin(f);
-    double diam = 0, tol = 0;
-    scale_of(m.nodes, v, v + k, opt.rel_tol, &diam, &tol);
-    Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
-    Vec3 g;
-    for (int i = 0; i < k; ++i) {
-      const Vec3 p = m.nodes[v[i]];
-      g += p;
-      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-    }
-    g = g / k;
-    const Vec3 pad{tol, tol, tol};
-    tree.query(lo - pad, hi + pad, [&](int32_t p) {
-      if (std::find(v, v + k, p) != v + k) return;
-      double d = DBL_MAX;
-      for (int i = 0; i < k && d > tol; ++i)
-        d = std::min(d, point_triangle_distance(m.nodes[p], g, m.nodes[v[i]], m.nodes[v[(i + 1) % k]]));
-      if (d <= tol) {
-        ++hanging_pairs;
-        hanging[p] = 1;
-        push_example(ex_hanging, p);
-        mark_face(f);
+  // Face by face in parallel: the (face, node) pairs found, per chunk in face order; then
+  // recorded in face order as a serial scan would.
+  struct Chunk {
+    int64_t begin;
+    std::vector<std::pair<int32_t, int32_t>> hits;
+  };
+  std::vector<Chunk> chunks;
+  std::mutex chunks_mutex;
+  parallel_ranges(nf, [&](int64_t fb, int64_t fe) {
+    Chunk chunk{fb, {}};
+    for (int f = static_cast<int>(fb); f < fe; ++f) {
+      const int k = m.face_size(f);
+      const int32_t* v = m.face_begin(f);
+      double diam = 0, tol = 0;
+      scale_of(m.nodes, v, v + k, opt.rel_tol, &diam, &tol);
+      Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+      Vec3 g;
+      for (int i = 0; i < k; ++i) {
+        const Vec3 p = m.nodes[v[i]];
+        g += p;
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
       }
-    });
-  }
+      g = g / k;
+      const Vec3 pad{tol, tol, tol};
+      tree.query(lo - pad, hi + pad, [&](int32_t p) {
+        if (std::find(v, v + k, p) != v + k) return;
+        double d = DBL_MAX;
+        for (int i = 0; i < k && d > tol; ++i)
+          d = std::min(d, point_triangle_distance(m.nodes[p], g, m.nodes[v[i]], m.nodes[v[(i + 1) % k]]));
+        if (d <= tol) chunk.hits.emplace_back(f, p);
+      });
+    }
+    if (chunk.hits.empty()) return;
+    std::lock_guard<std::mutex> lock(chunks_mutex);
+    chunks.push_back(std::move(chunk));
+  });
+  std::sort(chunks.begin(), chunks.end(), [](const Chunk& a, const Chunk& b) { return a.begin < b.begin; });
+  for (const Chunk& chunk : chunks)
+    for (const auto& [f, p] : chunk.hits) {
+      ++hanging_pairs;
+      hanging[p] = 1;
+      push_example(ex_hanging, p);
+      mark_face(f);
+    }
   const int64_t hanging_nodes = std::count(hanging.begin(), hanging.end(), 1);
   (void)geo;
 
@@ -444,14 +543,17 @@ CheckResult check_closure(const PolyMesh& m, const MeshGeometry& geo, const Chec
   CheckResult r;
   r.name = "closure";
   r.values.assign(m.n_cells(), 0.0);
-  for (int c = 0; c < m.n_cells(); ++c) {
-    double total = 0;
-    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) total += norm(geo.face_area[*f]);
-    const double s = norm(cell_area_sum(m, geo, c));
-    const double ratio = total > 0 ? s / total : 1.0;
-    r.values[c] = std::isnan(ratio) ? 1.0 : ratio;
+  parallel_ranges(m.n_cells(), [&](int64_t b, int64_t e) {
+    for (int c = static_cast<int>(b); c < e; ++c) {
+      double total = 0;
+      for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) total += norm(geo.face_area[*f]);
+      const double s = norm(cell_area_sum(m, geo, c));
+      const double ratio = total > 0 ? s / total : 1.0;
+      r.values[c] = std::isnan(ratio) ? 1.0 : ratio;
+    }
+  });
+  for (int c = 0; c < m.n_cells(); ++c)
     if (!(r.values[c] <= opt.closure_tol)) ++r.violations;
-  }
   rank_worst(r, true);
   r.measures = {{"tolerance", opt.closure_tol}};
   return r;
@@ -508,21 +610,25 @@ CheckResult check_auto_centering(const PolyMesh& m, const MeshGeometry& geo, con
   r.name = "auto_centering";
   r.values.assign(m.n_cells(), 0.0);
   const CellScales sc = compute_cell_scales(m, opt.rel_tol);
-  for (int c = 0; c < m.n_cells(); ++c) {
-    const Vec3 x = m.cell_fv_center[c];
-    double worst = -std::numeric_limits<double>::infinity();
-    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
-      const Vec3 a = m.face_sign(*fp, c) * geo.face_area[*fp];
-      const double an = norm(a);
-      if (!(an > 0)) continue;
-      worst = std::max(worst, dot(x - geo.face_centroid[*fp], a / an));
+  std::vector<char> violates(m.n_cells(), 0);
+  parallel_ranges(m.n_cells(), [&](int64_t b, int64_t e) {
+    for (int c = static_cast<int>(b); c < e; ++c) {
+      const Vec3 x = m.cell_fv_center[c];
+      double worst = -std::numeric_limits<double>::infinity();
+      for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+        const Vec3 a = m.face_sign(*fp, c) * geo.face_area[*fp];
+        const double an = norm(a);
+        if (!(an > 0)) continue;
+        worst = std::max(worst, dot(x - geo.face_centroid[*fp], a / an));
+      }
+      const double L = sc.length[c];
+      double value = L > 0 ? worst / L : 1.0;
+      if (std::isnan(value) || !std::isfinite(worst)) value = 1.0;  // no usable face or a NaN centre
+      r.values[c] = value;
+      violates[c] = !(worst < -sc.tol[c]) || !std::isfinite(worst);
     }
-    const double L = sc.length[c];
-    double value = L > 0 ? worst / L : 1.0;
-    if (std::isnan(value) || !std::isfinite(worst)) value = 1.0;  // no usable face or a NaN centre
-    r.values[c] = value;
-    if (!(worst < -sc.tol[c]) || !std::isfinite(worst)) ++r.violations;
-  }
+  });
+  r.violations = std::count(violates.begin(), violates.end(), 1);
   rank_worst(r, true);
   r.measures = {{"rel_tol", opt.rel_tol}};
   return r;

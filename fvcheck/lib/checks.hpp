@@ -59,6 +59,8 @@ CellScales compute_cell_scales(const PolyMesh& mesh, double rel_tol);
 
 /// Distinct node ids of cell c, sorted ascending.
 std::vector<int32_t> cell_node_ids(const PolyMesh& mesh, int c);
+/// The same into *ids (reuses its storage).
+void cell_node_ids_into(const PolyMesh& mesh, int c, std::vector<int32_t>* ids);
 
 /// Convexity: every node of a cell not on face F lies on the inner side of F's plane
 /// (through the face centroid, normal = outward area vector) within tol_c, and every face

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "meshgen/core/progress.hpp"
+
 namespace hm {
 
 bool FvReport::ok() const {
@@ -45,14 +47,16 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   for (int f = 0; f < mesh.n_faces(); ++f) r.boundary_faces += mesh.face_neighbour[f] < 0;
   r.cell_region = mesh.cell_region;
   r.k_metric = !(mesh.metric_scale == Vec3{1, 1, 1});
+  Progress progress("checks", 9);
   const MeshGeometry geo = compute_geometry(mesh);
-  r.checks.push_back(check_convexity(mesh, geo, opt));
-  r.checks.push_back(check_conformity(mesh, geo, opt, build));
-  r.checks.push_back(check_closure(mesh, geo, opt));
-  r.checks.push_back(check_volume(mesh, geo, opt));
-  r.checks.push_back(check_orthogonality(mesh, geo, opt));
-  r.checks.push_back(check_auto_centering(mesh, geo, opt));
-  r.checks.push_back(check_planarity(mesh, geo, opt));
+  progress.advance();
+  r.checks.push_back(check_convexity(mesh, geo, opt)), progress.advance();
+  r.checks.push_back(check_conformity(mesh, geo, opt, build)), progress.advance();
+  r.checks.push_back(check_closure(mesh, geo, opt)), progress.advance();
+  r.checks.push_back(check_volume(mesh, geo, opt)), progress.advance();
+  r.checks.push_back(check_orthogonality(mesh, geo, opt)), progress.advance();
+  r.checks.push_back(check_auto_centering(mesh, geo, opt)), progress.advance();
+  r.checks.push_back(check_planarity(mesh, geo, opt)), progress.advance();
   r.q_s = cell_shape_quality(mesh, h_ref);
   r.q_o_cell = cell_min_of_faces(mesh, r.k_metric ? face_orthogonality(mesh, geo) : r.find("orthogonality")->values);
   bool has_perm = true;

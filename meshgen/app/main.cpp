@@ -1,4 +1,4 @@
-// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]
+// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--quiet] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]
 // Exit codes: 0 success, 1 meshing failure (a stage, wells named; a mesh that fails the
 // self-check is never written), 2 bad input or arguments.
 #include <chrono>
@@ -17,6 +17,8 @@
 #include "fvcheck/lib/quality.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/core/cli.hpp"
+#include "meshgen/core/parallel.hpp"
+#include "meshgen/core/progress.hpp"
 #include "meshgen/core/text_file.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/local_frame.hpp"
@@ -28,8 +30,9 @@ namespace {
 
 int usage(const std::string& why) {
   std::cerr << "meshgen: " << why << "\n"
-            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]\n"
-            << "  -j N: at most N cavities meshed and optimised at once (default: every core)\n"
+            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--quiet] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]\n"
+            << "  -j N: at most N threads (cavities meshed and optimised at once, parallel checks; default: every core)\n"
+            << "  --quiet: no progress lines on stderr (shown only on a terminal, for stages over 2 s)\n"
             << "  mesh.vtu, summary.json and cavity_K.obj are always written; --export adds\n"
             << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n"
             << "  --png: pictures beside mesh.vtu (VTK, off-screen; re-runs under xvfb-run without an X display):\n"
@@ -43,7 +46,7 @@ int usage(const std::string& why) {
 int main(int argc, char** argv) {
   std::string case_path, out_dir;
   hm::PipelineOptions opts;
-  bool export_eclipse = false, export_openfoam = false, pictures = false;
+  bool export_eclipse = false, export_openfoam = false, pictures = false, quiet = false;
   hm::PictureOptions picture_opts;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -58,6 +61,8 @@ int main(int argc, char** argv) {
       const long j = std::strtol(argv[i], &end, 10);
       if (!end || *end != '\0' || j < 1 || j > 1024) return usage("-j: expected a number of threads in [1, 1024], got '" + std::string(argv[i]) + "'");
       opts.threads = static_cast<int>(j);
+    } else if (a == "-q" || a == "--quiet") {
+      quiet = true;
     } else if (a == "--no-transition") {
       opts.build_transition = false;
     } else if (a == "--export") {
@@ -98,6 +103,8 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  hm::set_progress_output(hm::progress_wanted(quiet), "meshgen");
+  const hm::ThreadLimit thread_limit(opts.threads);  // every parallel loop, not only the cavities
 
   hm::CaseSpec cs;
   hm::HybridMesh result;
@@ -146,6 +153,7 @@ int main(int argc, char** argv) {
   {
     // mesh.vtu: the hybrid mesh with its FV data and per-cell quality for ParaView.
     const fs::path p = out / "mesh.vtu";
+    const hm::Progress progress("writing mesh.vtu");
     const hm::WriteStatus st = hm::write_vtu(p.string(), m, extra);
     if (!st.ok) {
       std::cerr << "meshgen: " << st.message << "\n";

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "parallel.hpp"
+
 namespace hm {
 
 namespace {
@@ -39,19 +41,23 @@ void foam_face(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* 
 }
 
 // OpenFOAM's cell centre (primitiveMesh cell centres): the volume-weighted centroid of the
-// pyramids from the average of the face centres. Faces are given as outward cycles.
-Vec3 foam_cell_centre(const std::vector<Vec3>& nodes, const std::vector<std::vector<int32_t>>& outward) {
-  std::vector<Vec3> fc(outward.size()), fa(outward.size());
+// pyramids from the average of the face centres. Faces are given as outward cycles, flat:
+// face i is outward[off[i] .. off[i + 1]); fc and fa are scratch.
+Vec3 foam_cell_centre(const std::vector<Vec3>& nodes, const std::vector<int32_t>& outward, const std::vector<int>& off,
+                      std::vector<Vec3>& fc, std::vector<Vec3>& fa) {
+  const size_t n_faces = off.size() - 1;
+  fc.resize(n_faces);
+  fa.resize(n_faces);
   Vec3 est;
-  for (size_t i = 0; i < outward.size(); ++i) {
-    foam_face(nodes, outward[i].data(), outward[i].data() + outward[i].size(), &fc[i], &fa[i]);
+  for (size_t i = 0; i < n_faces; ++i) {
+    foam_face(nodes, outward.data() + off[i], outward.data() + off[i + 1], &fc[i], &fa[i]);
     est += fc[i];
   }
-  if (outward.empty()) return est;
-  est = est / static_cast<double>(outward.size());
+  if (n_faces == 0) return est;
+  est = est / static_cast<double>(n_faces);
   Vec3 sum;
   double vol = 0;
-  for (size_t i = 0; i < outward.size(); ++i) {
+  for (size_t i = 0; i < n_faces; ++i) {
     const double pv = std::max(dot(fa[i], fc[i] - est), 1e-300);
     sum += pv * (0.75 * fc[i] + 0.25 * est);
     vol += pv;
@@ -102,15 +108,17 @@ void cell_edges(const PolyMesh& m, int c, std::vector<std::pair<int32_t, int32_t
 
 std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& geo) {
   std::vector<double> q(m.n_faces(), 0.0);
-  for (int f = 0; f < m.n_faces(); ++f) {
-    const double a = norm(geo.face_area[f]);
-    const Vec3 p1 = m.cell_fv_center[m.face_owner[f]];
-    const Vec3 p2 = m.face_neighbour[f] >= 0 ? m.cell_fv_center[m.face_neighbour[f]] : geo.face_centroid[f];
-    const Vec3 d = p2 - p1;
-    const double l = norm(d);
-    if (!(a > 0) || !(l > 0)) continue;  // degenerate: Q_O = 0
-    q[f] = std::asin(clamp_unit(std::fabs(dot(d, geo.face_area[f])) / (l * a))) * kDeg;
-  }
+  parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
+    for (int f = static_cast<int>(fb); f < fe; ++f) {
+      const double a = norm(geo.face_area[f]);
+      const Vec3 p1 = m.cell_fv_center[m.face_owner[f]];
+      const Vec3 p2 = m.face_neighbour[f] >= 0 ? m.cell_fv_center[m.face_neighbour[f]] : geo.face_centroid[f];
+      const Vec3 d = p2 - p1;
+      const double l = norm(d);
+      if (!(a > 0) || !(l > 0)) continue;  // degenerate: Q_O = 0
+      q[f] = std::asin(clamp_unit(std::fabs(dot(d, geo.face_area[f])) / (l * a))) * kDeg;
+    }
+  });
   return q;
 }
 
@@ -141,27 +149,29 @@ std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometr
 
 std::vector<double> face_planarity(const PolyMesh& m, const MeshGeometry& geo) {
   std::vector<double> q(m.n_faces(), 0.0);
-  for (int f = 0; f < m.n_faces(); ++f) {
-    const double a = norm(geo.face_area[f]);
-    if (!(a > 0)) {
-      q[f] = 90.0;
-      continue;
+  parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
+    for (int f = static_cast<int>(fb); f < fe; ++f) {
+      const double a = norm(geo.face_area[f]);
+      if (!(a > 0)) {
+        q[f] = 90.0;
+        continue;
+      }
+      const Vec3 n = geo.face_area[f] / a;
+      const int k = m.face_size(f);
+      const int32_t* v = m.face_begin(f);
+      Vec3 g;
+      for (int i = 0; i < k; ++i) g += m.nodes[v[i]];
+      g = g / k;
+      double worst = 0;
+      for (int i = 0; i < k; ++i) {
+        const Vec3 t = cross(m.nodes[v[i]] - g, m.nodes[v[(i + 1) % k]] - g);  // 2 * triangle area vector
+        const double ta = norm(t);
+        if (!(ta > 2e-12 * a)) continue;
+        worst = std::max(worst, std::acos(clamp_unit(std::fabs(dot(n, t)) / ta)) * kDeg);
+      }
+      q[f] = worst;
     }
-    const Vec3 n = geo.face_area[f] / a;
-    const int k = m.face_size(f);
-    const int32_t* v = m.face_begin(f);
-    Vec3 g;
-    for (int i = 0; i < k; ++i) g += m.nodes[v[i]];
-    g = g / k;
-    double worst = 0;
-    for (int i = 0; i < k; ++i) {
-      const Vec3 t = cross(m.nodes[v[i]] - g, m.nodes[v[(i + 1) % k]] - g);  // 2 * triangle area vector
-      const double ta = norm(t);
-      if (!(ta > 2e-12 * a)) continue;
-      worst = std::max(worst, std::acos(clamp_unit(std::fabs(dot(n, t)) / ta)) * kDeg);
-    }
-    q[f] = worst;
-  }
+  });
   return q;
 }
 
@@ -187,37 +197,41 @@ std::vector<double> cell_max_of_faces(const PolyMesh& m, const std::vector<doubl
 
 std::vector<double> cell_mean_edge_length(const PolyMesh& m) {
   std::vector<double> out(m.n_cells(), 0.0);
-  std::vector<std::pair<int32_t, int32_t>> edges;
-  for (int c = 0; c < m.n_cells(); ++c) {
-    cell_edges(m, c, edges);
-    double s = 0;
-    for (auto [a, b] : edges) s += norm(m.nodes[b] - m.nodes[a]);
-    out[c] = edges.empty() ? 0.0 : s / static_cast<double>(edges.size());
-  }
+  parallel_ranges(m.n_cells(), [&](int64_t cb, int64_t ce) {
+    std::vector<std::pair<int32_t, int32_t>> edges;
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      cell_edges(m, c, edges);
+      double s = 0;
+      for (auto [a, b] : edges) s += norm(m.nodes[b] - m.nodes[a]);
+      out[c] = edges.empty() ? 0.0 : s / static_cast<double>(edges.size());
+    }
+  });
   return out;
 }
 
 std::vector<double> cell_shape_quality(const PolyMesh& m, const std::vector<double>& h_ref) {
   std::vector<double> out(m.n_cells(), 0.0);
   const bool use_ref = h_ref.size() == static_cast<size_t>(m.n_cells());
-  std::vector<std::pair<int32_t, int32_t>> edges;
-  for (int c = 0; c < m.n_cells(); ++c) {
-    cell_edges(m, c, edges);
-    if (edges.empty()) continue;
-    double h = use_ref ? h_ref[c] : 0.0;
-    if (!(h > 0) || !std::isfinite(h)) {
-      h = 0;
-      for (auto [a, b] : edges) h += norm(m.nodes[b] - m.nodes[a]);
-      h /= static_cast<double>(edges.size());
+  parallel_ranges(m.n_cells(), [&](int64_t cb, int64_t ce) {
+    std::vector<std::pair<int32_t, int32_t>> edges;
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      cell_edges(m, c, edges);
+      if (edges.empty()) continue;
+      double h = use_ref ? h_ref[c] : 0.0;
+      if (!(h > 0) || !std::isfinite(h)) {
+        h = 0;
+        for (auto [a, b] : edges) h += norm(m.nodes[b] - m.nodes[a]);
+        h /= static_cast<double>(edges.size());
+      }
+      if (!(h > 0)) continue;  // every edge has zero length
+      double q = 1.0;
+      for (auto [a, b] : edges) {
+        const double l = norm(m.nodes[b] - m.nodes[a]);
+        q = std::min(q, l > 0 ? std::min(l / h, h / l) : 0.0);
+      }
+      out[c] = q;
     }
-    if (!(h > 0)) continue;  // every edge has zero length
-    double q = 1.0;
-    for (auto [a, b] : edges) {
-      const double l = norm(m.nodes[b] - m.nodes[a]);
-      q = std::min(q, l > 0 ? std::min(l / h, h / l) : 0.0);
-    }
-    out[c] = q;
-  }
+  });
   return out;
 }
 
@@ -242,22 +256,31 @@ Stats stats_of(const std::vector<double>& values, const std::vector<bool>& mask)
 
 std::vector<double> openfoam_face_skewness(const PolyMesh& mesh) {
   std::vector<Vec3> centre(mesh.n_cells());
-  for (int c = 0; c < mesh.n_cells(); ++c) {
-    std::vector<std::vector<int32_t>> outward;
-    for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f) {
-      outward.emplace_back(mesh.face_begin(*f), mesh.face_end(*f));
-      if (mesh.face_owner[*f] != c) std::reverse(outward.back().begin(), outward.back().end());
+  parallel_ranges(mesh.n_cells(), [&](int64_t cb, int64_t ce) {
+    std::vector<int32_t> outward;
+    std::vector<int> off;
+    std::vector<Vec3> fc, fa;
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      outward.clear();
+      off.assign(1, 0);
+      for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f) {
+        outward.insert(outward.end(), mesh.face_begin(*f), mesh.face_end(*f));
+        if (mesh.face_owner[*f] != c) std::reverse(outward.begin() + off.back(), outward.end());
+        off.push_back(static_cast<int>(outward.size()));
+      }
+      centre[c] = foam_cell_centre(mesh.nodes, outward, off, fc, fa);
     }
-    centre[c] = foam_cell_centre(mesh.nodes, outward);
-  }
+  });
   std::vector<double> skew(mesh.n_faces());
-  for (int f = 0; f < mesh.n_faces(); ++f) {
-    Vec3 fc, fa;
-    foam_face(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), &fc, &fa);
-    const int32_t n = mesh.face_neighbour[f];
-    skew[f] = foam_skewness(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), fc, fa, centre[mesh.face_owner[f]],
-                            n >= 0 ? &centre[n] : nullptr);
-  }
+  parallel_ranges(mesh.n_faces(), [&](int64_t fb, int64_t fe) {
+    for (int f = static_cast<int>(fb); f < fe; ++f) {
+      Vec3 fc, fa;
+      foam_face(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), &fc, &fa);
+      const int32_t n = mesh.face_neighbour[f];
+      skew[f] = foam_skewness(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), fc, fa, centre[mesh.face_owner[f]],
+                              n >= 0 ? &centre[n] : nullptr);
+    }
+  });
   return skew;
 }
 

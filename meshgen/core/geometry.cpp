@@ -1,5 +1,9 @@
 #include "geometry.hpp"
 
+#include <array>
+
+#include "parallel.hpp"
+
 namespace hm {
 
 void polygon_area_centroid(const std::vector<Vec3>& nodes, const int32_t* begin, const int32_t* end,
@@ -9,7 +13,11 @@ void polygon_area_centroid(const std::vector<Vec3>& nodes, const int32_t* begin,
   for (const int32_t* v = begin; v != end; ++v) g += nodes[*v];
   g = g / n;
   Vec3 a_sum, c_sum;
-  std::vector<Vec3> tri_area(n);
+  // Fan triangle areas: on the stack for the usual faces (no allocation per face).
+  std::array<Vec3, 32> small;
+  std::vector<Vec3> large;
+  if (n > static_cast<int>(small.size())) large.resize(n);
+  Vec3* tri_area = n > static_cast<int>(small.size()) ? large.data() : small.data();
   for (int i = 0; i < n; ++i) {
     const Vec3 a = nodes[begin[i]], b = nodes[begin[(i + 1) % n]];
     tri_area[i] = 0.5 * cross(a - g, b - g);
@@ -34,37 +42,41 @@ MeshGeometry compute_geometry(const PolyMesh& m) {
   const int nf = m.n_faces(), nc = m.n_cells();
   geo.face_area.resize(nf);
   geo.face_centroid.resize(nf);
-  for (int f = 0; f < nf; ++f)
-    polygon_area_centroid(m.nodes, m.face_begin(f), m.face_end(f), &geo.face_area[f], &geo.face_centroid[f]);
+  parallel_ranges(nf, [&](int64_t b, int64_t e) {
+    for (int f = static_cast<int>(b); f < e; ++f)
+      polygon_area_centroid(m.nodes, m.face_begin(f), m.face_end(f), &geo.face_area[f], &geo.face_centroid[f]);
+  });
   geo.cell_volume.assign(nc, 0.0);
   geo.cell_centroid.assign(nc, Vec3{});
-  for (int c = 0; c < nc; ++c) {
-    // Reference point: mean of face centroids (inside for convex cells; any point works
-    // for the signed decomposition).
-    Vec3 x0;
-    int nfc = 0;
-    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f, ++nfc) x0 += geo.face_centroid[*f];
-    x0 = x0 / nfc;
-    double vol = 0;
-    Vec3 mom;
-    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
-      const int f = *fp;
-      const double s = m.face_sign(f, c);
-      const int n = m.face_size(f);
-      const int32_t* v = m.face_begin(f);
-      Vec3 g;
-      for (int i = 0; i < n; ++i) g += m.nodes[v[i]];
-      g = g / n;
-      for (int i = 0; i < n; ++i) {
-        const Vec3 a = m.nodes[v[i]], b = m.nodes[v[(i + 1) % n]];
-        const double tv = s * dot(g - x0, cross(a - x0, b - x0)) / 6.0;
-        vol += tv;
-        mom += tv * ((x0 + g + a + b) / 4.0);
+  parallel_ranges(nc, [&](int64_t cb, int64_t ce) {
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      // Reference point: mean of face centroids (inside for convex cells; any point works
+      // for the signed decomposition).
+      Vec3 x0;
+      int nfc = 0;
+      for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f, ++nfc) x0 += geo.face_centroid[*f];
+      x0 = x0 / nfc;
+      double vol = 0;
+      Vec3 mom;
+      for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+        const int f = *fp;
+        const double s = m.face_sign(f, c);
+        const int n = m.face_size(f);
+        const int32_t* v = m.face_begin(f);
+        Vec3 g;
+        for (int i = 0; i < n; ++i) g += m.nodes[v[i]];
+        g = g / n;
+        for (int i = 0; i < n; ++i) {
+          const Vec3 a = m.nodes[v[i]], b = m.nodes[v[(i + 1) % n]];
+          const double tv = s * dot(g - x0, cross(a - x0, b - x0)) / 6.0;
+          vol += tv;
+          mom += tv * ((x0 + g + a + b) / 4.0);
+        }
       }
+      geo.cell_volume[c] = vol;
+      geo.cell_centroid[c] = vol != 0 ? mom / vol : x0;
     }
-    geo.cell_volume[c] = vol;
-    geo.cell_centroid[c] = vol != 0 ? mom / vol : x0;
-  }
+  });
   return geo;
 }
 

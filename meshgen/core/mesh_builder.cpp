@@ -12,14 +12,19 @@ void note(BuildReport& r, const std::string& what) {
 }
 }  // namespace
 
-std::vector<int32_t> canonical_cycle(const std::vector<int32_t>& cycle, bool* reversed) {
+void canonical_cycle_into(const std::vector<int32_t>& cycle, std::vector<int32_t>* out, bool* reversed) {
   const size_t n = cycle.size();
   const size_t k = static_cast<size_t>(std::min_element(cycle.begin(), cycle.end()) - cycle.begin());
   const int32_t next = cycle[(k + 1) % n], prev = cycle[(k + n - 1) % n];
-  std::vector<int32_t> out(n);
+  out->resize(n);
   const bool rev = prev < next;
-  for (size_t i = 0; i < n; ++i) out[i] = rev ? cycle[(k + n - i) % n] : cycle[(k + i) % n];
+  for (size_t i = 0; i < n; ++i) (*out)[i] = rev ? cycle[(k + n - i) % n] : cycle[(k + i) % n];
   if (reversed) *reversed = rev;
+}
+
+std::vector<int32_t> canonical_cycle(const std::vector<int32_t>& cycle, bool* reversed) {
+  std::vector<int32_t> out;
+  canonical_cycle_into(cycle, &out, reversed);
   return out;
 }
 
@@ -28,17 +33,75 @@ int32_t MeshBuilder::add_node(Vec3 p) {
   return static_cast<int32_t>(nodes_.size() - 1);
 }
 
+namespace {
+
+// FNV-1a over the ids of a canonical cycle.
+uint64_t cycle_hash(const std::vector<int32_t>& key) {
+  uint64_t h = 1469598103934665603ull;
+  for (int32_t v : key) {
+    h ^= static_cast<uint32_t>(v);
+    h *= 1099511628211ull;
+  }
+  return h ^ (h >> 29);
+}
+
+// Whether the cycle at [c, c + n) has the canonical form `key` (the same cycle up to
+// rotation and orientation): start at key[0], which is the cycle's smallest id.
+bool same_cycle(const std::vector<int32_t>& key, const int32_t* c, size_t n) {
+  if (n != key.size()) return false;
+  const size_t k = static_cast<size_t>(std::find(c, c + n, key[0]) - c);
+  if (k == n) return false;
+  bool fwd = true, bwd = true;
+  for (size_t i = 1; i < n && (fwd || bwd); ++i) {
+    fwd = fwd && c[(k + i) % n] == key[i];
+    bwd = bwd && c[(k + n - i) % n] == key[i];
+  }
+  return fwd || bwd;
+}
+
+}  // namespace
+
+int32_t MeshBuilder::find_face(const std::vector<int32_t>& key, uint64_t hash) const {
+  if (table_.empty()) return -1;
+  const size_t mask = table_.size() - 1;
+  for (size_t i = hash & mask;; i = (i + 1) & mask) {
+    const int32_t f = table_[i];
+    if (f < 0) return -1;
+    if (face_hash_[f] == hash && same_cycle(key, face_nodes_.data() + face_ptr_[f], face_ptr_[f + 1] - face_ptr_[f]))
+      return f;
+  }
+}
+
+void MeshBuilder::insert_face(int32_t f, uint64_t hash) {
+  if (2 * (faces_.size() + 1) > table_.size()) {  // load factor <= 1/2
+    std::vector<int32_t> bigger(std::max<size_t>(1024, 2 * table_.size()), -1);
+    const size_t mask = bigger.size() - 1;
+    for (int32_t g : table_) {
+      if (g < 0) continue;
+      size_t i = face_hash_[g] & mask;
+      while (bigger[i] >= 0) i = (i + 1) & mask;
+      bigger[i] = g;
+    }
+    table_.swap(bigger);
+  }
+  const size_t mask = table_.size() - 1;
+  size_t i = hash & mask;
+  while (table_[i] >= 0) i = (i + 1) & mask;
+  table_[i] = f;
+}
+
 int32_t MeshBuilder::add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs) {
   const int32_t cell = static_cast<int32_t>(cells_.size());
   for (const CellFace& cf : faces) {
     // Drop repeated consecutive nodes (a conformity snap can merge two vertices).
-    std::vector<int32_t> cyc;
+    std::vector<int32_t>& cyc = cyc_;
+    cyc.clear();
     for (int32_t v : cf.nodes)
       if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
     while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    std::vector<int32_t> sorted = cyc;
-    std::sort(sorted.begin(), sorted.end());
-    if (cyc.size() < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+    sorted_.assign(cyc.begin(), cyc.end());
+    std::sort(sorted_.begin(), sorted_.end());
+    if (cyc.size() < 3 || std::adjacent_find(sorted_.begin(), sorted_.end()) != sorted_.end()) {
       ++report_.degenerate_faces;
       std::ostringstream os;
       os << "cell " << cell << ": degenerate face with " << cyc.size() << " nodes";
@@ -46,11 +109,13 @@ int32_t MeshBuilder::add_cell(const std::vector<CellFace>& faces, const CellAttr
       continue;
     }
     bool reversed = false;
-    std::vector<int32_t> key = canonical_cycle(cyc, &reversed);
-    auto it = face_index_.find(key);
-    if (it == face_index_.end()) {
+    canonical_cycle_into(cyc, &key_, &reversed);
+    const uint64_t hash = cycle_hash(key_);
+    const int32_t found = find_face(key_, hash);
+    if (found < 0) {
       const int32_t f = static_cast<int32_t>(faces_.size());
-      face_index_.emplace(std::move(key), f);
+      insert_face(f, hash);
+      face_hash_.push_back(hash);
       face_nodes_.insert(face_nodes_.end(), cyc.begin(), cyc.end());
       face_ptr_.push_back(static_cast<int32_t>(face_nodes_.size()));
       FaceRecord rec;
@@ -61,7 +126,7 @@ int32_t MeshBuilder::add_cell(const std::vector<CellFace>& faces, const CellAttr
       cell_faces_.push_back(f);
       continue;
     }
-    const int32_t f = it->second;
+    const int32_t f = found;
     FaceRecord& rec = faces_[f];
     ++rec.uses;
     if (rec.uses > 2) {
@@ -73,8 +138,8 @@ int32_t MeshBuilder::add_cell(const std::vector<CellFace>& faces, const CellAttr
     }
     // The stored cycle is the owner's orientation: the neighbour must name it reversed.
     bool stored_reversed = false;
-    std::vector<int32_t> stored(face_nodes_.begin() + face_ptr_[f], face_nodes_.begin() + face_ptr_[f + 1]);
-    canonical_cycle(stored, &stored_reversed);
+    stored_.assign(face_nodes_.begin() + face_ptr_[f], face_nodes_.begin() + face_ptr_[f + 1]);
+    canonical_cycle_into(stored_, &sorted_, &stored_reversed);
     if (stored_reversed == reversed) {
       ++report_.misoriented_faces;
       std::ostringstream os;
@@ -102,9 +167,12 @@ PolyMesh MeshBuilder::finish(BuildReport* report) {
       ++report_.removed_unused_nodes;
     }
   }
-  m.face_node_ptr = face_ptr_;
-  m.face_nodes.resize(face_nodes_.size());
-  for (size_t i = 0; i < face_nodes_.size(); ++i) m.face_nodes[i] = new_id[face_nodes_[i]];
+  nodes_ = {};
+  table_ = {};
+  face_hash_ = {};
+  m.face_node_ptr = std::move(face_ptr_);
+  m.face_nodes = std::move(face_nodes_);
+  for (int32_t& v : m.face_nodes) v = new_id[v];
   const size_t nf = faces_.size();
   m.face_owner.resize(nf);
   m.face_neighbour.resize(nf);
@@ -125,8 +193,9 @@ PolyMesh MeshBuilder::finish(BuildReport* report) {
       m.face_patch[f] = r.patch;
     }
   }
-  m.cell_face_ptr = cell_ptr_;
-  m.cell_faces = cell_faces_;
+  faces_ = {};
+  m.cell_face_ptr = std::move(cell_ptr_);
+  m.cell_faces = std::move(cell_faces_);
   const size_t nc = cells_.size();
   m.cell_region.resize(nc);
   m.cell_fv_center.resize(nc);
@@ -143,6 +212,7 @@ PolyMesh MeshBuilder::finish(BuildReport* report) {
     m.cell_radial[c] = cells_[c].radial;
   }
   if (report) *report = report_;
+  *this = MeshBuilder{};
   return m;
 }
 

@@ -4,7 +4,8 @@
 // exactly the conformity condition. Several grids (reservoir, wells, transition) add
 // into one builder and so share nodes and faces.
 #pragma once
-#include <map>
+#include <cstdint>
+#include <map>  // not used here any more; kept for the files that took it from this header
 #include <string>
 #include <vector>
 
@@ -39,7 +40,8 @@ class MeshBuilder {
   int32_t add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs);
   /// Finishes: compacts unused nodes, fixes patches, returns the mesh. The report says
   /// whether every face was used consistently; the mesh is returned either way so
-  /// that a caller can inspect it.
+  /// that a caller can inspect it. The builder's arrays move into the mesh: the builder
+  /// is left empty (no second copy of a large mesh stays alive).
   PolyMesh finish(BuildReport* report);
 
  private:
@@ -52,7 +54,14 @@ class MeshBuilder {
   std::vector<int32_t> face_ptr_{0};
   std::vector<int32_t> face_nodes_;
   std::vector<FaceRecord> faces_;
-  std::map<std::vector<int32_t>, int32_t> face_index_;  // canonical cycle -> face id
+  // Face lookup by canonical cycle: an open-addressing hash table of face ids (-1: empty
+  // slot), probed linearly; the key of face f is the canonical form of its stored cycle,
+  // compared in place. face_hash_[f] keeps each face's hash for growing the table.
+  int32_t find_face(const std::vector<int32_t>& key, uint64_t hash) const;
+  void insert_face(int32_t f, uint64_t hash);
+  std::vector<int32_t> table_;
+  std::vector<uint64_t> face_hash_;
+  std::vector<int32_t> cyc_, sorted_, key_, stored_;  // scratch of add_cell
   std::vector<int32_t> cell_ptr_{0};
   std::vector<int32_t> cell_faces_;
   std::vector<CellAttributes> cells_;
@@ -63,6 +72,8 @@ class MeshBuilder {
 /// that the second entry is the smaller neighbour. `reversed` tells whether the
 /// orientation was flipped to get there.
 std::vector<int32_t> canonical_cycle(const std::vector<int32_t>& cycle, bool* reversed);
+/// The same into *out (no allocation once *out has the capacity).
+void canonical_cycle_into(const std::vector<int32_t>& cycle, std::vector<int32_t>* out, bool* reversed);
 
 /// Checks the CSR/ownership invariants listed in docs/mesh-layout.md.
 CsrReport check_csr_invariants(const PolyMesh& mesh);

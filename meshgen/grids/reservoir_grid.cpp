@@ -59,12 +59,12 @@ std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const Reserv
                                          const std::vector<int32_t>& node_ids, const std::vector<char>& active,
                                          MeshBuilder& builder) {
   std::vector<int32_t> cell_id(grid.n_cells(), -1);
+  std::vector<CellFace> faces(6);  // reused: no allocation per cell
   for (int c = 0; c < grid.n_cells(); ++c) {
     if (!active[c]) continue;
-    std::vector<CellFace> faces(6);
     for (int side = 0; side < 6; ++side) {
       const auto fn = grid.cell_face_nodes(c, side);
-      faces[side].nodes = {node_ids[fn[0]], node_ids[fn[1]], node_ids[fn[2]], node_ids[fn[3]]};
+      faces[side].nodes.assign({node_ids[fn[0]], node_ids[fn[1]], node_ids[fn[2]], node_ids[fn[3]]});
       faces[side].patch = grid.neighbour(c, side) < 0 ? kOuterBoundary : kInteriorFace;
     }
     CellAttributes at;

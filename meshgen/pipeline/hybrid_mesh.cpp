@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "meshgen/core/progress.hpp"
 #include "perforations.hpp"
 
 namespace hm {
@@ -62,15 +63,17 @@ namespace {
 
 class StageTimer {
  public:
-  explicit StageTimer(std::vector<std::pair<std::string, double>>* out) : out_(out) {}
+  StageTimer(std::vector<std::pair<std::string, double>>* out, const PipelineOptions& opts) : out_(out), opts_(opts) {}
   void mark(const std::string& stage) {
     const auto now = std::chrono::steady_clock::now();
     out_->push_back({stage, std::chrono::duration<double>(now - last_).count()});
-    last_ = now;
+    if (opts_.on_stage) opts_.on_stage(stage);
+    last_ = std::chrono::steady_clock::now();
   }
 
  private:
   std::vector<std::pair<std::string, double>>* out_;
+  const PipelineOptions& opts_;
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
@@ -165,7 +168,7 @@ std::string caps_hint(const CaseSpec& cs, const std::vector<int>& wells) {
 // built again. The other cavities keep their transitions.
 HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOptions& opts) {
   HybridMesh out;
-  StageTimer timer(&out.timings_s);
+  StageTimer timer(&out.timings_s, opts);
   CaseSpec cs = input;  // end caps as meshed
   const int nw = static_cast<int>(cs.wells.size());
 
@@ -288,11 +291,14 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
         to_build.push_back(k);
       }
     }
+    Progress progress(topts.optimize ? "transition meshes + optimisation (cavities)" : "transition meshes (cavities)",
+                      static_cast<int64_t>(to_build.size()));
     tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
     arena.execute([&] {
       tbb::parallel_for(size_t(0), to_build.size(), [&](size_t i) {
         const int k = to_build[i];
         outcomes[k] = try_build_transition(out.cavities.cavities[k], coords, out.grid, out.blocks, base, topts);
+        progress.advance();
       });
     });
     bool refused = false;
@@ -339,9 +345,13 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
   out.cavity_node_coords = coords;
   timer.mark(opts.build_transition ? "cavities_and_transition" : "cavities");
 
-  add_reservoir_cells(out.grid, cs.reservoir, res_nodes, out.cavities.reservoir_active, builder);
+  {
+    Progress progress("reservoir cells");
+    add_reservoir_cells(out.grid, cs.reservoir, res_nodes, out.cavities.reservoir_active, builder);
+  }
   timer.mark("reservoir_cells");
 
+  std::optional<Progress> assembly_progress(std::in_place, "assembly + geometry");
   // Assemble the transition cells; free nodes are renumbered cavity by cavity.
   std::vector<int32_t> cell_cavity_list;
   std::vector<double> h_ref_list;
@@ -382,6 +392,7 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
     if (out.mesh.cell_region[c] == kReservoir) out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
   }
   out.geometry = compute_geometry(out.mesh);
+  assembly_progress.reset();
   timer.mark("assembly_geometry");
   std::vector<int> all_wells(nw);
   for (int w = 0; w < nw; ++w) all_wells[w] = w;
@@ -400,6 +411,7 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
     const PolyMesh sub = transition_submesh(t, coords);
     return transition_quality(sub, compute_geometry(sub), t.h_ref);
   };
+  std::optional<Progress> quality_progress(std::in_place, "transition quality before/after");
   for (const TransitionCells& t : transitions) {
     out.optimized = out.optimized || t.unoptimized != nullptr;
     add_quality(out.transition_before, quality_of(t.unoptimized ? *t.unoptimized : t));
@@ -409,6 +421,7 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
     a.rounds = std::max(a.rounds, o.rounds);
     a.proposed += o.proposed, a.kept += o.kept, a.refused += o.refused, a.invalid += o.invalid;
   }
+  quality_progress.reset();
   timer.mark("transition_quality");
   std::vector<std::vector<int>> cavity_wells;
   for (const Cavity& c : out.cavities.cavities) cavity_wells.push_back(c.wells);

@@ -1,6 +1,7 @@
 // The whole meshing job: case -> reservoir grid + well blocks -> cavities ->
 // transition meshes -> one conforming PolyMesh, with a report of every stage.
 #pragma once
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -23,6 +24,9 @@ struct PipelineOptions {
   bool build_transition = true;  ///< false: stop after the cavities (the mesh then has open cavity faces)
   bool optimize = true;          ///< run the small-edge optimisation when the case asks for it
   int threads = 0;               ///< cavities built at once (meshgen -j); 0: every core
+  /// Called at the end of each stage of HybridMesh::timings_s with its name (benchmarks
+  /// sample memory there); may be empty.
+  std::function<void(const std::string& stage)> on_stage;
 };
 
 /// The paper's Table 1 and 2 quantities for the transition cells of a mesh.

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/progress.hpp"
 
 namespace hm {
 
@@ -69,14 +70,15 @@ SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildR
     return out;
   }
   const CheckOptions opt;  // fvcheck's defaults: what `fvcheck mesh.vtu` would apply
+  Progress progress("self-check", 8);
   std::vector<CheckResult> checks;
-  checks.push_back(check_convexity(mesh, geo, opt));
-  checks.push_back(check_conformity(mesh, geo, opt, &build));
-  checks.push_back(check_closure(mesh, geo, opt));
-  checks.push_back(check_volume(mesh, geo, opt));
-  checks.push_back(check_orthogonality(mesh, geo, opt));
-  checks.push_back(check_auto_centering(mesh, geo, opt));
-  checks.push_back(check_planarity(mesh, geo, opt));
+  checks.push_back(check_convexity(mesh, geo, opt)), progress.advance();
+  checks.push_back(check_conformity(mesh, geo, opt, &build)), progress.advance();
+  checks.push_back(check_closure(mesh, geo, opt)), progress.advance();
+  checks.push_back(check_volume(mesh, geo, opt)), progress.advance();
+  checks.push_back(check_orthogonality(mesh, geo, opt)), progress.advance();
+  checks.push_back(check_auto_centering(mesh, geo, opt)), progress.advance();
+  checks.push_back(check_planarity(mesh, geo, opt)), progress.advance();
   for (const CheckResult& r : checks) {
     if (r.ok()) continue;
     SelfCheckFailure f;

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "meshgen/core/fv_quality.hpp"
@@ -118,6 +119,21 @@ class SiteOptimizer {
     return v >= t.base_node_id ? t.new_nodes[v - t.base_node_id] : coords_[v];
   }
   bool rebuild(TransitionCells& fresh, int32_t base) const;
+  // A diagram's submesh (local node ids, `global` mapping them back), Q_S per cell, skewed
+  // faces (worst first), their count and the worst skewness per cell.
+  struct Measured {
+    PolyMesh sub;
+    std::vector<int32_t> global;
+    std::vector<double> qs, max_skew;
+    std::vector<int> skewed, skewed_faces;
+  };
+  Measured measure(const TransitionCells& t) const {
+    Measured m;
+    m.sub = transition_submesh(t, coords_, &m.global);
+    m.qs = cell_shape_quality(m.sub, h_ref_);
+    m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
+    return m;
+  }
   static std::array<int, 4> key_of(const TransitionCells& t, int32_t v) {
     return v >= t.base_node_id ? t.new_node_sites[v - t.base_node_id] : std::array<int, 4>{-1, -1, -1, v};
   }
@@ -144,6 +160,7 @@ class SiteOptimizer {
   const TransitionOptions& opt_;
   std::set<std::array<int, 9>> refused_;
   int skewed_left_ = 0;
+  std::optional<Measured> next_;  // the measurement of the diagram the last round left in `out`
 };
 
 bool SiteOptimizer::rebuild(TransitionCells& fresh, int32_t base) const {
@@ -218,12 +235,20 @@ bool SiteOptimizer::trial_step(int s, int other, bool away, int size, Move* m) {
 }
 
 bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only) {
-  std::vector<int32_t> global;
-  const PolyMesh sub = transition_submesh(out, coords_, &global);
-  const std::vector<double> qs = cell_shape_quality(sub, h_ref_);
-  std::vector<int> skewed_faces;
-  std::vector<double> max_skew, max_skew2;
-  const std::vector<int> skewed = skewed_faces_of_cells(sub, &skewed_faces, &max_skew);
+  // The diagram's measurement: the one the previous round took of the diagram it left, if any.
+  Measured now = next_ ? std::move(*next_) : measure(out);
+  next_.reset();
+  const std::vector<int32_t>& global = now.global;
+  const PolyMesh& sub = now.sub;
+  const std::vector<double>& qs = now.qs;
+  const std::vector<int>& skewed_faces = now.skewed_faces;
+  const std::vector<double>& max_skew = now.max_skew;
+  const std::vector<int>& skewed = now.skewed;
+  // `out` unchanged on return: its measurement serves the next round.
+  auto unchanged = [&] {
+    next_ = std::move(now);
+    return false;
+  };
   skewed_left_ = static_cast<int>(skewed_faces.size());
   const int nc = sub.n_cells();
   // node -> cells and edge -> cells over local node ids (sorted incidence lists)
@@ -357,7 +382,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     if (best.site >= 0) admit(best);
   }
   rep.proposed += static_cast<int>(moves.size());
-  if (moves.empty()) return false;
+  if (moves.empty()) return unchanged();
 
   // Rebuild with the moves; an invalid diagram keeps the first half of them, down to none.
   TransitionCells fresh;
@@ -370,15 +395,15 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     keep = half;
     if (keep == 0) {
       moves.clear();
-      return false;
+      return unchanged();
     }
   }
   moves.resize(keep);
   // Keep a move only if the Q_S of the cells it touches improves (sum over its region).
-  std::vector<int32_t> g2;
-  const PolyMesh sub2 = transition_submesh(fresh, coords_, &g2);
-  const std::vector<double> qs2 = cell_shape_quality(sub2, h_ref_);
-  const std::vector<int> skewed2 = skewed_faces_of_cells(sub2, nullptr, &max_skew2);
+  Measured after = measure(fresh);
+  const std::vector<double>& qs2 = after.qs;
+  const std::vector<int>& skewed2 = after.skewed;
+  const std::vector<double>& max_skew2 = after.max_skew;
   std::vector<Move> kept;
   for (const Move& m : moves) {
     double before = 0, after = 0;
@@ -397,15 +422,16 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   }
   rep.refused += static_cast<int>(moves.size() - kept.size());
   if (kept.empty()) {
-    return false;
+    return unchanged();
   }
   if (kept.size() < moves.size() && !rebuild(fresh, out.base_node_id)) {
     for (const Move& m : kept) restore(m.site, m.before);
     rep.invalid += static_cast<int>(kept.size());
-    return false;
+    return unchanged();
   }
   rep.kept += static_cast<int>(kept.size());
   out = std::move(fresh);
+  if (kept.size() == moves.size()) next_ = std::move(after);  // else rebuilt with fewer moves: measured anew
   return true;
 }
 

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -224,8 +225,14 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
   };
   std::vector<ClassInfo> info(nc);
   int exact_centers = 0;
-  std::map<int, std::vector<int>> class_cells;
-  for (int a = 0; a < nc; ++a) class_cells[uf.find(a)].push_back(a);
+  // The cells of each class (CSR over class roots, cells ascending).
+  std::vector<int> class_begin(nc + 1, 0), class_members(nc), root_of(nc);
+  for (int a = 0; a < nc; ++a) root_of[a] = uf.find(a), ++class_begin[root_of[a] + 1];
+  for (int a = 0; a < nc; ++a) class_begin[a + 1] += class_begin[a];
+  {
+    std::vector<int> fill(class_begin.begin(), class_begin.end() - 1);
+    for (int a = 0; a < nc; ++a) class_members[fill[root_of[a]]++] = a;
+  }
   auto cell_class_info = [&](int cls) -> ClassInfo& {
     ClassInfo& ci = info[cls];
     if (ci.done) return ci;
@@ -233,7 +240,8 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
     bool first = true;
     int rep_cell = -1;
     std::vector<int32_t> candidates;
-    for (int a : class_cells[cls]) {
+    for (int k = class_begin[cls]; k < class_begin[cls + 1]; ++k) {
+      const int a = class_members[k];
       std::array<int, 4> key;
       for (int i = 0; i < 4; ++i) key[i] = cells[a]->vertex(i)->info();
       std::sort(key.begin(), key.end());
@@ -350,16 +358,18 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
   }
   rep.coincident_vertices = coincident;
   // Merged classes: smallest key, its point; identified node if any member has one.
-  std::map<int, ClassInfo> merged;
+  // (indexed by class root; has_merged tells which roots have one)
+  std::vector<ClassInfo> merged(nc);
+  std::vector<char> has_merged(nc, 0);
   for (int cls : used) {
     const ClassInfo& ci = cell_class_info(cls);
     const int root = uf.find(cls);
-    auto it = merged.find(root);
-    if (it == merged.end()) {
+    if (!has_merged[root]) {
       merged[root] = ci;
+      has_merged[root] = 1;
       continue;
     }
-    ClassInfo& m = it->second;
+    ClassInfo& m = merged[root];
     if (ci.node >= 0 && m.node >= 0 && ci.node != m.node) ++m.ambiguous;
     if (ci.key < m.key) {
       const int32_t node = m.node >= 0 ? m.node : ci.node;
@@ -370,7 +380,10 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
       m.node = ci.node;
     }
   }
-  auto class_info = [&](int cls) -> ClassInfo& { return merged.at(cls); };
+  auto class_info = [&](int cls) -> ClassInfo& {
+    if (cls < 0 || cls >= nc || !has_merged[cls]) throw std::out_of_range("transition: power vertex class without info");
+    return merged[cls];
+  };
   {
     std::vector<RawFace> kept;
     for (RawFace& f : faces) {
@@ -403,7 +416,8 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
       v.insert(v.end(), cand.begin(), cand.end());
     }
   }
-  std::map<int, int32_t> snapped;  // class -> node
+  std::vector<int32_t> snapped(nc, -1);  // class -> node
+  int snapped_count = 0;
   for (auto& [cls, cand] : snap_candidates) {
     std::sort(cand.begin(), cand.end());
     cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
@@ -411,16 +425,15 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
     int32_t best = cand[0];
     for (int32_t v : cand)
       if (norm2(coords[v] - p) < norm2(coords[best] - p)) best = v;
-    snapped[cls] = best;
+    snapped[cls] = best, ++snapped_count;
     rep.max_snap_shift = std::max(rep.max_snap_shift, norm(coords[best] - p));
   }
-  rep.snapped_vertices = static_cast<int>(snapped.size());
+  rep.snapped_vertices = snapped_count;
 
   auto token = [&](int cls) -> Token {
     const ClassInfo& ci = class_info(cls);
     if (ci.node >= 0) return ci.node;
-    auto it = snapped.find(cls);
-    if (it != snapped.end()) return it->second;
+    if (snapped[cls] >= 0) return snapped[cls];
     return -1 - static_cast<Token>(cls);
   };
   std::vector<std::vector<Token>> cycles(faces.size());
@@ -439,21 +452,26 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
 
   // ---- number the free vertices by their class key (deterministic)
   std::vector<std::pair<std::array<int, 4>, int>> free_classes;
-  std::map<int, int32_t> free_id;
+  constexpr int32_t kNoFreeId = std::numeric_limits<int32_t>::min();
+  std::vector<int32_t> free_id(nc, kNoFreeId);  // class -> node id of its free vertex
+  auto free_id_of = [&](int cls) {
+    if (cls < 0 || cls >= nc || free_id[cls] == kNoFreeId) throw std::out_of_range("transition: free vertex without id");
+    return free_id[cls];
+  };
   int identified = 0, ambiguous = 0;
   {
-    std::map<int, bool> seen_class;
+    std::vector<char> seen_class(nc, 0);
     for (size_t i = 0; i < faces.size(); ++i) {
       if (cycles[i].size() < 3) continue;
       for (int cls : faces[i].classes) {
-        if (seen_class.count(cls)) continue;
-        seen_class[cls] = true;
+        if (seen_class[cls]) continue;
+        seen_class[cls] = 1;
         const ClassInfo& ci = class_info(cls);
         ambiguous += ci.ambiguous ? 1 : 0;
         if (ci.node >= 0) ++identified;
       }
       for (Token tk : cycles[i])
-        if (tk < 0 && !free_id.count(static_cast<int>(-1 - tk))) {
+        if (tk < 0 && free_id[static_cast<int>(-1 - tk)] == kNoFreeId) {
           const int cls = static_cast<int>(-1 - tk);
           free_id[cls] = -1;
           free_classes.push_back({class_info(cls).key, cls});
@@ -474,13 +492,13 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
     if (!faces[i].boundary || cycles[i].size() < 3) continue;
     const MirrorPlane& m = images.planes[set.sites[faces[i].t].plane];
     for (Token tk : cycles[i])
-      if (tk < 0) out.new_nodes[free_id.at(static_cast<int>(-1 - tk)) - out.base_node_id][m.axis] = m.value;
+      if (tk < 0) out.new_nodes[free_id_of(static_cast<int>(-1 - tk)) - out.base_node_id][m.axis] = m.value;
   }
   rep.identified_vertices = identified;
   rep.free_vertices = static_cast<int>(out.new_nodes.size());
   rep.ambiguous_vertices = ambiguous;
   rep.exact_power_centers = exact_centers;
-  auto node_of = [&](Token tk) -> int32_t { return tk >= 0 ? static_cast<int32_t>(tk) : free_id.at(static_cast<int>(-1 - tk)); };
+  auto node_of = [&](Token tk) -> int32_t { return tk >= 0 ? static_cast<int32_t>(tk) : free_id_of(static_cast<int>(-1 - tk)); };
 
   // ---- cells
   std::vector<int> cell_of_site(ns, -1);

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "meshgen/core/geometry.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 
@@ -120,4 +122,64 @@ TEST(CsrInvariants, DetectsBrokenPointers) {
   broken = m;
   broken.cell_faces.pop_back();
   EXPECT_FALSE(check_csr_invariants(broken).ok);
+}
+
+namespace {
+// An n x n x n lattice of unit boxes; cell (i,j,k)'s faces are handed over rotated by
+// (i + j + k) % 4 positions (the builder must find a face from any rotation of its cycle).
+MeshBuilder lattice_builder(int n, bool misorient_one) {
+  MeshBuilder b;
+  auto id = [&](int i, int j, int k) { return static_cast<int32_t>((k * (n + 1) + j) * (n + 1) + i); };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) b.add_node({double(i), double(j), double(k)});
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        int32_t q[8];
+        for (int c = 0; c < 8; ++c) q[c] = id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
+        std::vector<CellFace> faces = box_faces(q);
+        for (CellFace& f : faces) {
+          std::rotate(f.nodes.begin(), f.nodes.begin() + (i + j + k) % 4, f.nodes.end());
+          if (!(i == 0 && j == 0 && k == 0)) f.patch = kInteriorFace;
+        }
+        for (int s = 0; s < 6; ++s) {
+          const bool outer = (s == 0 && k == 0) || (s == 1 && k == n - 1) || (s == 2 && j == 0) ||
+                             (s == 3 && j == n - 1) || (s == 4 && i == 0) || (s == 5 && i == n - 1);
+          faces[s].patch = outer ? kOuterBoundary : kInteriorFace;
+        }
+        if (misorient_one && i == n / 2 && j == n / 2 && k == n / 2)  // its +x face named as its neighbour names it
+          std::reverse(faces[5].nodes.begin(), faces[5].nodes.end());
+        b.add_cell(faces, {});
+      }
+  return b;
+}
+}  // namespace
+
+// The face lookup (a hash table that grows many times here) finds every shared face from
+// any rotation of its cycle: 3 n^2 (n + 1) faces, n^3 cells, each interior face used twice.
+TEST(MeshBuilder, LargeLatticeSharesEveryInteriorFaceOnce) {
+  const int n = 24;
+  MeshBuilder b = lattice_builder(n, false);
+  BuildReport rep;
+  const PolyMesh m = b.finish(&rep);
+  ASSERT_TRUE(rep.ok) << (rep.problems.empty() ? "" : rep.problems[0]);
+  EXPECT_EQ(m.n_cells(), n * n * n);
+  EXPECT_EQ(m.n_faces(), 3 * n * n * (n + 1));
+  int interior = 0;
+  for (int f = 0; f < m.n_faces(); ++f) interior += m.face_neighbour[f] >= 0;
+  EXPECT_EQ(interior, 3 * n * n * (n - 1));
+  EXPECT_TRUE(check_csr_invariants(m).ok);
+  // finish() leaves the builder empty (the arrays moved into the mesh).
+  EXPECT_EQ(b.n_nodes(), 0);
+}
+
+// The same lattice with one face named twice in the same orientation: found, and reported.
+TEST(MeshBuilder, LargeLatticeReportsTheOneMisorientedFace) {
+  MeshBuilder b = lattice_builder(24, true);
+  BuildReport rep;
+  b.finish(&rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.misoriented_faces, 1);
+  EXPECT_EQ(rep.unmatched_faces, 0);
 }
