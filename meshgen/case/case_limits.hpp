@@ -17,6 +17,12 @@ inline constexpr double kMaxSurveyDoglegDeg = 90;
 /// Relative slack of a perforation's md_to beyond the path's end: a trajectory's length is a
 /// sum of rounded segment lengths, so an interval typed to its exact end may exceed it by ulps.
 inline constexpr double kMeasuredDepthTolerance = 1e-9;
+/// Largest bend between two legs of a trajectory (docs/case-format.md, "Bends"; the bend sweep of
+/// docs/robustness.md measures what the transition holds up to it).
+inline constexpr double kMaxBendDegrees = 120;
+/// A bend counts as above the limit when it exceeds it by more than this relative amount: the
+/// angle computed from typed coordinates (e.g. 30 sin 120 rounded to 6 digits) may be a hair off.
+inline constexpr double kBendLimitTolerance = 1e-6;
 inline constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
 inline constexpr std::size_t kMaxCaseFileBytes = std::size_t(64) << 20;
 

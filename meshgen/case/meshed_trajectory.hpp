@@ -56,6 +56,13 @@ MeshedTrajectory meshed_trajectory(const ReservoirSpec& reservoir, const WellSpe
 /// (end_caps: auto; explicit hemisphere caps are refused there by meshed_trajectory).
 WellSpec meshed_well_spec(const CaseSpec& cs, int w);
 
+/// The angle (degrees) between two leg directions d1, d2 (not necessarily unit).
+double bend_degrees(Vec3 d1, Vec3 d2);
+
+/// Throws InputError "<key>.trajectory: bend of B degrees at point k exceeds the L-degree limit"
+/// for the first bend of the polyline above kMaxBendDegrees (case_limits.hpp).
+void check_bend_limit(const std::vector<Vec3>& points, const std::string& key);
+
 /// "the reservoir top (z = 1000)" etc.: a boundary plane in words.
 std::string boundary_plane_name(int axis, bool upper, double value);
 

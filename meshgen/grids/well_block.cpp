@@ -27,6 +27,7 @@
 #include <stdexcept>
 
 #include "gabriel.hpp"
+#include "meshgen/case/case_limits.hpp"
 #include "meshgen/case/meshed_trajectory.hpp"
 #include "meshgen/case/segment_distance.hpp"
 
@@ -48,14 +49,13 @@ std::string well_label(const CaseSpec& cs, int w) { return well_key(w) + " (" + 
 
 // The minimal rotation taking unit d1 to unit d2 (about d1 x d2), applied to x.
 // Rodrigues with the unnormalised axis k = d1 x d2: sin = |k|, cos = c, (1 - c) / sin^2 = 1 / (1 + c).
-// Requires d1 . d2 > -1 (bends above 120 degrees are rejected before).
+// Requires d1 . d2 > -1 (bends above kMaxBendDegrees are rejected before).
 Vec3 rotate_minimal(Vec3 x, Vec3 d1, Vec3 d2) {
   const Vec3 k = cross(d1, d2);
   const double c = dot(d1, d2);
   return c * x + cross(k, x) + (dot(k, x) / (1.0 + c)) * k;
 }
 
-double angle_degrees(Vec3 d1, Vec3 d2) { return std::atan2(norm(cross(d1, d2)), dot(d1, d2)) * 180.0 / kPi; }
 
 struct Leg {
   Vec3 a, b;       // trajectory points at its ends
@@ -82,6 +82,7 @@ void validate_well(const WellSpec& ws, int w, int sectors) {
 std::vector<Leg> make_legs(const WellSpec& ws, int w) {
   const std::vector<Vec3>& traj = ws.trajectory;
   const int n_legs = static_cast<int>(traj.size()) - 1;
+  check_bend_limit(traj, well_key(w));  // also checked by case validation; blocks are built from specs in tests
   std::vector<Leg> legs(n_legs);
   for (int k = 0; k < n_legs; ++k) {
     Leg& g = legs[k];
@@ -91,10 +92,7 @@ std::vector<Leg> make_legs(const WellSpec& ws, int w) {
     g.d = (g.b - g.a) / g.length;
   }
   for (int k = 1; k < n_legs; ++k) {
-    const double deg = angle_degrees(legs[k - 1].d, legs[k].d);
-    if (deg > 120.0)
-      throw InputError(well_key(w) + ".trajectory: bend of " + num(deg) + " degrees at point " + std::to_string(k) +
-                       " exceeds the 120-degree limit");
+    const double deg = bend_degrees(legs[k - 1].d, legs[k].d);
     legs[k - 1].bend_end = deg;
     legs[k].bend_start = deg;
   }
@@ -150,7 +148,10 @@ struct BendPlan {
   int wedges = 0;       // k
 };
 
-constexpr double kMinFilletFactor = 1.05;     // rho >= 1.05 R: the wedges' inner sides stay open
+// rho >= 1.3 R: the wedges' inner sides stay open and the transition's free sites fit on the
+// bend's focal line (docs/transition.md, "Bends": fillets of 1.1-1.25 R failed the self-check
+// at 60-119.9 degrees, 1.3-2 R passed).
+constexpr double kMinFilletFactor = 1.3;
 constexpr double kPreferredFilletFactor = 1.5;  // rho = 1.5 R when the legs allow it
 constexpr double kMaxWedgeAngle = kPi / 6;    // 30 degrees per wedge keeps the outer surface Gabriel
 
@@ -345,7 +346,7 @@ GabrielDiagnosis diagnose_gabriel(const WellBlock& block, const std::vector<Vec3
   if (diag.bend_point > 0) {
     const Vec3 d1 = normalized(trajectory[diag.bend_point] - trajectory[diag.bend_point - 1]);
     const Vec3 d2 = normalized(trajectory[diag.bend_point + 1] - trajectory[diag.bend_point]);
-    diag.bend_degrees = angle_degrees(d1, d2);
+    diag.bend_degrees = bend_degrees(d1, d2);
   }
   return diag;
 }
@@ -500,6 +501,11 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   for (const Station& st : stations) {
     block.layer_center.push_back(st.p);
     block.layer_bend.push_back(st.bend_point);
+  }
+  for (const BendPlan& p : plans) {
+    const Vec3 d1 = legs[p.point - 1].d, d2 = legs[p.point].d;
+    const Vec3 inward = normalized(d2 - dot(d1, d2) * d1);  // from the first leg toward the arc's centre
+    block.bend_axes.push_back({ws.trajectory[p.point] - p.tangent * d1 + p.radius * inward, p.axis, p.radius});
   }
   for (const BendPlan& p : plans)
     block.notes.push_back(well_label(cs, w) + ": bend of " + num(p.angle * 180 / kPi) + " degrees at trajectory point " +

@@ -19,6 +19,15 @@
 
 namespace hm {
 
+/// The focal line of a bend: the line through the fillet arc's centre along the bend's rotation
+/// axis. Every wedge's cross-section planes contain it, so the dual lines of the wedge polygons on
+/// the inside of the bend converge on it (docs/transition.md, "Bends").
+struct BendAxis {
+  Vec3 center;               ///< the fillet arc's centre
+  Vec3 axis;                 ///< unit rotation axis of the bend
+  double fillet_radius = 0;  ///< arc radius of the meshed axis (> the block's outer radius)
+};
+
 /// A well block as a stand-alone piece of mesh with LOCAL node ids 0..nodes.size()-1.
 struct WellBlock {
   int well = -1;                   ///< index of the well in the case
@@ -27,6 +36,7 @@ struct WellBlock {
   std::vector<Vec3> nodes;         ///< local node coordinates
   std::vector<Vec3> layer_center;  ///< layers: axis point of each cross-section (the meshed axis polyline)
   std::vector<int32_t> layer_bend; ///< layers: trajectory point of the bend whose wedges it bounds, or -1
+  std::vector<BendAxis> bend_axes; ///< one per bend (collinear points excluded)
   /// Cells: faces with local node ids, outward oriented; patch = wellbore_patch(well) for
   /// wellbore faces, kInteriorFace for everything else (outer faces are claimed by the
   /// transition mesh).

@@ -115,6 +115,7 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   }
   SiteSet set = make_sites(cavity, node_coords, grid, frames, report.notes);
   place_end_face_sites(set, cavity, node_coords, blocks, frames);
+  cap_sites_off_bend_axes(set, cavity, node_coords, blocks, frames);
   enforce_empty_spheres(set, cavity, node_coords, grid, frames);
   int iterations = 0;
   report.site_corrections = correct_sites(set, cavity, node_coords, grid, frames, kMaxCorrectionIterations, &iterations);
@@ -217,7 +218,7 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   r.split_boxes = set.splits;
   r.emptiness_fixes = set.emptiness_fixes;
   if (r.free_sites > 0 || r.dropped_tip_sites > 0)
-    r.notes.push_back(std::to_string(r.free_sites) + " tip sites (weight 0) grade the cells beyond the well ends" +
+    r.notes.push_back(std::to_string(r.free_sites) + " free sites (weight 0) grade the cells beyond the well ends and fill the bends' focal lines" +
                       (r.dropped_tip_sites > 0 ? " (" + std::to_string(r.dropped_tip_sites) + " dropped)" : ""));
   return out;
 }

@@ -154,13 +154,19 @@ std::vector<WellEnd> well_ends(const Cavity& cavity, const std::vector<WellBlock
 int place_end_face_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                          const std::vector<WellBlock>& blocks, const std::vector<PolygonFrame>& frames);
 
-/// Replaces the Free sites of `set` by a new set: sites of weight 0 on half-shells around
-/// each well end of the cavity (radii growing geometrically from r_w with half the ring
+/// Replaces the Free sites of `set` by a new set: sites of weight 0 on the focal line of every
+/// bend (cap_sites_off_bend_axes) and on half-shells around each well end of the cavity (radii growing geometrically from r_w with half the ring
 /// ratio of the block), kept only where they are strictly inside the cavity, clear of every
 /// cavity vertex and outside every other site's sphere (so every site stays in its own power
 /// cell and no free site takes a constrained face). Returns the number of free sites.
 int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords, const ReservoirGrid& grid,
                     const std::vector<WellBlock>& blocks);
+
+/// Bends (docs/transition.md, "Bends"): lowers (and caps) the internal sites of the well polygons
+/// whose spheres reach the focal line of a bend of their block (BendAxis), so that the free sites
+/// place_tip_sites puts on that line fit. Returns the number of sites lowered.
+int cap_sites_off_bend_axes(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                            const std::vector<WellBlock>& blocks, const std::vector<PolygonFrame>& frames);
 
 /// Drops the Free sites that an other site's sphere (grown by the free site's clearance) now
 /// reaches, after sites moved (hidden-site repair), also through the outer-boundary planes.

@@ -32,6 +32,14 @@ constexpr double kShellReach = 2.0;
 // Clearance of a free site from every other site's sphere, every cavity vertex and the well
 // blocks, in units of the local radial step: keeps its cell (and its neighbours') well shaped.
 constexpr double kClearance = 0.25;
+// Bends: the sites' spheres keep this fraction of the gap between the focal line and the inner
+// side of the bend (fillet radius - drainage radius) from the focal line, and free sites are
+// placed on it every kBendAxisSpacing x that gap (docs/transition.md, "Bends").
+constexpr double kBendAxisClearance = 0.25;
+constexpr double kBendAxisSpacing = 0.5;
+// Free sites on a focal line start this fraction of a spacing off the symmetric positions
+// (no free site in the bend's plane: symmetric placements make co-spherical quadruples).
+constexpr double kBendAxisOffset = 0.137;
 
 struct Obstacle {
   Vec3 p;
@@ -77,7 +85,71 @@ bool near_block(const WellBlock& b, Vec3 x, double margin) {
   return false;
 }
 
+// The part of a bend's focal line (well_block.hpp, BendAxis) that the wedge cells on the inside
+// of the bend reach: the fan of wedge polygons at angle phi from the bend's inner side
+// converges on it at rho tan(phi) from the arc's centre; |s| <= rho covers phi <= 45 degrees.
+struct FocalSegment {
+  int well = -1;
+  Vec3 a, b;               ///< end points
+  double clearance = 0;    ///< what sites keep from it (and free sites from every sphere)
+  double spacing = 0;      ///< of the free sites placed on it
+};
+
+std::vector<FocalSegment> focal_segments(const Cavity& cavity, const std::vector<WellBlock>& blocks) {
+  std::vector<FocalSegment> out;
+  for (const WellBlock& b : blocks) {
+    if (std::find(cavity.wells.begin(), cavity.wells.end(), b.well) == cavity.wells.end() || b.radii.empty()) continue;
+    for (const BendAxis& ax : b.bend_axes) {
+      const double gap = ax.fillet_radius - b.radii.back();  // focal line to the inner side
+      if (!(gap > 0)) continue;
+      FocalSegment f;
+      f.well = b.well;
+      f.a = ax.center - ax.fillet_radius * ax.axis;
+      f.b = ax.center + ax.fillet_radius * ax.axis;
+      f.clearance = kBendAxisClearance * gap;
+      f.spacing = kBendAxisSpacing * gap;
+      out.push_back(f);
+    }
+  }
+  return out;
+}
+
+double distance_to_segment(Vec3 x, Vec3 a, Vec3 b) {
+  const Vec3 d = b - a;
+  const double s = std::clamp(dot(x - a, d) / norm2(d), 0.0, 1.0);
+  return norm(x - (a + s * d));
+}
+
 }  // namespace
+
+int cap_sites_off_bend_axes(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                            const std::vector<WellBlock>& blocks, const std::vector<PolygonFrame>& frames) {
+  const std::vector<FocalSegment> segments = focal_segments(cavity, blocks);
+  int capped = 0;
+  for (const FocalSegment& fs : segments) {
+    for (size_t q = 0; q < cavity.faces.size(); ++q) {
+      const ConstrainedFace& face = cavity.faces[q];
+      const int s = set.internal_of[q];
+      if (face.side != FaceSide::Well || face.well != fs.well || s < 0) continue;
+      if (set.sites[s].kind != SiteKind::InternalPolygon) continue;
+      const PolygonFrame& f = frames[q];
+      // Sphere of the site at t (through the polygon's circle) clear of the segment by the clearance.
+      auto clear_at = [&](double t) {
+        return distance_to_segment(f.center + t * f.normal, fs.a, fs.b) >= std::sqrt(f.radius * f.radius + t * t) + fs.clearance;
+      };
+      double hi = set.sites[s].t, lo = min_t(frames, static_cast<int>(q));
+      if (clear_at(hi) || !clear_at(lo)) continue;
+      for (int it = 0; it < 40; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (clear_at(mid) ? lo : hi) = mid;
+      }
+      set.sites[s].t_cap = std::min(set.sites[s].t_cap, lo);
+      place_polygon_site(set, s, lo, cavity, coords, frames);
+      ++capped;
+    }
+  }
+  return capped;
+}
 
 std::vector<WellEnd> well_ends(const Cavity& cavity, const std::vector<WellBlock>& blocks) {
   std::vector<WellEnd> ends;
@@ -106,7 +178,8 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
   for (Site& s : set.sites)
     if (s.kind == SiteKind::Free) s.alive = false;
   const std::vector<WellEnd> ends = well_ends(cavity, blocks);
-  if (ends.empty()) return 0;
+  const std::vector<FocalSegment> segments = focal_segments(cavity, blocks);
+  if (ends.empty() && segments.empty()) return 0;
 
   // Obstacles sorted by x - radius: every live site's sphere and every cavity vertex.
   // Through an outer-boundary plane a free site must also clear the images of the spheres (its
@@ -140,6 +213,32 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
   };
 
   int added = 0;
+  auto try_place = [&](Vec3 f, double delta) {
+    const int cell = cell_at(grid, f);
+    if (cell < 0 || !std::binary_search(cavity.deactivated_cells.begin(), cavity.deactivated_cells.end(), cell))
+      return;
+    bool in_block = false;
+    for (const WellBlock& blk : blocks) in_block = in_block || near_block(blk, f, delta);
+    if (in_block || !clear(f, delta)) return;
+    Site s;
+    s.kind = SiteKind::Free;
+    s.p = f;
+    s.w2 = 0;
+    s.clearance = delta;
+    s.unchecked = false;
+    set.sites.push_back(s);
+    placed.push_back(f);
+    ++added;
+  };
+  // Bends first: a free cell on the focal line ends the fans of wedge cells that would
+  // otherwise all meet on it (degenerate power vertices).
+  for (const FocalSegment& fs : segments) {
+    const int n = std::max(2, static_cast<int>(std::lround(norm(fs.b - fs.a) / fs.spacing)));
+    for (int k = 0; k < n; ++k) {
+      const Vec3 f = fs.a + ((k + 0.5 + kBendAxisOffset) / n) * (fs.b - fs.a);
+      try_place(f, fs.clearance);
+    }
+  }
   for (const WellEnd& end : ends) {
     const double r0 = end.radii.front(), r_out = end.radii.back();
     const int rings = static_cast<int>(end.radii.size()) - 1;
@@ -163,21 +262,7 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
           const double psi = 2.0 * kPi * k / n_az + kGoldenAngle * (b + 3 * shell);
           const Vec3 f = end.center + radius * (std::cos(phi) * end.axis +
                                                 std::sin(phi) * (std::cos(psi) * u + std::sin(psi) * v));
-          const int cell = cell_at(grid, f);
-          if (cell < 0 || !std::binary_search(cavity.deactivated_cells.begin(), cavity.deactivated_cells.end(), cell))
-            continue;
-          bool in_block = false;
-          for (const WellBlock& blk : blocks) in_block = in_block || near_block(blk, f, delta);
-          if (in_block || !clear(f, delta)) continue;
-          Site s;
-          s.kind = SiteKind::Free;
-          s.p = f;
-          s.w2 = 0;
-          s.clearance = delta;
-          s.unchecked = false;
-          set.sites.push_back(s);
-          placed.push_back(f);
-          ++added;
+          try_place(f, delta);
         }
       }
     }

@@ -574,8 +574,13 @@ TEST(CaseErrors, TrajectoryShape) {
 TEST(CaseErrors, TrajectoryRepeatsPoint) {
   EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", "[[30, 50, 15], [30, 50, 45], [30, 50, 45]]")),
             "wells[0].trajectory[2]: repeats the previous point");
-  // Coming back to an earlier (not the previous) point is not this rule.
-  EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", "[[30, 50, 15], [30, 50, 45], [30, 50, 15]]")), "");
+  // Coming back to an earlier (not the previous) point is not this rule (a square of 90-degree
+  // bends; turning straight back is a 180-degree bend, above the limit).
+  EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]",
+                          "[[30, 50, 15], [30, 50, 45], [45, 50, 45], [45, 50, 15], [30, 50, 15]]")),
+            "");
+  EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", "[[30, 50, 15], [30, 50, 45], [30, 50, 15]]")),
+            "wells[0].trajectory: bend of 180 degrees at point 1 exceeds the 120-degree limit");
 }
 
 TEST(CaseErrors, TrajectoryOutsideTheReservoir) {

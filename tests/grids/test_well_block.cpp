@@ -781,19 +781,19 @@ TEST(WellBlockInput, LegTooShortForItsBend) {
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "wells[0].trajectory: leg 0 too short for its bend of 90 degrees (needs > 8.4 m with drainage radius 8)");
+              "wells[0].trajectory: leg 0 too short for its bend of 90 degrees (needs > 10.4 m with drainage radius 8)");
   }
-  // Pass/fail: 8.5 m is enough.
-  p.trajectory = {{0, 0, 0}, {0, 0, 8.5}, {10, 0, 8.5}};
+  // Pass/fail: 10.5 m is enough (and the second leg holds 1.3 R tan 45 = 10.4 m).
+  p.trajectory = {{0, 0, 0}, {0, 0, 10.5}, {11, 0, 10.5}};
   EXPECT_NO_THROW(make_well_block(make_case(p), 0, 12));
-  // The middle leg of a U holds both fillets: at least 1.05 R tan 45 = 8.4 m each.
-  p.trajectory = {{0, 0, 0}, {0, 0, 20}, {15, 0, 20}, {15, 0, 0}};
+  // The middle leg of a U holds both fillets: at least 1.3 R tan 45 = 10.4 m each.
+  p.trajectory = {{0, 0, 0}, {0, 0, 20}, {20, 0, 20}, {20, 0, 0}};
   try {
     make_well_block(make_case(p), 0, 12);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "wells[0].trajectory: leg 1 too short for its bends of 90 and 90 degrees (needs > 16.8 m with drainage "
+              "wells[0].trajectory: leg 1 too short for its bends of 90 and 90 degrees (needs > 20.8 m with drainage "
               "radius 8)");
   }
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "meshgen/case/case.hpp"
+#include "meshgen/case/case_limits.hpp"
 
 namespace hm::testing {
 
@@ -23,10 +24,14 @@ struct RealisticOptions {
   bool optimize = false;         ///< transition.optimize
   bool field_origin = false;     ///< shift x, y by (452000, 6780000) (the issue's UTM example)
   int max_wells = 3;             ///< 1..3 wells per case
-  bool bends = true;             ///< some wells get one bend of 10-120 degrees (the documented limit)
-  /// Hook for wells through the reservoir top/bottom (issue 12 item 2, branch `boundary`): when
-  /// set, the first trajectory point of every well lies above the reservoir top. Off by default
-  /// (today the mesher requires the dilated trajectory inside the box).
+  bool bends = true;             ///< some wells get one bend of 10 degrees to kMaxBendDegrees (the documented limit)
+  /// Wells through the reservoir top (and, for half of these cases, the bottom): the first
+  /// trajectory point of every well lies 0.5-1.5 R above the top (the layers above it are dropped);
+  /// through the bottom, the last point lies 0.5-1.5 R below it. Inclination 0-60 degrees (a fifth
+  /// of the wells exactly vertical: the block then ends in the plane), legs lengthened by what lies
+  /// outside and by the retraction of an oblique end (kRetractGap); end caps flat (a well that
+  /// crosses the boundary has flat or boundary ends, docs/case-format.md); a bend is kept only if
+  /// the second leg still descends (d_z >= 0.5 through the bottom, >= 0.1 otherwise).
   bool cross_top_bottom = false;
   /// Bound on the size of a case: at most this many layers across a cavity (6 R / dz); dz is raised
   /// (never R lowered, never above max_dz) until it holds, so that R keeps its 0.3-2 lateral cells.
@@ -41,6 +46,7 @@ struct RealisticCase {
   double dx = 0, dz = 0, drainage_radius = 0;  ///< lateral spacing, layer thickness, largest R
   double inclination_deg = 0;                  ///< of the first well's first leg
   int wells = 0, bends = 0;
+  bool through_top = false, through_bottom = false;
   std::string label;  ///< one line describing the case
 };
 
@@ -90,27 +96,39 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
   };
   std::vector<Well> wells;
   double r_max = 0;
+  const bool crossing = opt.cross_top_bottom;
+  rc.through_top = crossing;
+  rc.through_bottom = crossing && u(rng) < 0.5;
   for (int w = 0; w < rc.wells; ++w) {
     Well well;
     well.R = std::max(1.0, rc.dx * (0.3 + 1.7 * u(rng)));
     well.seg = std::clamp(0.5 * well.R, 0.5, 10.0);
-    const double inc = u(rng) * M_PI / 2, az = u(rng) * 2 * M_PI;
+    double inc = u(rng) * M_PI / 2;
+    const double az = u(rng) * 2 * M_PI;
+    if (crossing) inc = u(rng) < 0.2 ? 0.0 : inc * (2.0 / 3.0);  // 0-60 degrees, a fifth exactly vertical
     if (w == 0) rc.inclination_deg = inc * 180 / M_PI;
-    const Vec3 d1{std::sin(inc) * std::cos(az), std::sin(inc) * std::sin(az), std::cos(inc)};
-    const double len1 = well.R * (2 + 3 * u(rng));
+    const Vec3 d1 = inc == 0 ? Vec3{0, 0, 1} : Vec3{std::sin(inc) * std::cos(az), std::sin(inc) * std::sin(az), std::cos(inc)};
+    // Through a plane: up to 1.5 R (in z) outside, and an oblique end retracted by
+    // (R sin(inc) + kRetractGap R) / cos(inc) (meshed_trajectory.cpp).
+    const double outside = (1.5 * well.R + well.R * std::sin(inc) + 0.5 * well.R) / std::cos(inc);
+    const double len1 = well.R * (2 + 3 * u(rng)) + (crossing ? outside : 0.0) + (rc.through_bottom ? outside : 0.0);
     well.traj = {Vec3{0, 0, 0}, len1 * d1};
     if (opt.bends && u(rng) < 0.3) {
       // Second leg turned by the bend angle about a random axis normal to the first leg; both legs
-      // longer than the fillet's tangent length (1.5 R tan(beta / 2) <= 2.6 R at 120 degrees).
-      const double beta = (10 + 110 * u(rng)) * M_PI / 180, phi = 2 * M_PI * u(rng);
+      // longer than the fillet's tangent length (1.5 R tan(beta / 2), 2.6 R at 120 degrees).
+      const double beta = (10 + (kMaxBendDegrees - 10) * u(rng)) * M_PI / 180, phi = 2 * M_PI * u(rng);
       const Vec3 ref = std::abs(d1.z) < 0.9 ? Vec3{0, 0, 1} : Vec3{1, 0, 0};
       const Vec3 e1 = normalized(cross(d1, ref)), e2 = cross(d1, e1);
-      const Vec3 n = std::cos(phi) * e1 + std::sin(phi) * e2;
+      Vec3 n = std::cos(phi) * e1 + std::sin(phi) * e2;
+      if (crossing && n.z < 0) n = -1.0 * n;
       const Vec3 d2 = std::cos(beta) * d1 + std::sin(beta) * n;
       const double t = 1.5 * well.R * std::tan(beta / 2);
-      const double first = std::max(len1, 1.5 * t + well.seg), second = std::max(well.R * (2 + 2 * u(rng)), 1.5 * t + well.seg);
-      well.traj = {Vec3{0, 0, 0}, first * d1, first * d1 + second * d2};
-      ++rc.bends;
+      const double first = std::max(len1, 1.5 * t + well.seg + (crossing ? outside : 0.0)),
+                   second = std::max(well.R * (2 + 2 * u(rng)), 1.5 * t + well.seg) + (rc.through_bottom ? outside : 0.0);
+      if (!crossing || d2.z >= (rc.through_bottom ? 0.5 : 0.1)) {
+        well.traj = {Vec3{0, 0, 0}, first * d1, first * d1 + second * d2};
+        ++rc.bends;
+      }
     }
     r_max = std::max(r_max, well.R);
     wells.push_back(well);
@@ -139,10 +157,15 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
   const std::vector<double> x = detail::axis_nodes(lo.x - m_xy, hi.x + m_xy, rc.dx, rc.dx * u(rng));
   const std::vector<double> y = detail::axis_nodes(lo.y - m_xy, hi.y + m_xy, rc.dx, rc.dx * u(rng));
   std::vector<double> z = detail::axis_nodes(lo.z - m_z, hi.z + m_z, rc.dz, rc.dz * u(rng));
-  if (opt.cross_top_bottom) {  // the first point of every well above the top: drop the layers above it
-    double top = 1e300;
-    for (const Well& w : wells) top = std::min(top, w.traj.front().z + 0.5 * w.R);
+  if (rc.through_top) {  // the first point of every well at least 0.5 R above the top: drop the layers above
+    double top = -1e300;
+    for (const Well& w : wells) top = std::max(top, w.traj.front().z + 0.5 * w.R);
     z.erase(std::remove_if(z.begin(), z.end(), [&](double v) { return v < top; }), z.end());
+  }
+  if (rc.through_bottom) {  // the last point of every well at least 0.5 R below the bottom
+    double bottom = 1e300;
+    for (const Well& w : wells) bottom = std::min(bottom, w.traj.back().z - 0.5 * w.R);
+    z.erase(std::remove_if(z.begin(), z.end(), [&](double v) { return v > bottom; }), z.end());
   }
 
   std::ostringstream os;
@@ -156,7 +179,7 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
   detail::yaml_axis(os, "z", shifted(z, origin.z));
   os << "  permeability: [100, 100, 10]\ntransition: {dilation: " << num(dilation)
      << ", optimize: " << (opt.optimize ? "true" : "false") << "}\nwells:\n";
-  const char* caps = opt.caps == RealisticOptions::Caps::Flat ? "flat"
+  const char* caps = opt.caps == RealisticOptions::Caps::Flat || crossing ? "flat"
                      : opt.caps == RealisticOptions::Caps::Hemisphere ? "hemisphere" : "auto";
   for (size_t w = 0; w < wells.size(); ++w) {
     os << "- name: W" << w + 1 << "\n  bhp: 150\n  radius: 0.1\n  drainage_radius: " << num(wells[w].R)
@@ -168,8 +191,9 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
   rc.yaml = os.str();
   rc.spec = parse_case(rc.yaml);
   char label[200];
-  std::snprintf(label, sizeof label, "seed %u: dx %.1f dz %.2f R %.1f inc %.0f wells %d bends %d cells %zu", seed,
+  std::snprintf(label, sizeof label, "seed %u: dx %.1f dz %.2f R %.1f inc %.0f wells %d bends %d%s cells %zu", seed,
                 rc.dx, rc.dz, r_max, rc.inclination_deg, rc.wells, rc.bends,
+                rc.through_bottom ? " top+bottom" : rc.through_top ? " top" : "",
                 (x.size() - 1) * (y.size() - 1) * (z.size() - 1));
   rc.label = label;
   return rc;

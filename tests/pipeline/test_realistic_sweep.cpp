@@ -33,18 +33,20 @@ RealisticOptions sweep_options(uint32_t seed) {
   o.caps = d(m) % 3 == 2 ? RealisticOptions::Caps::Flat : RealisticOptions::Caps::Hemisphere;
   o.optimize = d(m) % 4 == 1;
   o.field_origin = d(m) % 4 == 3;
+  o.cross_top_bottom = d(m) % 4 == 2;  // wells through the top (half of them also the bottom), flat ends
   o.max_cavity_layers = 40;
   return o;
 }
 
 std::string mode_label(const RealisticOptions& o) {
-  return std::string(o.caps == RealisticOptions::Caps::Flat ? "flat" : "caps") + (o.optimize ? " opt" : "") +
-         (o.field_origin ? " utm" : "");
+  return std::string(o.caps == RealisticOptions::Caps::Flat || o.cross_top_bottom ? "flat" : "caps") +
+         (o.optimize ? " opt" : "") + (o.field_origin ? " utm" : "") + (o.cross_top_bottom ? " cross" : "");
 }
 
 }  // namespace
 
 TEST(RealisticCases, GeneratorIsDeterministicAndValid) {
+  int crossing = 0, bottom = 0;
   for (uint32_t seed = 1; seed <= 50; ++seed) {
     const RealisticCase a = make_realistic_case(seed, sweep_options(seed));
     const RealisticCase b = make_realistic_case(seed, sweep_options(seed));
@@ -56,8 +58,14 @@ TEST(RealisticCases, GeneratorIsDeterministicAndValid) {
     for (const WellSpec& w : a.spec.wells) {
       EXPECT_GE(w.drainage_radius, std::max(1.0, 0.3 * a.dx) - 1e-9);
       EXPECT_LE(w.drainage_radius, 2.0 * a.dx + 1e-9);
+      // Through the top: the first point above it; through the bottom: the last point below it.
+      EXPECT_EQ(w.trajectory.front().z < a.spec.reservoir.z.front(), a.through_top) << a.label;
+      EXPECT_EQ(w.trajectory.back().z > a.spec.reservoir.z.back(), a.through_bottom) << a.label;
     }
+    crossing += a.through_top, bottom += a.through_bottom;
   }
+  EXPECT_GT(crossing, 5);
+  EXPECT_GT(bottom, 2);
 }
 
 TEST(RealisticSweep, FullSweepTable) {
@@ -65,6 +73,7 @@ TEST(RealisticSweep, FullSweepTable) {
   const int n = env_int("HM_SWEEP_CASES", 200), first = env_int("HM_SWEEP_SEED", 1000);
   const double timeout = env_int("HM_SWEEP_TIMEOUT", 600);
   const char* log_path = std::getenv("HM_SWEEP_LOG");
+  const bool only_bent = env_int("HM_SWEEP_ONLY_BENT", 0) == 1;  // rerun only the cases with a bent well
   std::ofstream log;
   if (log_path) log.open(log_path);
   struct Row {
@@ -78,6 +87,7 @@ TEST(RealisticSweep, FullSweepTable) {
     const uint32_t seed = static_cast<uint32_t>(first + i);
     const RealisticOptions o = sweep_options(seed);
     const RealisticCase rc = make_realistic_case(seed, o);
+    if (only_bent && rc.bends == 0) continue;
     const CaseResult r = mesh_and_check_isolated(rc, timeout);
     for (Row* row : {&rows[shape_class(rc)], &all}) {
       ++row->count[r.outcome];
@@ -140,6 +150,29 @@ TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
                 r.seconds);
   }
   for (const auto& [k, v] : shapes) std::printf("[ ci sweep  ] %s: %d cases\n", k.c_str(), v);
+}
+
+// The CI subset's wells through the reservoir boundary: the first two seeds whose case goes
+// through the top only and through the top and the bottom (flat ends, local coordinates, no
+// optimisation, cells at most 20 m wide). Both must mesh and pass mesh_and_check.
+TEST(RealisticSweep, CiSubsetWellsThroughTopAndBottomMeshAndPassFvcheck) {
+  bool top_only = false, top_bottom = false;
+  for (uint32_t seed = 1; seed <= 40 && !(top_only && top_bottom); ++seed) {
+    RealisticOptions o;
+    o.cross_top_bottom = true;
+    o.max_wells = 1;
+    o.max_cavity_layers = 48;
+    o.max_dx = 20;
+    const RealisticCase rc = make_realistic_case(seed, o);
+    bool& done = rc.through_bottom ? top_bottom : top_only;
+    if (done) continue;
+    done = true;
+    const CaseResult r = mesh_and_check(rc);
+    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+    std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
+                r.seconds);
+  }
+  EXPECT_TRUE(top_only && top_bottom);
 }
 
 // Reproducer of issue 12 (1 m layers, 10 m cells, one deviated well with R = 15 m): it crashed
