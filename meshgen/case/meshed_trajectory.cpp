@@ -148,26 +148,47 @@ MeshedTrajectory meshed_trajectory(const ReservoirSpec& r, const WellSpec& ws, c
   // 3. The block keeps the gap from every plane it does not end on. Its lateral surface around
   //    a leg with direction d reaches R sqrt(1 - d_k^2) along axis k; a hemispherical cap
   //    reaches R beyond an inside end in every direction.
-  const double R = ws.drainage_radius, gap = kBoundaryGap * R;
+  const int m = static_cast<int>(out.points.size());
+  // Whether the block ends at right angles in the plane (axis k, side) at leg s: it then comes no closer.
+  auto ends_in = [&](int s, int k, bool upper) {
+    bool ends_here = false;
+    for (int e = 0; e < 2; ++e)
+      ends_here = ends_here || (out.ends[e] == WellEndKind::Boundary && out.plane_axis[e] == k &&
+                                out.plane_value[e] == (upper ? hi[k] : lo[k]) && (e == 0 ? s == 0 : s + 2 == m));
+    return ends_here;
+  };
+  // A block squeezed between both planes of one axis (no translation can make it fit) gets the
+  // largest drainage radius that keeps kBoundaryGap x that radius from both.
+  double R = ws.drainage_radius;
+  for (int s = 0; s + 1 < m; ++s) {
+    const Vec3 a = out.points[s], b = out.points[s + 1], d = normalized(b - a);
+    for (int k = 0; k < 3; ++k) {
+      const double sk = std::sqrt(std::max(0.0, 1.0 - d[k] * d[k]));
+      const double d_lo = std::min(a[k] - lo[k], b[k] - lo[k]), d_hi = std::min(hi[k] - a[k], hi[k] - b[k]);
+      const bool lo_close = !ends_in(s, k, false) && d_lo - R * sk < kBoundaryGap * R;
+      const bool hi_close = !ends_in(s, k, true) && d_hi - R * sk < kBoundaryGap * R;
+      if (lo_close && hi_close && sk > 0) {
+        // (1 - 1e-12): the gap test below then holds despite the rounding of this quotient.
+        const double fit = std::min(d_lo, d_hi) / (sk + kBoundaryGap) * (1 - 1e-12);
+        if (fit >= kMinFittedRadius * ws.drainage_radius && fit > ws.radius) R = std::min(R, fit);
+      }
+    }
+  }
+  out.drainage_radius = R;
+  const double gap = kBoundaryGap * R;
   auto too_close = [&](const std::string& what, int k, bool upper, double distance) {
     throw InputError(tkey + ": " + what + " comes within " + num(std::max(0.0, distance)) + " m of " +
                      boundary_plane_name(k, upper, upper ? hi[k] : lo[k]) + "; it must keep " + num(gap) +
                      " m (" + num(kBoundaryGap) +
                      " x drainage_radius) from a boundary plane it does not end on, or cross the plane");
   };
-  const int m = static_cast<int>(out.points.size());
   for (int s = 0; s + 1 < m; ++s) {
     const Vec3 a = out.points[s], b = out.points[s + 1], d = normalized(b - a);
     for (int k = 0; k < 3; ++k) {
       const double reach = R * std::sqrt(std::max(0.0, 1.0 - d[k] * d[k]));
       for (int side = 0; side < 2; ++side) {
         const bool upper = side == 1;
-        // A block ending in this plane at right angles does not come closer than its end.
-        bool ends_here = false;
-        for (int e = 0; e < 2; ++e)
-          ends_here = ends_here || (out.ends[e] == WellEndKind::Boundary && out.plane_axis[e] == k &&
-                                    out.plane_value[e] == (upper ? hi[k] : lo[k]) && (e == 0 ? s == 0 : s + 2 == m));
-        if (ends_here) continue;
+        if (ends_in(s, k, upper)) continue;
         const double da = upper ? hi[k] - a[k] : a[k] - lo[k], db = upper ? hi[k] - b[k] : b[k] - lo[k];
         const double dist = std::min(da, db) - reach;
         if (check_fit && dist < gap) too_close("the radial block around leg " + std::to_string(s), k, upper, dist);
@@ -211,6 +232,7 @@ WellSpec meshed_well_spec(const CaseSpec& cs, int w) {
   WellSpec ws = cs.wells.at(w);
   const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, ws, "wells[" + std::to_string(w) + "]", false);
   ws.trajectory = mt.points;
+  ws.drainage_radius = mt.drainage_radius;
   if (ws.end_caps == EndCaps::Hemisphere && !mt.caps_fit) {
     ws.end_caps = EndCaps::Flat;
     ws.end_caps_fallback = false;

@@ -29,6 +29,9 @@ constexpr double kBoundaryGap = 0.25;
 /// (Retracted end), in drainage radii (measured: 0.2 left 30-degree crossings failing fvcheck,
 /// 0.5 passes).
 constexpr double kRetractGap = 0.5;
+/// Smallest fraction of the requested drainage radius a block squeezed between two opposite
+/// boundary planes is lowered to (MeshedTrajectory::drainage_radius); below it the case is refused.
+constexpr double kMinFittedRadius = 0.5;
 
 struct MeshedTrajectory {
   std::vector<Vec3> points;  ///< >= 2 points, consecutive points distinct
@@ -37,6 +40,10 @@ struct MeshedTrajectory {
   std::array<double, 2> plane_value{0, 0};  ///< and its coordinate
   std::array<bool, 2> plane_upper{false, false};  ///< the plane is the box's max side on that axis
   std::array<double, 2> retraction{0, 0};   ///< Retracted: distance (m) from the crossing to the block's end
+  /// Drainage radius of the block: the well's, or lower where the block is squeezed between the two
+  /// planes of one axis (a horizontal well in a reservoir thinner than 2 (1 + kBoundaryGap) R):
+  /// the largest that keeps the gap from both, at least kMinFittedRadius x the well's.
+  double drainage_radius = 0;
   /// Hemispherical caps at both ends keep the gap from every plane (false when clipped).
   bool caps_fit = false;
   bool clipped() const { return ends[0] != WellEndKind::Inside || ends[1] != WellEndKind::Inside; }

@@ -113,9 +113,8 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
   //    dilation x drainage_radius of the trajectory.
   const double dil = cs.transition.dilation;
   for (size_t w = 0; w < blocks.size(); ++w) {
-    const WellSpec& ws = cs.wells[blocks[w].well];
     const std::vector<Vec3>& traj = blocks[w].trajectory;  // the meshed part
-    const double reach = dil * ws.drainage_radius;
+    const double reach = dil * blocks[w].radii.back();     // the block's drainage radius (meshed_trajectory.hpp)
     Vec3 lo = traj[0], hi = traj[0];
     for (Vec3 p : traj)
       for (int a = 0; a < 3; ++a) { lo[a] = std::min(lo[a], p[a]); hi[a] = std::max(hi[a], p[a]); }
@@ -336,9 +335,8 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
     for (int c : cav.deactivated_cells) {
       double best = INFINITY;
       for (int w : cav.wells) {
-        const WellSpec& ws = cs.wells[blocks[w].well];
         best = std::min(best, box_polyline_dist(grid.cell_lo(c), grid.cell_hi(c), blocks[w].trajectory) /
-                                  ws.drainage_radius);
+                                  blocks[w].radii.back());
       }
       dmax = std::max(dmax, best);
     }

@@ -478,6 +478,10 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
                                  : ": the radial block ends " + num(mt.retraction[e]) +
                                        " m inside (flat end), the transition mesh fills the rest up to the plane"));
   }
+  if (mt.drainage_radius < cs.wells[w].drainage_radius)
+    block.notes.push_back(well_label(cs, w) + ": drainage radius lowered from " + num(cs.wells[w].drainage_radius) +
+                          " to " + num(mt.drainage_radius) + " m: the radial block lies between two opposite boundary "
+                          "planes and keeps " + num(kBoundaryGap) + " x drainage_radius from both");
   if (cs.wells[w].end_caps == EndCaps::Hemisphere && ws.end_caps == EndCaps::Flat)
     block.notes.push_back(well_label(cs, w) + ": closed with flat ends (end_caps: auto): hemispherical caps do not fit "
                                               "between the trajectory's ends and the reservoir boundary");

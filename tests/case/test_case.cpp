@@ -718,7 +718,7 @@ TEST(CaseRobustness, MalformedDocumentsGiveOneLineInputErrors) {
       "name: \x01\x02\n",
       std::string("name: a\0b\n", 10),
       "name: a\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1]}\nwells:\n  - name: P1\n    trajectory: [[0.5, 0.5, 0.5], "
-      "[0.5, 0.5, 0.6]]\n    radius: 0.1\n    drainage_radius: 0.4\n    bhp: 100\n",
+      "[0.5, 0.5, 0.6]]\n    radius: 0.1\n    drainage_radius: 0.9\n    bhp: 100\n",
       "{{{{{{{{\n",
       "'unterminated\n",
       "key: [unbalanced}\n",

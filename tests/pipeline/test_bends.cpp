@@ -127,21 +127,22 @@ TEST(Bends, ValidationRefusesBendsAboveTheLimit) {
   }
 }
 
-// The bend sweep (docs/robustness.md, "Bends"): every combination of bend (90 degrees to the limit
-// in HM_BEND_STEP steps, default 2.5), R / dx (0.6, 1.4), inclination of the first leg (0, 50, 90),
+// The bend sweep (docs/robustness.md, "Bends"): every combination of bend (HM_BEND_FROM, default 90
+// degrees, to the limit in HM_BEND_STEP steps, default 2.5), R / dx (0.6, 1.4), inclination of the first leg (0, 50, 90),
 // fillet (1.5 R, 1.3 R); caps and flat ends alternate, the bend plane turns by 37 degrees per case,
 // optimisation on for every fourth case. Prints one line per case and a table per bend angle.
 TEST(Bends, SweepTable) {
   const char* v = std::getenv("HM_LONG_TESTS");
   if (!(v && std::string(v) == "1")) GTEST_SKIP() << "long test: set HM_LONG_TESTS=1";
   const double step = std::getenv("HM_BEND_STEP") ? std::atof(std::getenv("HM_BEND_STEP")) : 2.5;
+  const double from = std::getenv("HM_BEND_FROM") ? std::atof(std::getenv("HM_BEND_FROM")) : 90;
   struct Row {
     int cases = 0, meshed = 0;
     std::map<Outcome, int> count;
   };
   std::map<double, Row> rows;
   int index = 0;
-  for (double beta = 90; beta <= kMaxBendDegrees + 1e-9; beta += step)
+  for (double beta = from; beta <= kMaxBendDegrees + 1e-9; beta += step)
     for (double r : {0.6, 1.4})
       for (double inc : {0.0, 50.0, 90.0})
         for (bool short_legs : {false, true}) {

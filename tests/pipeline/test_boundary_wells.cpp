@@ -1,8 +1,8 @@
 // Wells that cross the reservoir's outer boundary (issue 12, item 2): the shipped cases
 // vertical_through (fully penetrating, blocks ending in the top and bottom planes),
 // deviated_through_top (30 degrees through the top: the block ends inside, the cavity reaches the
-// top) and horizontal_through_sides (a reservoir 2.5 drainage radii thick, blocks ending in the
-// side planes, cavity reaching top and bottom) mesh and pass every FV check; the volume is the box
+// top) and horizontal_through_sides (a reservoir 2 drainage radii thick: blocks lowered to 0.8 R,
+// ending in the side planes, cavity reaching top and bottom) mesh and pass every FV check; the volume is the box
 // minus the exact wellbore holes; the outer-boundary faces tile the box's surface (less the holes'
 // sections where a block ends in a plane) and no interior face lies in a boundary plane.
 #include <gtest/gtest.h>
@@ -141,7 +141,7 @@ void check_case(const std::string& name, Expect want) {
 
 TEST(BoundaryWells, FullyPenetratingVerticalWells) { check_case("vertical_through", {4, {{2, 1000}, {2, 1060}}}); }
 TEST(BoundaryWells, WellThroughTheTopAt30Degrees) { check_case("deviated_through_top", {2, {{2, 1000}}}); }
-TEST(BoundaryWells, HorizontalWellsInAThinReservoir) { check_case("horizontal_through_sides", {4, {{0, 0}, {0, 72}, {2, 1000}, {2, 1012.5}}});
+TEST(BoundaryWells, HorizontalWellsInAThinReservoir) { check_case("horizontal_through_sides", {4, {{0, 0}, {0, 72}, {2, 1000}, {2, 1010}}});
 }
 
 // The case of the issue: a vertical well from 12 m below the top to 12 m above the bottom of a 60 m
@@ -187,3 +187,34 @@ TEST(BoundaryWells, BlockCoversOnlyTheMeshedPart) {
 }
 
 }  // namespace
+
+// A block squeezed between two opposite planes (a horizontal well in a reservoir 2 R thick) gets the
+// largest drainage radius that keeps kBoundaryGap x that radius from both: half the thickness /
+// (1 + kBoundaryGap) = 0.8 R, noted; a block too close to one plane only is refused (the well can
+// move); a reservoir thinner than 2 x kMinFittedRadius x (1 + kBoundaryGap) R is refused.
+TEST(BoundaryWells, SqueezedBlockGetsTheLargestRadiusThatFits) {
+  CaseSpec cs = example("horizontal_through_sides");
+  const ReservoirSpec& r = cs.reservoir;
+  ASSERT_DOUBLE_EQ(r.z.back() - r.z.front(), 2 * cs.wells[0].drainage_radius);
+  const MeshedTrajectory mt = meshed_trajectory(r, cs.wells[0], "wells[0]");
+  EXPECT_NEAR(mt.drainage_radius, 0.5 * (r.z.back() - r.z.front()) / (1 + kBoundaryGap), 1e-9);
+  const WellBlock b = make_well_block(cs, 0, cs.wells[0].sectors);
+  EXPECT_DOUBLE_EQ(b.radii.back(), mt.drainage_radius);
+  bool noted = false;
+  for (const std::string& n : b.notes) noted = noted || n.find("drainage radius lowered from 5 to 4 m") != std::string::npos;
+  EXPECT_TRUE(noted);
+  // Off-centre by 1 m: near the top only would be refused; here both planes are within the gap.
+  WellSpec w = cs.wells[0];
+  for (Vec3& p : w.trajectory) p.z = 1004;
+  EXPECT_NEAR(meshed_trajectory(r, w, "wells[0]").drainage_radius, 4 / (1 + kBoundaryGap), 1e-9);
+  // A thick reservoir, the well 1 m below the top: the block is too close to one plane only.
+  ReservoirSpec thick = r;
+  thick.z = {1000, 1010, 1020, 1030};
+  for (Vec3& p : w.trajectory) p.z = 1001;
+  EXPECT_THROW(meshed_trajectory(thick, w, "wells[0]"), InputError);
+  // Too thin: 4 m = 0.8 R < 2 x 0.5 x 1.25 R.
+  ReservoirSpec thin = r;
+  thin.z = {1000, 1004};
+  for (Vec3& p : w.trajectory) p.z = 1002;
+  EXPECT_THROW(meshed_trajectory(thin, w, "wells[0]"), InputError);
+}
