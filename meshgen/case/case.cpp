@@ -504,7 +504,7 @@ void check_wells(const CaseSpec& cs) {
     const std::string path = index_path("wells", a);
     // The part inside the box is meshed; its radial block must fit (meshed_trajectory.hpp).
     meshed.push_back(meshed_trajectory(r, w, path).points);
-    check_bend_limit(meshed.back(), path);
+    check_bend_limit(meshed.back(), path, kMaxBendDegrees);
     for (size_t b = 0; b < a; ++b) {
       if (cs.wells[b].name == w.name) fail(path + ".name", "duplicate of " + index_path("wells", b) + ".name");
       if (lower(cs.wells[b].name) == lower(w.name))

@@ -219,12 +219,12 @@ double bend_degrees(Vec3 d1, Vec3 d2) {
   return std::atan2(norm(cross(d1, d2)), dot(d1, d2)) * 180.0 / 3.14159265358979323846;
 }
 
-void check_bend_limit(const std::vector<Vec3>& points, const std::string& key) {
+void check_bend_limit(const std::vector<Vec3>& points, const std::string& key, double limit_deg) {
   for (size_t k = 1; k + 1 < points.size(); ++k) {
     const double deg = bend_degrees(points[k] - points[k - 1], points[k + 1] - points[k]);
-    if (deg > kMaxBendDegrees * (1 + kBendLimitTolerance))
+    if (deg > limit_deg * (1 + kBendLimitTolerance))
       throw InputError(key + ".trajectory: bend of " + num(deg) + " degrees at point " + std::to_string(k) +
-                       " exceeds the " + num(kMaxBendDegrees) + "-degree limit");
+                       " exceeds the " + num(limit_deg) + "-degree limit");
   }
 }
 

@@ -67,8 +67,8 @@ WellSpec meshed_well_spec(const CaseSpec& cs, int w);
 double bend_degrees(Vec3 d1, Vec3 d2);
 
 /// Throws InputError "<key>.trajectory: bend of B degrees at point k exceeds the L-degree limit"
-/// for the first bend of the polyline above kMaxBendDegrees (case_limits.hpp).
-void check_bend_limit(const std::vector<Vec3>& points, const std::string& key);
+/// for the first bend of the polyline above limit_deg (kMaxBendDegrees for a case, case_limits.hpp).
+void check_bend_limit(const std::vector<Vec3>& points, const std::string& key, double limit_deg);
 
 /// "the reservoir top (z = 1000)" etc.: a boundary plane in words.
 std::string boundary_plane_name(int axis, bool upper, double value);

@@ -49,7 +49,7 @@ std::string well_label(const CaseSpec& cs, int w) { return well_key(w) + " (" + 
 
 // The minimal rotation taking unit d1 to unit d2 (about d1 x d2), applied to x.
 // Rodrigues with the unnormalised axis k = d1 x d2: sin = |k|, cos = c, (1 - c) / sin^2 = 1 / (1 + c).
-// Requires d1 . d2 > -1 (bends above kMaxBendDegrees are rejected before).
+// Requires d1 . d2 > -1 (bends above kMaxBlockBendDegrees are rejected before).
 Vec3 rotate_minimal(Vec3 x, Vec3 d1, Vec3 d2) {
   const Vec3 k = cross(d1, d2);
   const double c = dot(d1, d2);
@@ -82,7 +82,8 @@ void validate_well(const WellSpec& ws, int w, int sectors) {
 std::vector<Leg> make_legs(const WellSpec& ws, int w) {
   const std::vector<Vec3>& traj = ws.trajectory;
   const int n_legs = static_cast<int>(traj.size()) - 1;
-  check_bend_limit(traj, well_key(w));  // also checked by case validation; blocks are built from specs in tests
+  // The block's own limit; case validation refuses bends above kMaxBendDegrees (what the transition holds).
+  check_bend_limit(traj, well_key(w), kMaxBlockBendDegrees);
   std::vector<Leg> legs(n_legs);
   for (int k = 0; k < n_legs; ++k) {
     Leg& g = legs[k];

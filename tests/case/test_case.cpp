@@ -574,13 +574,14 @@ TEST(CaseErrors, TrajectoryShape) {
 TEST(CaseErrors, TrajectoryRepeatsPoint) {
   EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", "[[30, 50, 15], [30, 50, 45], [30, 50, 45]]")),
             "wells[0].trajectory[2]: repeats the previous point");
-  // Coming back to an earlier (not the previous) point is not this rule (a square of 90-degree
-  // bends; turning straight back is a 180-degree bend, above the limit).
+  // Coming back to an earlier (not the previous) point's neighbourhood with bends within the limit
+  // (30-60 degrees) is valid; turning straight back is a 180-degree bend, above the limit.
   EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]",
-                          "[[30, 50, 15], [30, 50, 45], [45, 50, 45], [45, 50, 15], [30, 50, 15]]")),
+                          "[[30, 50, 15], [30, 50, 35], [35, 50, 43.660], [45, 50, 43.660], [50, 50, 35], "
+                          "[50, 50, 15], [47, 50, 13]]")),
             "");
   EXPECT_EQ(error_of(with(kBase, "[[30, 50, 15], [30, 50, 45]]", "[[30, 50, 15], [30, 50, 45], [30, 50, 15]]")),
-            "wells[0].trajectory: bend of 180 degrees at point 1 exceeds the 120-degree limit");
+            "wells[0].trajectory: bend of 180 degrees at point 1 exceeds the 60-degree limit");
 }
 
 TEST(CaseErrors, TrajectoryOutsideTheReservoir) {

@@ -25,13 +25,13 @@ struct RealisticOptions {
   bool field_origin = false;     ///< shift x, y by (452000, 6780000) (the issue's UTM example)
   int max_wells = 3;             ///< 1..3 wells per case
   bool bends = true;             ///< some wells get one bend of 10 degrees to kMaxBendDegrees (the documented limit)
-  /// Wells through the reservoir top (and, for half of these cases, the bottom): the first
+  /// Wells through the reservoir top (and, for half of these cases, the bottom, with one well): the first
   /// trajectory point of every well lies 0.5-1.5 R above the top (the layers above it are dropped);
   /// through the bottom, the last point lies 0.5-1.5 R below it. Inclination 0-60 degrees (a fifth
   /// of the wells exactly vertical: the block then ends in the plane), legs lengthened by what lies
   /// outside and by the retraction of an oblique end (kRetractGap); end caps flat (a well that
   /// crosses the boundary has flat or boundary ends, docs/case-format.md); a bend is kept only if
-  /// the second leg still descends (d_z >= 0.5 through the bottom, >= 0.1 otherwise).
+  /// the well does not cross the bottom and its second leg still descends (d_z >= 0.1).
   bool cross_top_bottom = false;
   /// Bound on the size of a case: at most this many layers across a cavity (6 R / dz); dz is raised
   /// (never R lowered, never above max_dz) until it holds, so that R keeps its 0.3-2 lateral cells.
@@ -99,6 +99,7 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
   const bool crossing = opt.cross_top_bottom;
   rc.through_top = crossing;
   rc.through_bottom = crossing && u(rng) < 0.5;
+  if (rc.through_bottom) rc.wells = 1;  // one well: the others' ends would set its top and bottom
   for (int w = 0; w < rc.wells; ++w) {
     Well well;
     well.R = std::max(1.0, rc.dx * (0.3 + 1.7 * u(rng)));
@@ -115,7 +116,7 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
     well.traj = {Vec3{0, 0, 0}, len1 * d1};
     if (opt.bends && u(rng) < 0.3) {
       // Second leg turned by the bend angle about a random axis normal to the first leg; both legs
-      // longer than the fillet's tangent length (1.5 R tan(beta / 2), 2.6 R at 120 degrees).
+      // longer than the fillet's tangent length (1.5 R tan(beta / 2)).
       const double beta = (10 + (kMaxBendDegrees - 10) * u(rng)) * M_PI / 180, phi = 2 * M_PI * u(rng);
       const Vec3 ref = std::abs(d1.z) < 0.9 ? Vec3{0, 0, 1} : Vec3{1, 0, 0};
       const Vec3 e1 = normalized(cross(d1, ref)), e2 = cross(d1, e1);
@@ -125,7 +126,7 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
       const double t = 1.5 * well.R * std::tan(beta / 2);
       const double first = std::max(len1, 1.5 * t + well.seg + (crossing ? outside : 0.0)),
                    second = std::max(well.R * (2 + 2 * u(rng)), 1.5 * t + well.seg) + (rc.through_bottom ? outside : 0.0);
-      if (!crossing || d2.z >= (rc.through_bottom ? 0.5 : 0.1)) {
+      if (!crossing || (!rc.through_bottom && d2.z >= 0.1)) {
         well.traj = {Vec3{0, 0, 0}, first * d1, first * d1 + second * d2};
         ++rc.bends;
       }
@@ -162,10 +163,17 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
     for (const Well& w : wells) top = std::max(top, w.traj.front().z + 0.5 * w.R);
     z.erase(std::remove_if(z.begin(), z.end(), [&](double v) { return v < top; }), z.end());
   }
-  if (rc.through_bottom) {  // the last point of every well at least 0.5 R below the bottom
+  if (rc.through_bottom) {  // the last point of every well 0.5-1 R below the bottom
     double bottom = 1e300;
     for (const Well& w : wells) bottom = std::min(bottom, w.traj.back().z - 0.5 * w.R);
     z.erase(std::remove_if(z.begin(), z.end(), [&](double v) { return v > bottom; }), z.end());
+    bottom = z.back();
+    for (Well& w : wells) {  // a deeper end moves back along its last leg (d_z >= 0.5) to 1 R below
+      Vec3& b = w.traj.back();
+      const Vec3 d = normalized(b - w.traj[w.traj.size() - 2]);
+      const double excess = b.z - (bottom + w.R);
+      if (excess > 0) b = b - (excess / d.z) * d;
+    }
   }
 
   std::ostringstream os;
