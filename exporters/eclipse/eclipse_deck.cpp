@@ -188,11 +188,11 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
                          (w.type == WellType::Producer ? "produce" : "inject") + " from the initial pressure " +
                          text_number(cs.reservoir.initial_pressure) +
                          " bar: flow shuts it at the start of a transient run (the deck's WTEST re-opens it)");
-  // AsTyped: the transient runs 40 relaxation times (at least 1 day), within flow's calendar.
+  // AsTyped: the transient runs kAsTypedRelaxationTimes relaxation times (at least 1 day), within flow's calendar.
   const double relaxation = eclipse_relaxation_time_days(cs, mesh, geo, wells);
   const double first_step =
       options.first_step_days > 0 ? options.first_step_days : std::clamp(0.5 * relaxation, kOneSecondInDays, 1.0);
-  double end_days = options.end_days > 0 ? options.end_days : std::max(1.0, 40 * relaxation);
+  double end_days = options.end_days > 0 ? options.end_days : std::max(1.0, kAsTypedRelaxationTimes * relaxation);
   if (end_days <= first_step) return fail("end_days must be longer than the first step");
   if (end_days > 130000) {
     warnings.push_back("the estimated relaxation time (" + std::to_string(relaxation) +
@@ -379,7 +379,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       o << "-- Run as typed: flow 2022.10 reads no time-step keyword without options (TUNING, NEXTSTEP need\n"
         << "-- --enable-tuning); it starts at min(1 day, report step), grows at most 3x per step, at most 365 days.\n"
         << "-- The run is the case's transient from its initial pressure to the steady state, "
-        << end_days << " days = 40 x the\n"
+        << end_days << " days = " << kAsTypedRelaxationTimes << " x the\n"
         << "-- estimated relaxation time " << relaxation << " days (docs/export-eclipse.md).\n"
         << "-- Re-open any well flow shut because it could not flow at its BHP, as soon as it can:\n"
         << "WTEST\n'*' 0.01 'P' /\n/\n\n"
