@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "run_command.hpp"
+#include "small_case.hpp"
 
 namespace fs = std::filesystem;
 using hm_test::fresh_dir;
@@ -23,24 +24,7 @@ hm_test::CommandResult mesh_text(const std::string& name, const std::string& yam
   return run_command(kMeshgen + " '" + (d / "case.yaml").string() + "' -o '" + (d / "out").string() + "'");
 }
 
-const char* kSmallCase = R"(name: small
-reservoir:
-  x: [0, 20, 40, 50, 55, 60, 65, 70, 80, 100, 120]
-  y: [0, 20, 40, 50, 55, 60, 65, 70, 80, 100, 120]
-  z: [1000, 1010, 1020, 1025, 1030, 1035, 1040, 1045, 1050, 1060, 1070]
-  permeability: [100, 100, 10]
-  porosity: 0.2
-  initial_pressure: 200
-wells:
-  - name: P1
-    trajectory: [[60, 60, 1027], [60, 60, 1043]]
-    radius: 0.1
-    drainage_radius: 3
-    rings: 3
-    sectors: 8
-    segment_length: 4
-    bhp: 150
-)";
+using hm::test::kSmallCase;
 }  // namespace
 
 TEST(MeshgenCli, BadArgumentsExitWithCode2) {

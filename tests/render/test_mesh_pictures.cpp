@@ -17,6 +17,7 @@
 
 #include "../e2e/run_command.hpp"
 #include "exporters/png/mesh_pictures.hpp"
+#include "small_case.hpp"
 
 namespace fs = std::filesystem;
 using hm_test::fresh_dir;
@@ -34,25 +35,7 @@ size_t occurrences(const std::string& text, const std::string& what) {
   return n;
 }
 
-// A small vertical well (a few hundred cells): meshes in about a second.
-const char* kSmallCase = R"(name: small
-reservoir:
-  x: [0, 20, 40, 50, 55, 60, 65, 70, 80, 100, 120]
-  y: [0, 20, 40, 50, 55, 60, 65, 70, 80, 100, 120]
-  z: [1000, 1010, 1020, 1025, 1030, 1035, 1040, 1045, 1050, 1060, 1070]
-  permeability: [100, 100, 10]
-  porosity: 0.2
-  initial_pressure: 200
-wells:
-  - name: P1
-    trajectory: [[60, 60, 1027], [60, 60, 1043]]
-    radius: 0.1
-    drainage_radius: 3
-    rings: 3
-    sectors: 8
-    segment_length: 4
-    bhp: 150
-)";
+using hm::test::kSmallCase;
 
 struct Image {
   int width = 0, height = 0, components = 0;
