@@ -89,6 +89,29 @@ double foam_skewness(const std::vector<Vec3>& nodes, const int32_t* b, const int
 }
 
 
+// The point of triangle (a, b, c) nearest to p (Ericson, Real-Time Collision Detection 5.1.5:
+// Voronoi regions of the vertices, then of the edges, else the interior).
+Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double den = va + vb + vc;
+  if (!(den > 0)) return a;  // degenerate triangle: its vertex regions cover it
+  return a + (vb / den) * ab + (vc / den) * ac;
+}
+
 // Distinct undirected edges (a < b) of cell c.
 void cell_edges(const PolyMesh& m, int c, std::vector<std::pair<int32_t, int32_t>>& edges) {
   edges.clear();
@@ -106,13 +129,40 @@ void cell_edges(const PolyMesh& m, int c, std::vector<std::pair<int32_t, int32_t
 }
 }  // namespace
 
-std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& geo) {
+std::vector<Vec3> boundary_flux_points(const PolyMesh& m, const MeshGeometry& geo) {
+  std::vector<Vec3> out(geo.face_centroid);
+  const Vec3 s = m.metric_scale;
+  auto to_frame = [&](Vec3 p) { return Vec3{p.x / s.x, p.y / s.y, p.z / s.z}; };
+  parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
+    for (int f = static_cast<int>(fb); f < fe; ++f) {
+      if (m.face_neighbour[f] >= 0) continue;
+      const Vec3 x = to_frame(m.cell_fv_center[m.face_owner[f]]);
+      const int k = m.face_size(f);
+      const int32_t* v = m.face_begin(f);
+      Vec3 g;
+      for (int i = 0; i < k; ++i) g += m.nodes[v[i]];
+      g = to_frame(g / k);
+      double best = std::numeric_limits<double>::infinity();
+      Vec3 best_p = geo.face_centroid[f];
+      for (int i = 0; i < k; ++i) {
+        const Vec3 p = closest_point_on_triangle(x, g, to_frame(m.nodes[v[i]]), to_frame(m.nodes[v[(i + 1) % k]]));
+        const double d2 = norm2(p - x);
+        if (d2 < best) best = d2, best_p = Vec3{p.x * s.x, p.y * s.y, p.z * s.z};
+      }
+      if (std::isfinite(best)) out[f] = best_p;
+    }
+  });
+  return out;
+}
+
+std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& geo, BoundaryPoint boundary) {
   std::vector<double> q(m.n_faces(), 0.0);
+  const std::vector<Vec3> end = boundary == BoundaryPoint::Flux ? boundary_flux_points(m, geo) : geo.face_centroid;
   parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
     for (int f = static_cast<int>(fb); f < fe; ++f) {
       const double a = norm(geo.face_area[f]);
       const Vec3 p1 = m.cell_fv_center[m.face_owner[f]];
-      const Vec3 p2 = m.face_neighbour[f] >= 0 ? m.cell_fv_center[m.face_neighbour[f]] : geo.face_centroid[f];
+      const Vec3 p2 = m.face_neighbour[f] >= 0 ? m.cell_fv_center[m.face_neighbour[f]] : end[f];
       const Vec3 d = p2 - p1;
       const double l = norm(d);
       if (!(a > 0) || !(l > 0)) continue;  // degenerate: Q_O = 0
@@ -132,11 +182,12 @@ std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometr
     const Vec3 ns{r.x * area.x, r.y * area.y, r.z * area.z}, ds{d.x / r.x, d.y / r.y, d.z / r.z};
     return std::atan2(norm(cross(ds, ns)), std::fabs(dot(ds, ns))) * kDeg;
   };
+  const std::vector<Vec3> end = boundary_flux_points(m, geo);
   for (int f = 0; f < m.n_faces(); ++f) {
     const Vec3 a = geo.face_area[f];
     const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
     const Vec3 p1 = m.cell_fv_center[o];
-    const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : geo.face_centroid[f]) - p1;
+    const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : end[f]) - p1;
     if (!(norm(a) > 0) || !(norm(d) > 0)) {
       q[f] = 90.0;  // degenerate
       continue;

@@ -11,14 +11,32 @@
 
 namespace hm {
 
+/// The boundary point of the two-point flux of every boundary face (docs/fvcheck.md, "Boundary
+/// faces"): the point of the face (its fan of triangles around the node mean, as in
+/// compute_geometry) nearest to the owner's FV centre, distances measured in the mesh's
+/// permeability frame (coordinates divided by metric_scale; Euclidean when it is (1, 1, 1)).
+/// It is the foot of the perpendicular from the FV centre when that foot lies in the face, so
+/// the pair (FV centre, point) is then exactly normal to a planar face; otherwise a point of the
+/// face's edge. Interior faces: their centroid. The solver's Dirichlet value, the boundary
+/// half-transmissibility and Q_O of boundary faces all use this point.
+std::vector<Vec3> boundary_flux_points(const PolyMesh& mesh, const MeshGeometry& geo);
+
+/// Which point the boundary faces' two-point segment ends on in face_orthogonality.
+enum class BoundaryPoint {
+  Flux,      ///< boundary_flux_points: the checked measure (fvcheck, the self-check)
+  Centroid,  ///< the face centroid: the paper's literal eq. 8, reported for information only
+};
+
 /// Q_O(F) in degrees for every face (eq. 8): arcsin |u . n| with u the unit vector between
-/// the FV centres of owner and neighbour (boundary face: owner's FV centre -> face centroid)
-/// and n the unit face normal. 0 for a degenerate face or coincident points.
-std::vector<double> face_orthogonality(const PolyMesh& mesh, const MeshGeometry& geo);
+/// the FV centres of owner and neighbour (boundary face: owner's FV centre -> its boundary
+/// flux point, or the face centroid with BoundaryPoint::Centroid) and n the unit face normal.
+/// 0 for a degenerate face or coincident points.
+std::vector<double> face_orthogonality(const PolyMesh& mesh, const MeshGeometry& geo,
+                                       BoundaryPoint boundary = BoundaryPoint::Flux);
 
 /// K-non-orthogonality in degrees for every face (docs/anisotropy.md): the angle between K n and
 /// the line d between the FV centres of owner and neighbour (boundary face: owner's FV centre ->
-/// face centroid), measured in the metric of K^-1, i.e. the angle between n and d in coordinates
+/// its boundary flux point), measured in the metric of K^-1, i.e. the angle between n and d in coordinates
 /// scaled by K^-1/2 where the cell's K is isotropic (invariant under that scaling, so it equals
 /// the Euclidean non-orthogonality of the mesh in a permeability frame); K the cell's diagonal
 /// permeability, the larger of the owner's and the neighbour's angle. 0 iff K n || d; 90 for a

@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "meshgen/core/fv_quality.hpp"
 #include "ordering.hpp"
 
 namespace hm {
@@ -142,16 +143,21 @@ std::vector<BoundaryTerm> boundary_terms(const FlowProblem& pb, const Transmissi
   std::map<int, const WellControl*> control;
   for (const WellControl& wc : pb.wells) control[wc.well] = &wc;
   std::vector<BoundaryTerm> terms;
+  // The Dirichlet value of an outer face is taken at its boundary flux point, where its
+  // half-transmissibility ends (docs/fvcheck.md, "Boundary faces").
+  const std::vector<Vec3> flux_point = pb.outer_dirichlet ? boundary_flux_points(m, g) : std::vector<Vec3>{};
   for (int f = 0; f < m.n_faces(); ++f) {
     if (m.face_neighbour[f] >= 0) continue;
     const int32_t o = m.face_owner[f], patch = m.face_patch[f];
-    const double z_cell = m.cell_fv_center[o].z, z_face = g.face_centroid[f].z;
+    const double z_cell = m.cell_fv_center[o].z;
     const double grad_cell = st.rho[o] * gf;
     if (patch == kOuterBoundary && pb.outer_dirichlet) {
-      const double p = pb.outer_dirichlet(g.face_centroid[f]);
+      const Vec3 x_b = flux_point[f];
+      const double p = pb.outer_dirichlet(x_b);
       if (std::isnan(p)) continue;
-      terms.push_back({o, tr.half_owner[f] / mu * st.b[o], p + grad_cell * (z_cell - z_face), -1});
+      terms.push_back({o, tr.half_owner[f] / mu * st.b[o], p + grad_cell * (z_cell - x_b.z), -1});
     } else if (is_wellbore_patch(patch)) {
+      const double z_face = g.face_centroid[f].z;
       const int w = well_of_patch(patch);
       if (pb.wellbore_pressure) {
         terms.push_back(

@@ -63,7 +63,9 @@ struct FlowProblem {
   /// Extra connections (Peaceman); the wellbore faces of the mesh are connections too.
   std::vector<WellConnection> connections;
   /// Outer boundary: no-flow by default. When set, every face on kOuterBoundary gets
-  /// p = outer_dirichlet(face centroid) through the owner's half-transmissibility; a face for
+  /// p = outer_dirichlet(x_b) through the owner's half-transmissibility, x_b the face's boundary
+  /// flux point (boundary_flux_points: the foot of the perpendicular from the owner's FV centre,
+  /// the face centroid for a box cell); a face for
   /// which it returns NaN stays no-flow (mixed boundaries).
   std::function<double(Vec3)> outer_dirichlet;
   /// Optional: overrides BHP on every wellbore face (evaluated at the face centroid) and every

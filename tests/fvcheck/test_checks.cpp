@@ -266,31 +266,83 @@ TEST(Orthogonality, ExactAnglesAndThreshold) {
     if (*f != fi) {
       EXPECT_NEAR(q[*f], 90.0, 1e-12);
     }
-  // Cell 1's boundary face y = 0: centre (1.5,1.5,.5) to centroid (1.5,0,.5) is along -y: 90.
-  // Its face z = 0: centre to centroid (1.5,.5,0) = (0,-1,-.5): asin(.5 / sqrt(1.25)).
+  // Cell 1's centre (1.5,1.5,.5) lies beyond its face y = 1. Its boundary faces y = 0 and y = 1
+  // have the centre's foot inside: 90. Faces z = 0, z = 1, x = 2: the foot lies 0.5 beyond the
+  // edge y = 1 and the nearest point of the face is on that edge, (0, -.5, -/+.5) or (.5, -.5, 0)
+  // from the centre: 45 deg. To the face centroid (the paper's literal eq. 8, BoundaryPoint::
+  // Centroid) the segment is (0, -1, -/+.5) or (.5, -1, 0): asin(.5 / sqrt(1.25)) = 26.57 deg.
   const double expect_z0 = std::asin(0.5 / std::sqrt(1.25)) * 180.0 / M_PI;
-  bool seen = false;
-  for (const int32_t* f = m.cell_begin(1); f != m.cell_end(1); ++f)
-    if (std::fabs(g.face_centroid[*f].z) < 1e-15) {
-      EXPECT_NEAR(q[*f], expect_z0, 1e-12);
-      seen = true;
-    }
-  EXPECT_TRUE(seen);
+  const std::vector<double> q_centroid = face_orthogonality(m, g, BoundaryPoint::Centroid);
+  int seen = 0;
+  for (const int32_t* f = m.cell_begin(1); f != m.cell_end(1); ++f) {
+    if (*f == fi) continue;
+    const Vec3 c = g.face_centroid[*f];
+    const bool foot_inside = std::fabs(c.y) < 1e-15 || std::fabs(c.y - 1) < 1e-15;
+    EXPECT_NEAR(q[*f], foot_inside ? 90.0 : 45.0, 1e-12) << "face " << *f;
+    EXPECT_NEAR(q_centroid[*f], foot_inside ? 90.0 : expect_z0, 1e-12) << "face " << *f;
+    ++seen;
+  }
+  EXPECT_EQ(seen, 5);
   const std::vector<double> qc = cell_min_of_faces(m, q);
   EXPECT_NEAR(qc[0], 45.0, 1e-12);
-  EXPECT_NEAR(qc[1], std::min(45.0, expect_z0), 1e-12);
+  EXPECT_NEAR(qc[1], 45.0, 1e-12);
 
   CheckOptions strict;
   strict.min_orthogonality_deg = 50;
   const CheckResult fail = check_orthogonality(m, g, strict);
-  // Faces below 50 deg: the interior face (45) and cell 1's faces z = 0, z = 1 and x = 2
-  // (centre to centroid (0, -1, -/+.5) and (.5, -1, 0): 26.57 deg each).
+  // Faces below 50 deg: the interior face and cell 1's faces z = 0, z = 1 and x = 2 (45 each).
   EXPECT_EQ(fail.violations, 4);
-  EXPECT_NEAR(fail.worst, expect_z0, 1e-12);
+  EXPECT_NEAR(fail.worst, 45.0, 1e-12);
+  EXPECT_NEAR(measure_of(fail, "boundary_centroid_min_deg"), expect_z0, 1e-12);
+  EXPECT_EQ(count_of(fail, "boundary_faces_below_threshold_at_centroid"), 3);
   CheckOptions loose;
   loose.min_orthogonality_deg = 20;
   EXPECT_TRUE(check_orthogonality(m, g, loose).ok());
   EXPECT_TRUE(check_orthogonality(box_grid(2, 2, 2), compute_geometry(box_grid(2, 2, 2))).ok());
+}
+
+// A boundary face's two-point pair is the FV centre and its boundary flux point: the foot of the
+// perpendicular when it lies in the face (docs/fvcheck.md, "Boundary faces"). One flat triangular
+// prism, (0,0), (10,0), (9,.5) x [0, 1], with two FV centres inside it (convexity and auto-centering
+// hold for both): the first projects into every face, the second projects 5.2 beyond the short
+// sloped face (10,0)-(9,.5), 3.04 away from its plane.
+TEST(Orthogonality, BoundaryFaceIsOrthogonalExactlyWhenTheCentreProjectsIntoIt) {
+  const std::vector<std::pair<double, double>> sliver{{0, 0}, {10, 0}, {9, 0.5}};
+  const Vec3 sloped_n = normalized(Vec3{0.5, 1, 0});  // outward normal of the face (10,0)-(9,.5)
+
+  const PolyMesh good = prism(sliver, 0, 1, {9.0, 0.3, 0.5});
+  const MeshGeometry gg = compute_geometry(good);
+  EXPECT_TRUE(check_convexity(good, gg).ok());
+  EXPECT_TRUE(check_auto_centering(good, gg).ok());
+  const CheckResult ok = check_orthogonality(good, gg);
+  EXPECT_TRUE(ok.ok());
+  EXPECT_NEAR(ok.worst, 90.0, 1e-9);
+  // The flux point of every face is the foot: the centre minus its distance along the normal.
+  const std::vector<Vec3> foot = boundary_flux_points(good, gg);
+  for (int f = 0; f < good.n_faces(); ++f) {
+    const Vec3 n = normalized(gg.face_area[f]), x = good.cell_fv_center[0];
+    const Vec3 expect = x - dot(x - gg.face_centroid[f], n) * n;
+    EXPECT_LT(norm(foot[f] - expect), 1e-12) << "face " << f;
+  }
+  // The centroid rule would have failed every face of this cell; worst the long face (0,0)-(9,.5),
+  // seen from the centre (9, .3) towards its centroid (4.5, .25) at 2.5 degrees.
+  const Vec3 to_centroid{-4.5, -0.05, 0}, long_n = normalized(Vec3{-0.5, 9, 0});
+  EXPECT_NEAR(measure_of(ok, "boundary_centroid_min_deg"),
+              std::asin(std::fabs(dot(to_centroid, long_n)) / norm(to_centroid)) * 180 / M_PI, 1e-9);
+  EXPECT_EQ(count_of(ok, "boundary_faces_below_threshold_at_centroid"), 5);
+
+  const PolyMesh bad = prism(sliver, 0, 1, {3.0, 0.1, 0.5});
+  const MeshGeometry gb = compute_geometry(bad);
+  EXPECT_TRUE(check_convexity(bad, gb).ok());
+  EXPECT_TRUE(check_auto_centering(bad, gb).ok());
+  const CheckResult r = check_orthogonality(bad, gb);
+  EXPECT_FALSE(r.ok());
+  ASSERT_EQ(r.violations, 1);
+  // The nearest point of the sloped face is its edge at (9, .5, .5): d = (6, .4, 0).
+  const Vec3 d{6, 0.4, 0};
+  EXPECT_NEAR(r.worst, std::asin(std::fabs(dot(d, sloped_n)) / norm(d)) * 180 / M_PI, 1e-9);
+  EXPECT_LT(r.worst, 45.0);
+  EXPECT_LT(norm(boundary_flux_points(bad, gb)[r.worst_ids[0]] - Vec3{9, 0.5, 0.5}), 1e-12);
 }
 
 // ---------------------------------------------------------------- auto-centering

@@ -74,6 +74,8 @@ TEST(RealisticSweep, FullSweepTable) {
   const double timeout = env_int("HM_SWEEP_TIMEOUT", 600);
   const char* log_path = std::getenv("HM_SWEEP_LOG");
   const bool only_bent = env_int("HM_SWEEP_ONLY_BENT", 0) == 1;  // rerun only the cases with a bent well
+  // HM_SWEEP_DUMP=DIR: every case's file as DIR/seed_<seed>.yaml, to rerun with `meshgen FILE -o OUT`.
+  const char* dump_dir = std::getenv("HM_SWEEP_DUMP");
   std::ofstream log;
   if (log_path) log.open(log_path);
   struct Row {
@@ -88,6 +90,11 @@ TEST(RealisticSweep, FullSweepTable) {
     const RealisticOptions o = sweep_options(seed);
     const RealisticCase rc = make_realistic_case(seed, o);
     if (only_bent && rc.bends == 0) continue;
+    if (dump_dir) {
+      std::ofstream yaml(std::string(dump_dir) + "/seed_" + std::to_string(seed) + ".yaml");
+      yaml << rc.yaml;
+      EXPECT_TRUE(yaml.good()) << "HM_SWEEP_DUMP: cannot write into " << dump_dir;
+    }
     const CaseResult r = mesh_and_check_isolated(rc, timeout);
     for (Row* row : {&rows[shape_class(rc)], &all}) {
       ++row->count[r.outcome];
