@@ -71,6 +71,12 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
     if (!(std::abs(got - expected) <= 1e-9 * expected)) bad += "volume " + std::to_string(got / expected - 1) + "; ";
     res.outcome = bad.empty() ? Outcome::Meshed : Outcome::CheckFailed;
     res.reason = bad;
+    // For the before/after tables (docs/robustness.md): a mesh that passes would have failed the
+    // boundary-face rule before session 6 (FV centre to face centroid, docs/fvcheck.md).
+    for (const CheckResult& c : fv.checks)
+      for (const auto& [k, v] : c.counts)
+        if (res.outcome == Outcome::Meshed && k == "boundary_faces_below_threshold_at_centroid" && v > 0)
+          res.reason = "passes; the centroid rule would fail " + std::to_string(v) + " boundary faces";
   } catch (const InputError& e) {
     res.outcome = Outcome::Refused;
     res.reason = e.what();

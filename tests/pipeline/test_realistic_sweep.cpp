@@ -74,6 +74,7 @@ TEST(RealisticSweep, FullSweepTable) {
   const double timeout = env_int("HM_SWEEP_TIMEOUT", 600);
   const char* log_path = std::getenv("HM_SWEEP_LOG");
   const bool only_bent = env_int("HM_SWEEP_ONLY_BENT", 0) == 1;  // rerun only the cases with a bent well
+  const bool only_cross = env_int("HM_SWEEP_ONLY_CROSS", 0) == 1;  // only the wells through the top (and bottom)
   // HM_SWEEP_DUMP=DIR: every case's file as DIR/seed_<seed>.yaml, to rerun with `meshgen FILE -o OUT`.
   const char* dump_dir = std::getenv("HM_SWEEP_DUMP");
   std::ofstream log;
@@ -90,6 +91,7 @@ TEST(RealisticSweep, FullSweepTable) {
     const RealisticOptions o = sweep_options(seed);
     const RealisticCase rc = make_realistic_case(seed, o);
     if (only_bent && rc.bends == 0) continue;
+    if (only_cross && !o.cross_top_bottom) continue;
     if (dump_dir) {
       std::ofstream yaml(std::string(dump_dir) + "/seed_" + std::to_string(seed) + ".yaml");
       yaml << rc.yaml;
@@ -160,13 +162,15 @@ TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
 }
 
 // The CI subset's wells through the reservoir boundary (flat ends, local coordinates, no
-// optimisation, cells at most 20 m wide): seed 2 (vertical, through the top and the bottom) and 3
-// (1 degree, through the top), or seeds 1..N with HM_CROSS_SEEDS=N. Each must mesh and pass
-// mesh_and_check. These two are regression guards, not a sample: of seeds 1-12 only 2, 3 and 12
-// (all near vertical) pass; the others fail fvcheck's orthogonality in transition cells
-// (docs/robustness.md, "Wells through the top and bottom").
+// optimisation, cells at most 20 m wide), or seeds 1..N with HM_CROSS_SEEDS=N. Each must mesh and
+// pass mesh_and_check. Of seeds 1-30, 24 pass since boundary faces are measured towards their
+// boundary flux point (docs/fvcheck.md, "Boundary faces"; before: 3 of 1-12, the centroid rule
+// failing the others); 6, 7, 8, 16 and 29 still fail orthogonality on boundary faces whose
+// transition site projects outside them, 17 (bent) convexity (docs/robustness.md). The default
+// run takes nine small ones: inclination 0-50 degrees, five through the top only, four through the
+// top and the bottom (seed 5: the case whose boundary faces failed at 32-40 degrees before).
 TEST(RealisticSweep, CiSubsetWellsThroughTopAndBottomMeshAndPassFvcheck) {
-  std::vector<uint32_t> seeds = {2, 3};
+  std::vector<uint32_t> seeds = {1, 2, 3, 5, 9, 11, 12, 13, 27};
   if (const char* v = std::getenv("HM_CROSS_SEEDS")) {
     seeds.clear();
     for (int k = 1; k <= std::atoi(v); ++k) seeds.push_back(static_cast<uint32_t>(k));
