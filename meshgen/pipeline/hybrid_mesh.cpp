@@ -30,7 +30,10 @@ TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& g
   q.vertices = static_cast<int>(vertices.size());
   q.faces = static_cast<int>(faces.size());
   q.q_s = stats_of(cell_shape_quality(mesh, h_ref), is_transition);
-  q.q_o = stats_of(cell_min_of_faces(mesh, face_orthogonality(mesh, geo)), is_transition);
+  // The paper's Table 2 measure, kept comparable: on a cavity's own submesh its constrained polygons
+  // are boundary faces, measured from the site to their centroid (their flux point is the site's
+  // foot, so the checked measure would be 90 by construction there).
+  q.q_o = stats_of(cell_min_of_faces(mesh, face_orthogonality(mesh, geo, BoundaryPoint::Centroid)), is_transition);
   q.q_p = stats_of(cell_max_of_faces(mesh, face_planarity(mesh, geo)), is_transition);
   return q;
 }
