@@ -82,11 +82,13 @@ void print_figures(const std::string& name, const Agreement& a) {
   std::printf(
       "[ figures  ] %s: %g cells (%g polyhedra); VTK-read faces: volume max rel %.2g, convexity %.2g of the diameter; "
       "vtkCellSizeFilter: %g cells > 1e-6 (max %.3g), %g of them its triangulation's hole; vtkCellValidator: %g invalid "
-      "(orientation %g, all bounding-box centre outside: %s; non-convex %g = %g centroid + %g seam test; intersecting %g)\n",
+      "(orientation %g = %g bounding-box centre + %g short edge; non-convex %g = %g centroid + %g seam test; intersecting %g, "
+      "%g not on a short edge)\n",
       name.c_str(), a.at("cells"), a.at("polyhedra"), a.at("face_volume_max_rel"), a.at("convexity_max"), a.at("size_bad"),
       a.at("size_max_rel"), a.at("size_hole"), a.at("invalid"), a.at("invalid_orientation"),
-      a.at("invalid_orientation_unexplained") == 0 ? "yes" : "no", a.at("invalid_nonconvex"),
-      a.at("invalid_nonconvex_centroid"), a.at("invalid_nonconvex_seam"), a.at("invalid_intersecting"));
+      a.at("invalid_orientation_bbox"), a.at("invalid_orientation_short_edge"), a.at("invalid_nonconvex"),
+      a.at("invalid_nonconvex_centroid"), a.at("invalid_nonconvex_seam"), a.at("invalid_intersecting"),
+      a.at("invalid_intersecting_unexplained"));
 }
 
 // What must hold for any mesh we write: VTK reads our volume and a convex cell with outward
@@ -101,8 +103,10 @@ void expect_vtk_reads_ours(const hm::PolyMesh& m, const Agreement& a) {
   // Every vtkCellSizeFilter disagreement is a hole in VTK's point-cloud triangulation.
   EXPECT_EQ(a.at("size_unexplained"), 0);
   EXPECT_EQ(a.at("size_hole"), a.at("size_bad"));
-  // Every orientation flag comes from the bounding-box centre lying outside the (convex) cell.
+  // Every orientation flag comes from the bounding-box centre lying outside the (convex) cell or
+  // a face with an edge shorter than 1e-3 of the cell (ours), and every intersection flag a short edge.
   EXPECT_EQ(a.at("invalid_orientation_unexplained"), 0);
+  EXPECT_EQ(a.at("invalid_intersecting_unexplained"), 0);
   EXPECT_EQ(a.at("invalid_other"), 0);
 }
 

@@ -7,15 +7,19 @@ Our measures, on the points and faces VTK read (vtkCell.GetFace):
   face_volume_max_rel  volume by the divergence theorem over VTK's faces against `volume`
   convexity_max        the highest vertex above a face plane of its cell, over the cell diameter
   orientation_bad      cells with a face whose normal points towards the cell's vertex mean
-VTK 9.1's measures and the three defects that explain their disagreement:
+VTK 9.1's measures and what explains their disagreement, reproduced cell by cell:
   size_*               vtkCellSizeFilter; a polyhedron's volume is the sum of the tetrahedra of
                        vtkPolyhedron::Triangulate (a Delaunay triangulation of the cell's points in a
                        bounding octahedron 2 bounding-box diagonals wide, vtkOrderedTriangulator);
                        `hole`: those tetrahedra leave a triangle inside the cell uncovered
-  invalid_*            vtkCellValidator states; bit 32 (faces oriented incorrectly) is measured from
-                       the bounding-box centre (vtkPolyhedron's parametric centre); bit 16 (non-convex)
-                       from vtkPolygon::ComputeCentroid, which projects a face on the x-y plane unless
-                       its normal is horizontal to DBL_EPSILON
+  invalid_*            vtkCellValidator states. Bit 32 (faces oriented incorrectly) is measured from
+                       the bounding-box centre (vtkPolyhedron's parametric centre), and is also set
+                       when a face fails VTK's polygon check, which an edge shorter than 1e-3 of the
+                       cell does (`short_edge`: ours). Bit 16 (non-convex): vtkPolyhedron::IsConvex's
+                       edge test with vtkPolygon::ComputeCentroid, which projects a face on the x-y
+                       plane unless its normal is horizontal to DBL_EPSILON (`centroid`), or its seam
+                       test (`seam`). Bits 2 and 4 (intersecting edges, faces): FLT_EPSILON
+                       tolerances (vtkLine::Intersection: 1e-6 relative) on a cell with an edge shorter than 1e-3 of its diameter.
 """
 import collections
 import sys
@@ -25,6 +29,7 @@ import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
 DBL_EPS = np.finfo(float).eps
+FLT_EPS = float(np.finfo(np.float32).eps)  # vtkCellValidator's default tolerance
 
 
 def newell(Q):
@@ -180,6 +185,8 @@ def main(path):
         bbox_centre = (lo + hi) / 2
         vol = 0.0
         bbox_outside = False
+        short_edge = min(np.linalg.norm(P[f[i]] - P[f[(i + 1) % len(f)]]) for f in faces for i in range(len(f))) < 1e-3 * diam
+        rejected_face = False
         normals, vtk_c, true_c = [], [], []
         for f in faces:
             Q = np.array([P[i] for i in f])
@@ -191,6 +198,8 @@ def main(path):
                 orient_bad += 1
             if np.dot(nrm, bbox_centre - ac) >= 0:
                 bbox_outside = True
+            if state[c] & 32 and not rejected_face:
+                rejected_face = vtk.vtkCellValidator.Check(cell.GetFace(faces.index(f)), FLT_EPS) != 0
             normals.append(vtk91_normal(Q))
             vtk_c.append(vtk91_centroid(Q))
             true_c.append(ac)
@@ -217,7 +226,12 @@ def main(path):
             inv["invalid"] += 1
             if s & 32:
                 inv["invalid_orientation"] += 1
-                inv["invalid_orientation_unexplained"] += not bbox_outside
+                inv["invalid_orientation_bbox"] += bbox_outside
+                # FacesAreOrientedCorrectly also fails when a face fails VTK's polygon check, which
+                # happens on faces with an edge shorter than 1e-3 of the cell (our short edges).
+                by_face = not bbox_outside and rejected_face and short_edge
+                inv["invalid_orientation_short_edge"] += by_face
+                inv["invalid_orientation_unexplained"] += not (bbox_outside or by_face)
             if s & 16:
                 inv["invalid_nonconvex"] += 1
                 edges = collections.defaultdict(list)
@@ -236,6 +250,7 @@ def main(path):
                     print("## nonconvex flag not reproduced: cell", c, "type", g.GetCellType(c))
             if s & 6:
                 inv["invalid_intersecting"] += 1
+                inv["invalid_intersecting_unexplained"] += not short_edge
             if s & ~(32 | 16 | 6):
                 inv["invalid_other"] += 1
     out["face_volume_max_rel"] = fv_max
@@ -245,9 +260,10 @@ def main(path):
     out["size_max_rel"] = size_max
     out["size_hole"] = size_hole
     out["size_unexplained"] = size_unexplained
-    for k in ("invalid", "invalid_orientation", "invalid_orientation_unexplained", "invalid_nonconvex",
+    for k in ("invalid", "invalid_orientation", "invalid_orientation_bbox", "invalid_orientation_short_edge",
+              "invalid_orientation_unexplained", "invalid_nonconvex",
               "invalid_nonconvex_centroid",
-              "invalid_nonconvex_seam", "invalid_nonconvex_seam_centroid", "invalid_intersecting", "invalid_other"):
+              "invalid_nonconvex_seam", "invalid_nonconvex_seam_centroid", "invalid_intersecting", "invalid_intersecting_unexplained", "invalid_other"):
         out[k] = inv[k]
     for k, v in out.items():
         print("@@", k, repr(v), flush=True)
