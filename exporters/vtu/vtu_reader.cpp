@@ -28,6 +28,7 @@
 
 #include "exporters/vtu/vtu_mesh_arrays.hpp"
 #include "meshgen/core/geometry.hpp"
+#include "meshgen/core/parallel.hpp"
 
 namespace hm {
 
@@ -535,10 +536,166 @@ Parsed parse_document(Source& src) {
   return out;
 }
 
-ReadResult convert(Parsed&& in) {
-  ReadResult res;
-  res.has_face_patch = in.has_face_patch;
-  res.warnings = std::move(in.warnings);
+// The mesh of a file whose faces are all regular, built in parallel: exactly what MeshBuilder
+// builds from the same cells (faces numbered by first use, the owner's cycle stored, nodes
+// compacted in their order), without its serial hash table. Returns false, building nothing,
+// at the first irregularity (a face with fewer than 3 distinct nodes or a repeated node, a face
+// named by a third cell, twice by one cell or twice in the same orientation, an interior face
+// with no second cell): MeshBuilder then builds the mesh and reports the problems, in order.
+bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, const std::vector<int32_t>& face_patch,
+                        PolyMesh* out, BuildReport* report) {
+  const int64_t nq = cells.faces(), nc = cells.size();
+  if (nq >= std::numeric_limits<int32_t>::max() || static_cast<int64_t>(cells.nodes.size()) >= std::numeric_limits<int32_t>::max())
+    return false;
+  const int32_t* nodes = cells.nodes.data();
+  const int64_t* fp = cells.face_ptr.data();
+  // Per file face: its canonical form (start at the smallest id, direction towards the smaller
+  // neighbour, as canonical_cycle_into) and a hash of it; irregular faces stop the fast path.
+  std::vector<uint64_t> hash(static_cast<size_t>(nq));
+  std::vector<int32_t> start(static_cast<size_t>(nq));
+  std::vector<uint8_t> rev(static_cast<size_t>(nq));
+  std::vector<uint8_t> irregular(static_cast<size_t>(nq), 0);
+  parallel_ranges(nq, [&](int64_t b, int64_t e) {
+    std::vector<int32_t> sorted;
+    for (int64_t q = b; q < e; ++q) {
+      const int32_t* c = nodes + fp[q];
+      const int64_t n = fp[q + 1] - fp[q];
+      sorted.assign(c, c + n);
+      std::sort(sorted.begin(), sorted.end());
+      if (n < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+        irregular[q] = 1;
+        continue;
+      }
+      const int64_t k = std::min_element(c, c + n) - c;
+      const bool r = c[(k + n - 1) % n] < c[(k + 1) % n];
+      uint64_t h = 1469598103934665603ull;
+      for (int64_t i = 0; i < n; ++i) {
+        h ^= static_cast<uint32_t>(r ? c[(k + n - i) % n] : c[(k + i) % n]);
+        h *= 1099511628211ull;
+      }
+      hash[q] = h ^ (h >> 29);
+      start[q] = static_cast<int32_t>(k);
+      rev[q] = r;
+    }
+  });
+  if (std::any_of(irregular.begin(), irregular.end(), [](uint8_t x) { return x != 0; })) return false;
+  auto same = [&](int64_t a, int64_t b) {
+    const int64_t n = fp[a + 1] - fp[a];
+    if (n != fp[b + 1] - fp[b]) return false;
+    const int32_t *ca = nodes + fp[a], *cb = nodes + fp[b];
+    for (int64_t i = 0; i < n; ++i) {
+      const int32_t va = rev[a] ? ca[(start[a] + n - i) % n] : ca[(start[a] + i) % n];
+      const int32_t vb = rev[b] ? cb[(start[b] + n - i) % n] : cb[(start[b] + i) % n];
+      if (va != vb) return false;
+    }
+    return true;
+  };
+  std::vector<int32_t> cell_of(static_cast<size_t>(nq));
+  parallel_ranges(nc, [&](int64_t b, int64_t e) {
+    for (int64_t c = b; c < e; ++c)
+      for (int64_t q = cells.cell_ptr[c]; q < cells.cell_ptr[c + 1]; ++q) cell_of[q] = static_cast<int32_t>(c);
+  });
+  // Partner of each file face (the other file face with the same cycle, -1 if none): faces are
+  // grouped in buckets by the top bits of their hash (counted and scattered in file order), and
+  // each bucket sorted by (hash, file face) and matched on its own.
+  const int bits = 16;
+  const size_t nb = size_t(1) << bits;
+  std::vector<int64_t> bucket_ptr(nb + 1, 0);
+  for (int64_t q = 0; q < nq; ++q) ++bucket_ptr[(hash[q] >> (64 - bits)) + 1];
+  for (size_t i = 0; i < nb; ++i) bucket_ptr[i + 1] += bucket_ptr[i];
+  std::vector<int64_t> order(static_cast<size_t>(nq));
+  {
+    std::vector<int64_t> fill(bucket_ptr.begin(), bucket_ptr.end() - 1);
+    for (int64_t q = 0; q < nq; ++q) order[fill[hash[q] >> (64 - bits)]++] = q;
+  }
+  std::vector<int64_t> partner(static_cast<size_t>(nq), -1);
+  std::vector<uint8_t> bad(nb, 0);
+  parallel_ranges(static_cast<int64_t>(nb), [&](int64_t b, int64_t e) {
+    for (int64_t k = b; k < e; ++k) {
+      int64_t* lo = order.data() + bucket_ptr[k];
+      int64_t* hi = order.data() + bucket_ptr[k + 1];
+      std::sort(lo, hi, [&](int64_t x, int64_t y) { return hash[x] != hash[y] ? hash[x] < hash[y] : x < y; });
+      for (int64_t* run = lo; run < hi;) {
+        int64_t* end = run;
+        while (end < hi && hash[*end] == hash[*run]) ++end;
+        for (int64_t* i = run + 1; i < end; ++i)
+          for (int64_t* j = run; j < i; ++j) {
+            if (!same(*j, *i)) continue;
+            // *i is a later use of the face first named by *j (or by *j's partner)
+            if (partner[*j] >= 0 || partner[*i] >= 0 || cell_of[*j] == cell_of[*i] || rev[*j] == rev[*i]) bad[k] = 1;
+            partner[*j] = *i;
+            partner[*i] = *j;
+            break;
+          }
+        run = end;
+      }
+    }
+  }, 64);
+  if (std::any_of(bad.begin(), bad.end(), [](uint8_t x) { return x != 0; })) return false;
+  // Faces numbered by first use (file order), as MeshBuilder numbers them.
+  std::vector<int32_t> face_id(static_cast<size_t>(nq));
+  std::vector<int64_t> first_use;
+  first_use.reserve(static_cast<size_t>(nq / 2 + 1));
+  for (int64_t q = 0; q < nq; ++q) {
+    if (partner[q] < 0 || partner[q] > q) {
+      face_id[q] = static_cast<int32_t>(first_use.size());
+      first_use.push_back(q);
+    } else {
+      face_id[q] = face_id[partner[q]];
+    }
+  }
+  const int64_t nf = static_cast<int64_t>(first_use.size());
+  for (int64_t f = 0; f < nf; ++f)  // a boundary face the file calls interior: MeshBuilder reports it
+    if (partner[first_use[f]] < 0 && face_patch[first_use[f]] == kInteriorFace) return false;
+  // Nodes: those some face references, in their order.
+  std::vector<int32_t> new_id(points.size(), -1);
+  for (int32_t v : cells.nodes) new_id[v] = 0;
+  PolyMesh m;
+  int removed = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (new_id[i] == 0) {
+      new_id[i] = static_cast<int32_t>(m.nodes.size());
+      m.nodes.push_back(points[i]);
+    } else {
+      ++removed;
+    }
+  }
+  m.face_node_ptr.assign(static_cast<size_t>(nf) + 1, 0);
+  for (int64_t f = 0; f < nf; ++f)
+    m.face_node_ptr[f + 1] = m.face_node_ptr[f] + static_cast<int32_t>(fp[first_use[f] + 1] - fp[first_use[f]]);
+  m.face_nodes.resize(static_cast<size_t>(m.face_node_ptr[nf]));
+  m.face_owner.resize(static_cast<size_t>(nf));
+  m.face_neighbour.resize(static_cast<size_t>(nf));
+  m.face_patch.resize(static_cast<size_t>(nf));
+  parallel_ranges(nf, [&](int64_t b, int64_t e) {
+    for (int64_t f = b; f < e; ++f) {
+      const int64_t q = first_use[f];
+      int32_t* dst = m.face_nodes.data() + m.face_node_ptr[f];
+      for (int64_t i = fp[q]; i < fp[q + 1]; ++i) *dst++ = new_id[nodes[i]];
+      m.face_owner[f] = cell_of[q];
+      m.face_neighbour[f] = partner[q] >= 0 ? cell_of[partner[q]] : -1;
+      m.face_patch[f] = partner[q] >= 0 ? kInteriorFace : face_patch[q];
+    }
+  });
+  m.cell_face_ptr.resize(static_cast<size_t>(nc) + 1);
+  for (int64_t c = 0; c <= nc; ++c) m.cell_face_ptr[c] = static_cast<int32_t>(cells.cell_ptr[c]);
+  m.cell_faces = std::move(face_id);
+  const CellAttributes none{};
+  m.cell_region.assign(static_cast<size_t>(nc), none.region);
+  m.cell_fv_center.assign(static_cast<size_t>(nc), none.fv_center);
+  m.cell_ijk.assign(static_cast<size_t>(nc), none.ijk);
+  m.cell_perm.assign(static_cast<size_t>(nc), none.perm);
+  m.cell_porosity.assign(static_cast<size_t>(nc), none.porosity);
+  m.cell_radial.assign(static_cast<size_t>(nc), none.radial);
+  *out = std::move(m);
+  *report = BuildReport{};
+  report->removed_unused_nodes = removed;
+  return true;
+}
+
+// MeshBuilder's mesh of the file's cells, face by face (every file, and the one that reports
+// the problems of an irregular file).
+void build_with_mesh_builder(Parsed& in, ReadResult& res) {
   const RawCells& cells = in.cells;
   std::vector<int32_t> f;  // one face's point ids
   auto load_face = [&](int64_t q) {
@@ -572,6 +729,21 @@ ReadResult convert(Parsed&& in) {
   in.cells = RawCells{};
   in.face_patch = {};
   res.mesh = mb.finish(&res.build);
+}
+
+ReadResult convert(Parsed&& in, VtuAssembly assembly) {
+  ReadResult res;
+  res.has_face_patch = in.has_face_patch;
+  res.warnings = std::move(in.warnings);
+  if (assembly == VtuAssembly::Parallel && res.has_face_patch &&
+      build_regular_mesh(in.cells, in.points, in.face_patch, &res.mesh, &res.build)) {
+    res.assembled_in_parallel = true;
+    in.points = {};
+    in.cells = RawCells{};
+    in.face_patch = {};
+  } else {
+    build_with_mesh_builder(in, res);
+  }
   PolyMesh& m = res.mesh;
   for (const Array& a : in.cell_data) {
     std::vector<double> v(a.size());
@@ -594,7 +766,7 @@ ReadResult convert(Parsed&& in) {
 
 // Parses the stream with VTK's vtkXMLDataParser and converts it; VTK's first error message
 // becomes ours, and VTK prints nothing.
-ReadResult read_stream(std::istream& in, uint64_t file_bytes) {
+ReadResult read_stream(std::istream& in, uint64_t file_bytes, VtuAssembly assembly) {
   QuietVtk quiet;
   vtkNew<MessageCatcher> catcher;
   vtkNew<vtkXMLDataParser> parser;
@@ -616,7 +788,7 @@ ReadResult read_stream(std::istream& in, uint64_t file_bytes) {
     src.file_bytes = file_bytes;
     Parsed doc = parse_document(src);
     if (!catcher->errors.empty()) fail(catcher->errors.front());
-    r = convert(std::move(doc));
+    r = convert(std::move(doc), assembly);
   } catch (const VtuError& e) {
     r = ReadResult{};
     r.error = e.what;
@@ -635,17 +807,17 @@ ReadResult read_stream(std::istream& in, uint64_t file_bytes) {
 
 }  // namespace
 
-ReadResult read_vtu_buffer(const std::string& bytes) {
+ReadResult read_vtu_buffer(const std::string& bytes, VtuAssembly assembly) {
   if (bytes.empty()) {
     ReadResult r;
     r.error = "empty file";
     return r;
   }
   std::istringstream in(bytes);
-  return read_stream(in, bytes.size());
+  return read_stream(in, bytes.size(), assembly);
 }
 
-ReadResult read_vtu(const std::string& path) {
+ReadResult read_vtu(const std::string& path, VtuAssembly assembly) {
   std::error_code ec;
   ReadResult r;
   if (std::filesystem::is_directory(path, ec)) {
@@ -662,7 +834,7 @@ ReadResult read_vtu(const std::string& path) {
     r.error = path + ": empty file";
     return r;
   }
-  r = read_stream(in, size);
+  r = read_stream(in, size, assembly);
   if (!r.ok) r.error = path + ": " + r.error;
   return r;
 }
