@@ -560,18 +560,26 @@ bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, 
     for (int64_t q = b; q < e; ++q) {
       const int32_t* c = nodes + fp[q];
       const int64_t n = fp[q + 1] - fp[q];
-      sorted.assign(c, c + n);
-      std::sort(sorted.begin(), sorted.end());
-      if (n < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+      bool repeated = false;
+      if (n <= 16) {  // pairwise: no copy for the usual 3-8 nodes
+        for (int64_t i = 1; i < n && !repeated; ++i)
+          for (int64_t j = 0; j < i && !repeated; ++j) repeated = c[i] == c[j];
+      } else {
+        sorted.assign(c, c + n);
+        std::sort(sorted.begin(), sorted.end());
+        repeated = std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+      }
+      if (n < 3 || repeated) {
         irregular[q] = 1;
         continue;
       }
       const int64_t k = std::min_element(c, c + n) - c;
       const bool r = c[(k + n - 1) % n] < c[(k + 1) % n];
       uint64_t h = 1469598103934665603ull;
-      for (int64_t i = 0; i < n; ++i) {
-        h ^= static_cast<uint32_t>(r ? c[(k + n - i) % n] : c[(k + i) % n]);
+      for (int64_t i = 0, j = k; i < n; ++i) {  // j: the i-th canonical position, without a division
+        h ^= static_cast<uint32_t>(c[j]);
         h *= 1099511628211ull;
+        j = r ? (j == 0 ? n - 1 : j - 1) : (j == n - 1 ? 0 : j + 1);
       }
       hash[q] = h ^ (h >> 29);
       start[q] = static_cast<int32_t>(k);
@@ -583,10 +591,10 @@ bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, 
     const int64_t n = fp[a + 1] - fp[a];
     if (n != fp[b + 1] - fp[b]) return false;
     const int32_t *ca = nodes + fp[a], *cb = nodes + fp[b];
-    for (int64_t i = 0; i < n; ++i) {
-      const int32_t va = rev[a] ? ca[(start[a] + n - i) % n] : ca[(start[a] + i) % n];
-      const int32_t vb = rev[b] ? cb[(start[b] + n - i) % n] : cb[(start[b] + i) % n];
-      if (va != vb) return false;
+    for (int64_t i = 0, ja = start[a], jb = start[b]; i < n; ++i) {
+      if (ca[ja] != cb[jb]) return false;
+      ja = rev[a] ? (ja == 0 ? n - 1 : ja - 1) : (ja == n - 1 ? 0 : ja + 1);
+      jb = rev[b] ? (jb == 0 ? n - 1 : jb - 1) : (jb == n - 1 ? 0 : jb + 1);
     }
     return true;
   };
