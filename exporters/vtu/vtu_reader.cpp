@@ -536,24 +536,25 @@ Parsed parse_document(Source& src) {
   return out;
 }
 
-// The mesh of a file whose faces are all regular, built in parallel: exactly what MeshBuilder
-// builds from the same cells (faces numbered by first use, the owner's cycle stored, nodes
-// compacted in their order), without its serial hash table. Returns false, building nothing,
-// at the first irregularity (a face with fewer than 3 distinct nodes or a repeated node, a face
-// named by a third cell, twice by one cell or twice in the same orientation, an interior face
-// with no second cell): MeshBuilder then builds the mesh and reports the problems, in order.
-bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, const std::vector<int32_t>& face_patch,
-                        PolyMesh* out, BuildReport* report) {
-  const int64_t nq = cells.faces(), nc = cells.size();
-  if (nq >= std::numeric_limits<int32_t>::max() || static_cast<int64_t>(cells.nodes.size()) >= std::numeric_limits<int32_t>::max())
-    return false;
+// Canonical form of every face of a file (start at the smallest id, direction towards the
+// smaller neighbour, as canonical_cycle_into) and a hash of it.
+struct FaceKeys {
+  std::vector<uint64_t> hash;
+  std::vector<int32_t> start;
+  std::vector<uint8_t> rev;
+};
+
+// Fills the keys on all cores; false if a face has fewer than 3 nodes or a repeated node.
+bool face_keys(const RawCells& cells, FaceKeys* keys) {
+  const int64_t nq = cells.faces();
   const int32_t* nodes = cells.nodes.data();
   const int64_t* fp = cells.face_ptr.data();
-  // Per file face: its canonical form (start at the smallest id, direction towards the smaller
-  // neighbour, as canonical_cycle_into) and a hash of it; irregular faces stop the fast path.
-  std::vector<uint64_t> hash(static_cast<size_t>(nq));
-  std::vector<int32_t> start(static_cast<size_t>(nq));
-  std::vector<uint8_t> rev(static_cast<size_t>(nq));
+  std::vector<uint64_t>& hash = keys->hash;
+  std::vector<int32_t>& start = keys->start;
+  std::vector<uint8_t>& rev = keys->rev;
+  hash.resize(static_cast<size_t>(nq));
+  start.resize(static_cast<size_t>(nq));
+  rev.resize(static_cast<size_t>(nq));
   std::vector<uint8_t> irregular(static_cast<size_t>(nq), 0);
   parallel_ranges(nq, [&](int64_t b, int64_t e) {
     std::vector<int32_t> sorted;
@@ -586,7 +587,21 @@ bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, 
       rev[q] = r;
     }
   });
-  if (std::any_of(irregular.begin(), irregular.end(), [](uint8_t x) { return x != 0; })) return false;
+  return std::none_of(irregular.begin(), irregular.end(), [](uint8_t x) { return x != 0; });
+}
+
+// The partner of each file face (the other file face with the same cycle, -1 if none). Faces are
+// bucketed by the top bits of their hash (counted and scattered in file order), each bucket
+// sorted by (hash, file face) and matched on its own, so the result does not depend on the
+// threads. False if a face is named a third time, twice by one cell or twice in one orientation.
+bool match_faces(const RawCells& cells, const FaceKeys& keys, const std::vector<int32_t>& cell_of,
+                 std::vector<int32_t>* partner_out) {
+  const int64_t nq = cells.faces();
+  const int32_t* nodes = cells.nodes.data();
+  const int64_t* fp = cells.face_ptr.data();
+  const std::vector<uint64_t>& hash = keys.hash;
+  const std::vector<int32_t>& start = keys.start;
+  const std::vector<uint8_t>& rev = keys.rev;
   auto same = [&](int64_t a, int64_t b) {
     const int64_t n = fp[a + 1] - fp[a];
     if (n != fp[b + 1] - fp[b]) return false;
@@ -598,36 +613,29 @@ bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, 
     }
     return true;
   };
-  std::vector<int32_t> cell_of(static_cast<size_t>(nq));
-  parallel_ranges(nc, [&](int64_t b, int64_t e) {
-    for (int64_t c = b; c < e; ++c)
-      for (int64_t q = cells.cell_ptr[c]; q < cells.cell_ptr[c + 1]; ++q) cell_of[q] = static_cast<int32_t>(c);
-  });
-  // Partner of each file face (the other file face with the same cycle, -1 if none): faces are
-  // grouped in buckets by the top bits of their hash (counted and scattered in file order), and
-  // each bucket sorted by (hash, file face) and matched on its own.
   const int bits = 16;
   const size_t nb = size_t(1) << bits;
   std::vector<int64_t> bucket_ptr(nb + 1, 0);
   for (int64_t q = 0; q < nq; ++q) ++bucket_ptr[(hash[q] >> (64 - bits)) + 1];
   for (size_t i = 0; i < nb; ++i) bucket_ptr[i + 1] += bucket_ptr[i];
-  std::vector<int64_t> order(static_cast<size_t>(nq));
+  std::vector<int32_t> order(static_cast<size_t>(nq));  // file faces, by bucket
   {
     std::vector<int64_t> fill(bucket_ptr.begin(), bucket_ptr.end() - 1);
-    for (int64_t q = 0; q < nq; ++q) order[fill[hash[q] >> (64 - bits)]++] = q;
+    for (int64_t q = 0; q < nq; ++q) order[fill[hash[q] >> (64 - bits)]++] = static_cast<int32_t>(q);
   }
-  std::vector<int64_t> partner(static_cast<size_t>(nq), -1);
+  std::vector<int32_t>& partner = *partner_out;
+  partner.assign(static_cast<size_t>(nq), -1);
   std::vector<uint8_t> bad(nb, 0);
   parallel_ranges(static_cast<int64_t>(nb), [&](int64_t b, int64_t e) {
     for (int64_t k = b; k < e; ++k) {
-      int64_t* lo = order.data() + bucket_ptr[k];
-      int64_t* hi = order.data() + bucket_ptr[k + 1];
-      std::sort(lo, hi, [&](int64_t x, int64_t y) { return hash[x] != hash[y] ? hash[x] < hash[y] : x < y; });
-      for (int64_t* run = lo; run < hi;) {
-        int64_t* end = run;
+      int32_t* lo = order.data() + bucket_ptr[k];
+      int32_t* hi = order.data() + bucket_ptr[k + 1];
+      std::sort(lo, hi, [&](int32_t x, int32_t y) { return hash[x] != hash[y] ? hash[x] < hash[y] : x < y; });
+      for (int32_t* run = lo; run < hi;) {
+        int32_t* end = run;
         while (end < hi && hash[*end] == hash[*run]) ++end;
-        for (int64_t* i = run + 1; i < end; ++i)
-          for (int64_t* j = run; j < i; ++j) {
+        for (int32_t* i = run + 1; i < end; ++i)
+          for (int32_t* j = run; j < i; ++j) {
             if (!same(*j, *i)) continue;
             // *i is a later use of the face first named by *j (or by *j's partner)
             if (partner[*j] >= 0 || partner[*i] >= 0 || cell_of[*j] == cell_of[*i] || rev[*j] == rev[*i]) bad[k] = 1;
@@ -639,7 +647,31 @@ bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, 
       }
     }
   }, 64);
-  if (std::any_of(bad.begin(), bad.end(), [](uint8_t x) { return x != 0; })) return false;
+  return std::none_of(bad.begin(), bad.end(), [](uint8_t x) { return x != 0; });
+}
+
+// The mesh of a file whose faces are all regular, assembled on all cores: exactly what
+// MeshBuilder builds from the same cells (faces numbered by first use, the owner's cycle stored,
+// nodes compacted in their order). False, building nothing, at any irregularity (face_keys,
+// match_faces, or an interior patch on a face with one cell): MeshBuilder then builds the mesh
+// and reports the problems in order.
+bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, const std::vector<int32_t>& face_patch,
+                        PolyMesh* out, BuildReport* report) {
+  const int64_t nq = cells.faces(), nc = cells.size();
+  if (nq >= std::numeric_limits<int32_t>::max() || static_cast<int64_t>(cells.nodes.size()) >= std::numeric_limits<int32_t>::max())
+    return false;
+  const int32_t* nodes = cells.nodes.data();
+  const int64_t* fp = cells.face_ptr.data();
+  FaceKeys keys;
+  if (!face_keys(cells, &keys)) return false;
+  std::vector<int32_t> cell_of(static_cast<size_t>(nq));
+  parallel_ranges(nc, [&](int64_t b, int64_t e) {
+    for (int64_t c = b; c < e; ++c)
+      for (int64_t q = cells.cell_ptr[c]; q < cells.cell_ptr[c + 1]; ++q) cell_of[q] = static_cast<int32_t>(c);
+  });
+  std::vector<int32_t> partner;
+  if (!match_faces(cells, keys, cell_of, &partner)) return false;
+  keys = FaceKeys{};
   // Faces numbered by first use (file order), as MeshBuilder numbers them.
   std::vector<int32_t> face_id(static_cast<size_t>(nq));
   std::vector<int64_t> first_use;
