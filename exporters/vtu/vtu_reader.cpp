@@ -28,6 +28,7 @@
 
 #include "exporters/vtu/vtu_mesh_arrays.hpp"
 #include "meshgen/core/geometry.hpp"
+#include "meshgen/core/parallel.hpp"
 
 namespace hm {
 
@@ -535,10 +536,206 @@ Parsed parse_document(Source& src) {
   return out;
 }
 
-ReadResult convert(Parsed&& in) {
-  ReadResult res;
-  res.has_face_patch = in.has_face_patch;
-  res.warnings = std::move(in.warnings);
+// Canonical form of every face of a file (start at the smallest id, direction towards the
+// smaller neighbour, as canonical_cycle_into) and a hash of it.
+struct FaceKeys {
+  std::vector<uint64_t> hash;
+  std::vector<int32_t> start;
+  std::vector<uint8_t> rev;
+};
+
+// Fills the keys on all cores; false if a face has fewer than 3 nodes or a repeated node.
+bool face_keys(const RawCells& cells, FaceKeys* keys) {
+  const int64_t nq = cells.faces();
+  const int32_t* nodes = cells.nodes.data();
+  const int64_t* fp = cells.face_ptr.data();
+  std::vector<uint64_t>& hash = keys->hash;
+  std::vector<int32_t>& start = keys->start;
+  std::vector<uint8_t>& rev = keys->rev;
+  hash.resize(static_cast<size_t>(nq));
+  start.resize(static_cast<size_t>(nq));
+  rev.resize(static_cast<size_t>(nq));
+  std::vector<uint8_t> irregular(static_cast<size_t>(nq), 0);
+  parallel_ranges(nq, [&](int64_t b, int64_t e) {
+    std::vector<int32_t> sorted;
+    for (int64_t q = b; q < e; ++q) {
+      const int32_t* c = nodes + fp[q];
+      const int64_t n = fp[q + 1] - fp[q];
+      bool repeated = false;
+      if (n <= 16) {  // pairwise: no copy for the usual 3-8 nodes
+        for (int64_t i = 1; i < n && !repeated; ++i)
+          for (int64_t j = 0; j < i && !repeated; ++j) repeated = c[i] == c[j];
+      } else {
+        sorted.assign(c, c + n);
+        std::sort(sorted.begin(), sorted.end());
+        repeated = std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+      }
+      if (n < 3 || repeated) {
+        irregular[q] = 1;
+        continue;
+      }
+      const int64_t k = std::min_element(c, c + n) - c;
+      const bool r = c[(k + n - 1) % n] < c[(k + 1) % n];
+      uint64_t h = 1469598103934665603ull;
+      for (int64_t i = 0, j = k; i < n; ++i) {  // j: the i-th canonical position, without a division
+        h ^= static_cast<uint32_t>(c[j]);
+        h *= 1099511628211ull;
+        j = r ? (j == 0 ? n - 1 : j - 1) : (j == n - 1 ? 0 : j + 1);
+      }
+      hash[q] = h ^ (h >> 29);
+      start[q] = static_cast<int32_t>(k);
+      rev[q] = r;
+    }
+  });
+  return std::none_of(irregular.begin(), irregular.end(), [](uint8_t x) { return x != 0; });
+}
+
+// The partner of each file face (the other file face with the same cycle, -1 if none). Faces are
+// bucketed by the top bits of their hash (counted and scattered in file order), each bucket
+// sorted by (hash, file face) and matched on its own, so the result does not depend on the
+// threads. False if a face is named a third time, twice by one cell or twice in one orientation.
+bool match_faces(const RawCells& cells, const FaceKeys& keys, const std::vector<int32_t>& cell_of,
+                 std::vector<int32_t>* partner_out) {
+  const int64_t nq = cells.faces();
+  const int32_t* nodes = cells.nodes.data();
+  const int64_t* fp = cells.face_ptr.data();
+  const std::vector<uint64_t>& hash = keys.hash;
+  const std::vector<int32_t>& start = keys.start;
+  const std::vector<uint8_t>& rev = keys.rev;
+  auto same = [&](int64_t a, int64_t b) {
+    const int64_t n = fp[a + 1] - fp[a];
+    if (n != fp[b + 1] - fp[b]) return false;
+    const int32_t *ca = nodes + fp[a], *cb = nodes + fp[b];
+    for (int64_t i = 0, ja = start[a], jb = start[b]; i < n; ++i) {
+      if (ca[ja] != cb[jb]) return false;
+      ja = rev[a] ? (ja == 0 ? n - 1 : ja - 1) : (ja == n - 1 ? 0 : ja + 1);
+      jb = rev[b] ? (jb == 0 ? n - 1 : jb - 1) : (jb == n - 1 ? 0 : jb + 1);
+    }
+    return true;
+  };
+  const int bits = 16;
+  const size_t nb = size_t(1) << bits;
+  std::vector<int64_t> bucket_ptr(nb + 1, 0);
+  for (int64_t q = 0; q < nq; ++q) ++bucket_ptr[(hash[q] >> (64 - bits)) + 1];
+  for (size_t i = 0; i < nb; ++i) bucket_ptr[i + 1] += bucket_ptr[i];
+  std::vector<int32_t> order(static_cast<size_t>(nq));  // file faces, by bucket
+  {
+    std::vector<int64_t> fill(bucket_ptr.begin(), bucket_ptr.end() - 1);
+    for (int64_t q = 0; q < nq; ++q) order[fill[hash[q] >> (64 - bits)]++] = static_cast<int32_t>(q);
+  }
+  std::vector<int32_t>& partner = *partner_out;
+  partner.assign(static_cast<size_t>(nq), -1);
+  std::vector<uint8_t> bad(nb, 0);
+  parallel_ranges(static_cast<int64_t>(nb), [&](int64_t b, int64_t e) {
+    for (int64_t k = b; k < e; ++k) {
+      int32_t* lo = order.data() + bucket_ptr[k];
+      int32_t* hi = order.data() + bucket_ptr[k + 1];
+      std::sort(lo, hi, [&](int32_t x, int32_t y) { return hash[x] != hash[y] ? hash[x] < hash[y] : x < y; });
+      for (int32_t* run = lo; run < hi;) {
+        int32_t* end = run;
+        while (end < hi && hash[*end] == hash[*run]) ++end;
+        for (int32_t* i = run + 1; i < end; ++i)
+          for (int32_t* j = run; j < i; ++j) {
+            if (!same(*j, *i)) continue;
+            // *i is a later use of the face first named by *j (or by *j's partner)
+            if (partner[*j] >= 0 || partner[*i] >= 0 || cell_of[*j] == cell_of[*i] || rev[*j] == rev[*i]) bad[k] = 1;
+            partner[*j] = *i;
+            partner[*i] = *j;
+            break;
+          }
+        run = end;
+      }
+    }
+  }, 64);
+  return std::none_of(bad.begin(), bad.end(), [](uint8_t x) { return x != 0; });
+}
+
+// The mesh of a file whose faces are all regular, assembled on all cores: exactly what
+// MeshBuilder builds from the same cells (faces numbered by first use, the owner's cycle stored,
+// nodes compacted in their order). False, building nothing, at any irregularity (face_keys,
+// match_faces, or an interior patch on a face with one cell): MeshBuilder then builds the mesh
+// and reports the problems in order.
+bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, const std::vector<int32_t>& face_patch,
+                        PolyMesh* out, BuildReport* report) {
+  const int64_t nq = cells.faces(), nc = cells.size();
+  if (nq >= std::numeric_limits<int32_t>::max() || static_cast<int64_t>(cells.nodes.size()) >= std::numeric_limits<int32_t>::max())
+    return false;
+  const int32_t* nodes = cells.nodes.data();
+  const int64_t* fp = cells.face_ptr.data();
+  FaceKeys keys;
+  if (!face_keys(cells, &keys)) return false;
+  std::vector<int32_t> cell_of(static_cast<size_t>(nq));
+  parallel_ranges(nc, [&](int64_t b, int64_t e) {
+    for (int64_t c = b; c < e; ++c)
+      for (int64_t q = cells.cell_ptr[c]; q < cells.cell_ptr[c + 1]; ++q) cell_of[q] = static_cast<int32_t>(c);
+  });
+  std::vector<int32_t> partner;
+  if (!match_faces(cells, keys, cell_of, &partner)) return false;
+  keys = FaceKeys{};
+  // Faces numbered by first use (file order), as MeshBuilder numbers them.
+  std::vector<int32_t> face_id(static_cast<size_t>(nq));
+  std::vector<int64_t> first_use;
+  first_use.reserve(static_cast<size_t>(nq / 2 + 1));
+  for (int64_t q = 0; q < nq; ++q) {
+    if (partner[q] < 0 || partner[q] > q) {
+      face_id[q] = static_cast<int32_t>(first_use.size());
+      first_use.push_back(q);
+    } else {
+      face_id[q] = face_id[partner[q]];
+    }
+  }
+  const int64_t nf = static_cast<int64_t>(first_use.size());
+  for (int64_t f = 0; f < nf; ++f)  // a boundary face the file calls interior: MeshBuilder reports it
+    if (partner[first_use[f]] < 0 && face_patch[first_use[f]] == kInteriorFace) return false;
+  // Nodes: those some face references, in their order.
+  std::vector<int32_t> new_id(points.size(), -1);
+  for (int32_t v : cells.nodes) new_id[v] = 0;
+  PolyMesh m;
+  int removed = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (new_id[i] == 0) {
+      new_id[i] = static_cast<int32_t>(m.nodes.size());
+      m.nodes.push_back(points[i]);
+    } else {
+      ++removed;
+    }
+  }
+  m.face_node_ptr.assign(static_cast<size_t>(nf) + 1, 0);
+  for (int64_t f = 0; f < nf; ++f)
+    m.face_node_ptr[f + 1] = m.face_node_ptr[f] + static_cast<int32_t>(fp[first_use[f] + 1] - fp[first_use[f]]);
+  m.face_nodes.resize(static_cast<size_t>(m.face_node_ptr[nf]));
+  m.face_owner.resize(static_cast<size_t>(nf));
+  m.face_neighbour.resize(static_cast<size_t>(nf));
+  m.face_patch.resize(static_cast<size_t>(nf));
+  parallel_ranges(nf, [&](int64_t b, int64_t e) {
+    for (int64_t f = b; f < e; ++f) {
+      const int64_t q = first_use[f];
+      int32_t* dst = m.face_nodes.data() + m.face_node_ptr[f];
+      for (int64_t i = fp[q]; i < fp[q + 1]; ++i) *dst++ = new_id[nodes[i]];
+      m.face_owner[f] = cell_of[q];
+      m.face_neighbour[f] = partner[q] >= 0 ? cell_of[partner[q]] : -1;
+      m.face_patch[f] = partner[q] >= 0 ? kInteriorFace : face_patch[q];
+    }
+  });
+  m.cell_face_ptr.resize(static_cast<size_t>(nc) + 1);
+  for (int64_t c = 0; c <= nc; ++c) m.cell_face_ptr[c] = static_cast<int32_t>(cells.cell_ptr[c]);
+  m.cell_faces = std::move(face_id);
+  const CellAttributes none{};
+  m.cell_region.assign(static_cast<size_t>(nc), none.region);
+  m.cell_fv_center.assign(static_cast<size_t>(nc), none.fv_center);
+  m.cell_ijk.assign(static_cast<size_t>(nc), none.ijk);
+  m.cell_perm.assign(static_cast<size_t>(nc), none.perm);
+  m.cell_porosity.assign(static_cast<size_t>(nc), none.porosity);
+  m.cell_radial.assign(static_cast<size_t>(nc), none.radial);
+  *out = std::move(m);
+  *report = BuildReport{};
+  report->removed_unused_nodes = removed;
+  return true;
+}
+
+// MeshBuilder's mesh of the file's cells, face by face (every file, and the one that reports
+// the problems of an irregular file).
+void build_with_mesh_builder(Parsed& in, ReadResult& res) {
   const RawCells& cells = in.cells;
   std::vector<int32_t> f;  // one face's point ids
   auto load_face = [&](int64_t q) {
@@ -572,6 +769,21 @@ ReadResult convert(Parsed&& in) {
   in.cells = RawCells{};
   in.face_patch = {};
   res.mesh = mb.finish(&res.build);
+}
+
+ReadResult convert(Parsed&& in, VtuAssembly assembly) {
+  ReadResult res;
+  res.has_face_patch = in.has_face_patch;
+  res.warnings = std::move(in.warnings);
+  if (assembly == VtuAssembly::Parallel && res.has_face_patch &&
+      build_regular_mesh(in.cells, in.points, in.face_patch, &res.mesh, &res.build)) {
+    res.assembled_in_parallel = true;
+    in.points = {};
+    in.cells = RawCells{};
+    in.face_patch = {};
+  } else {
+    build_with_mesh_builder(in, res);
+  }
   PolyMesh& m = res.mesh;
   for (const Array& a : in.cell_data) {
     std::vector<double> v(a.size());
@@ -594,7 +806,7 @@ ReadResult convert(Parsed&& in) {
 
 // Parses the stream with VTK's vtkXMLDataParser and converts it; VTK's first error message
 // becomes ours, and VTK prints nothing.
-ReadResult read_stream(std::istream& in, uint64_t file_bytes) {
+ReadResult read_stream(std::istream& in, uint64_t file_bytes, VtuAssembly assembly) {
   QuietVtk quiet;
   vtkNew<MessageCatcher> catcher;
   vtkNew<vtkXMLDataParser> parser;
@@ -616,7 +828,7 @@ ReadResult read_stream(std::istream& in, uint64_t file_bytes) {
     src.file_bytes = file_bytes;
     Parsed doc = parse_document(src);
     if (!catcher->errors.empty()) fail(catcher->errors.front());
-    r = convert(std::move(doc));
+    r = convert(std::move(doc), assembly);
   } catch (const VtuError& e) {
     r = ReadResult{};
     r.error = e.what;
@@ -635,17 +847,17 @@ ReadResult read_stream(std::istream& in, uint64_t file_bytes) {
 
 }  // namespace
 
-ReadResult read_vtu_buffer(const std::string& bytes) {
+ReadResult read_vtu_buffer(const std::string& bytes, VtuAssembly assembly) {
   if (bytes.empty()) {
     ReadResult r;
     r.error = "empty file";
     return r;
   }
   std::istringstream in(bytes);
-  return read_stream(in, bytes.size());
+  return read_stream(in, bytes.size(), assembly);
 }
 
-ReadResult read_vtu(const std::string& path) {
+ReadResult read_vtu(const std::string& path, VtuAssembly assembly) {
   std::error_code ec;
   ReadResult r;
   if (std::filesystem::is_directory(path, ec)) {
@@ -662,7 +874,7 @@ ReadResult read_vtu(const std::string& path) {
     r.error = path + ": empty file";
     return r;
   }
-  r = read_stream(in, size);
+  r = read_stream(in, size, assembly);
   if (!r.ok) r.error = path + ": " + r.error;
   return r;
 }

@@ -27,6 +27,7 @@ struct ReadResult {
   bool has_fv_center = false;  ///< `fv_center` was present (else the cell centroid is used)
   bool has_face_patch = false; ///< field data `face_patch` was present and used
   bool has_radial = false;     ///< the radial_* arrays were present (exact radial transmissibilities)
+  bool assembled_in_parallel = false;  ///< VtuAssembly::Parallel built the mesh (a regular file)
   std::vector<std::string> missing_mesh_arrays;  ///< mesh_cell_arrays names absent from the file
   /// Every cell data array of the file, as Float64 values (cell order = mesh cell order).
   std::vector<VtuCellArray> cell_arrays;
@@ -39,9 +40,14 @@ struct ReadResult {
   }
 };
 
+/// How the mesh is assembled from the file's cells. Parallel (the default): a file whose faces
+/// are all regular is assembled on all cores, any other by MeshBuilder, which reports its
+/// problems; the mesh is the same either way. Serial: always MeshBuilder (tests compare the two).
+enum class VtuAssembly { Parallel, Serial };
+
 /// Reads a .vtu file. Never throws for bad content.
-ReadResult read_vtu(const std::string& path);
+ReadResult read_vtu(const std::string& path, VtuAssembly assembly = VtuAssembly::Parallel);
 /// Same, from the file's bytes (tests, fuzzing).
-ReadResult read_vtu_buffer(const std::string& bytes);
+ReadResult read_vtu_buffer(const std::string& bytes, VtuAssembly assembly = VtuAssembly::Parallel);
 
 }  // namespace hm

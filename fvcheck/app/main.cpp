@@ -112,7 +112,8 @@ int main(int argc, char** argv) {
   std::vector<double> h_ref;
   if (const hm::VtuCellArray* h = in.find("h_ref"); h && h->components == 1) h_ref = h->values;
 
-  hm::FvReport report = hm::run_fvcheck(in.mesh, opt, h_ref, &in.build);
+  hm::MeshGeometry geo;  // the checks' geometry pass, reused for the transmissibilities
+  hm::FvReport report = hm::run_fvcheck(in.mesh, opt, h_ref, &in.build, &geo);
   report.source = mesh_path;
   report.notes = in.warnings;
   for (const std::string& p : in.build.problems) report.notes.push_back("builder: " + p);
@@ -126,7 +127,6 @@ int main(int argc, char** argv) {
       report.notes.push_back("no permeability array: transmissibilities computed with k = 1 mD (geometric part)");
     }
     const hm::Progress progress("transmissibilities");
-    const hm::MeshGeometry geo = hm::compute_geometry(in.mesh);
     const hm::Transmissibilities t = hm::compute_transmissibilities(in.mesh, geo);
     report.transmissibility = hm::summarize_transmissibilities(t.face);
     report.transmissibility.negative_halves = t.negative;

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "meshgen/core/progress.hpp"
 
@@ -27,7 +28,7 @@ const CheckResult* FvReport::find(const std::string& name) const {
 }
 
 FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::vector<double>& h_ref,
-                     const BuildReport* build) {
+                     const BuildReport* build, MeshGeometry* geometry_out) {
   FvReport r;
   r.options = opt;
   r.cells = mesh.n_cells();
@@ -48,7 +49,7 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   r.cell_region = mesh.cell_region;
   r.k_metric = !(mesh.metric_scale == Vec3{1, 1, 1});
   Progress progress("checks", 9);
-  const MeshGeometry geo = compute_geometry(mesh);
+  MeshGeometry geo = compute_geometry(mesh);
   progress.advance();
   r.checks.push_back(check_convexity(mesh, geo, opt)), progress.advance();
   r.checks.push_back(check_conformity(mesh, geo, opt, build)), progress.advance();
@@ -76,6 +77,7 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   r.q_o_all = stats_of(r.q_o_cell);
   r.q_p_all = stats_of(r.q_p_cell);
   r.by_region = quality_by_region(mesh, r.q_s, r.q_o_cell, r.q_p_cell, r.k_angle_cell, r.k_angle_interior_cell);
+  if (geometry_out) *geometry_out = std::move(geo);
   return r;
 }
 

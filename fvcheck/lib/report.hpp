@@ -62,8 +62,10 @@ struct FvReport {
 
 /// Runs the checks. h_ref: reference length per cell for Q_S (empty: mean edge length).
 /// build: the builder's report if the mesh was just assembled (folded into conformity).
+/// geometry_out: receives compute_geometry(mesh) when the structure is valid (left empty
+/// otherwise), so that a caller needing it too does not compute it a second time.
 FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::vector<double>& h_ref = {},
-                     const BuildReport* build = nullptr);
+                     const BuildReport* build = nullptr, MeshGeometry* geometry_out = nullptr);
 
 /// A few lines for a terminal.
 std::string report_summary_text(const FvReport& r);
