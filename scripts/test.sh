@@ -37,5 +37,5 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   export LSAN_OPTIONS=suppressions="$root/tests/lsan.supp":print_suppressions=0  # third-party leaks only
-  (cd build-asan && ctest --output-on-failure -j"$jobs" -E '^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation|MeshPictures)')
+  (cd build-asan && ctest --output-on-failure -j"$jobs" -E '^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation|MeshPictures|Examples/VtkAgreement|VtkAgreement)')
 fi
