@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <memory>
 #include <optional>
 #include <set>
 
@@ -160,15 +159,7 @@ class SiteOptimizer {
   const std::vector<double>& h_ref_;
   const TransitionOptions& opt_;
   std::set<std::array<int, 9>> refused_;
-  PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds
-  // Moves refused by the last round: undone in the sites at once, in the diagram `out` at the
-  // next rebuild (with the next round's moves, which stay off their regions); and the moves
-  // that round kept, undone too if that rebuild cannot be made valid otherwise.
-  std::vector<Move> pending_, kept_last_;
-
- public:
-  // Brings `out` to the sites (the pending undos); false if that diagram is not valid.
-  bool settle(TransitionCells& out, SiteOptimizeReport& rep);
+  PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   int skewed_left_ = 0;
   std::optional<Measured> next_;  // the measurement of the diagram the last round left in `out`
 };
@@ -329,13 +320,6 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
 
   std::vector<char> locked(ns, 0), moved(ns, 0);
   std::vector<Move> moves;
-  // The pending undos come first, as moves of this round that are always kept.
-  for (Move& m : pending_) {
-    moved[m.site] = locked[m.site] = 1;
-    for (int c : m.region = region_of(m.site)) locked[out.cell_site[c]] = 1;
-  }
-  const size_t n_undo = pending_.size();
-  moves.swap(pending_);
   auto admit = [&](Move& m) {
     m.region = region_of(m.site);
     for (int c : m.region)
@@ -398,32 +382,24 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     }
     if (best.site >= 0) admit(best);
   }
-  rep.proposed += static_cast<int>(moves.size() - n_undo);
-  if (moves.size() == n_undo) {
-    if (n_undo == 0) return unchanged();
-    pending_.swap(moves);
-    settle(out, rep);
-    return false;
-  }
+  rep.proposed += static_cast<int>(moves.size());
+  if (moves.empty()) return unchanged();
 
-  // Rebuild with the moves; an invalid diagram keeps the first half of the new moves, down
-  // to none (then the last round's kept moves are undone too).
+  // Rebuild with the moves; an invalid diagram keeps the first half of them, down to none.
   TransitionCells fresh;
   size_t keep = moves.size();
   while (!rebuild(fresh, out.base_node_id)) {
-    if (keep == n_undo) {
-      pending_.assign(moves.begin(), moves.begin() + static_cast<long>(n_undo));
-      settle(out, rep);
-      return false;
-    }
-    const size_t half = n_undo + (keep - n_undo) / 2;
+    const size_t half = keep / 2;
     for (size_t i = half; i < keep; ++i) restore(moves[i].site, moves[i].before);
-    if (keep == n_undo + 1) refused_.insert(moves[n_undo].tag);
+    if (keep == 1) refused_.insert(moves[0].tag);
     rep.invalid += static_cast<int>(keep - half);
     keep = half;
+    if (keep == 0) {
+      moves.clear();
+      return unchanged();
+    }
   }
   moves.resize(keep);
-  moves.erase(moves.begin(), moves.begin() + static_cast<long>(n_undo));
   // Keep a move only if the Q_S of the cells it touches improves (sum over its region).
   Measured after = measure(fresh);
   const std::vector<double>& qs2 = after.qs;
@@ -446,32 +422,17 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
   rep.refused += static_cast<int>(moves.size() - kept.size());
-  // `fresh` still has the refused moves: the next rebuild undoes them.
-  for (const Move& m : moves)
-    if (std::find_if(kept.begin(), kept.end(), [&](const Move& k) { return k.site == m.site; }) == kept.end())
-      pending_.push_back(m);
-  rep.kept += static_cast<int>(kept.size());
-  kept_last_ = std::move(kept);
-  out = std::move(fresh);
-  next_ = std::move(after);
-  return !kept_last_.empty();
-}
-
-bool SiteOptimizer::settle(TransitionCells& out, SiteOptimizeReport& rep) {
-  if (pending_.empty()) return true;
-  pending_.clear();
-  next_.reset();
-  TransitionCells fresh;
-  if (!rebuild(fresh, out.base_node_id)) {
-    // Without the refused moves the kept ones do not make a valid diagram: undo them too,
-    // back to the diagram before that round (valid).
-    for (const Move& m : kept_last_) restore(m.site, m.before);
-    rep.invalid += static_cast<int>(kept_last_.size());
-    rep.kept -= static_cast<int>(kept_last_.size());
-    kept_last_.clear();
-    if (!rebuild(fresh, out.base_node_id)) return false;
+  if (kept.empty()) {
+    return unchanged();
   }
+  if (kept.size() < moves.size() && !rebuild(fresh, out.base_node_id)) {
+    for (const Move& m : kept) restore(m.site, m.before);
+    rep.invalid += static_cast<int>(kept.size());
+    return unchanged();
+  }
+  rep.kept += static_cast<int>(kept.size());
   out = std::move(fresh);
+  if (kept.size() == moves.size()) next_ = std::move(after);  // else rebuilt with fewer moves: measured anew
   return true;
 }
 
@@ -483,8 +444,6 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                                   TransitionCells& out) {
   SiteOptimizeReport rep;
-  const SiteSet initial = set;
-  const auto raw = std::make_unique<const TransitionCells>(out);
   const std::vector<double> h_ref = out.h_ref;  // the raw diagram's: the same reference before and after
   SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt);
   while (rep.rounds < opt.max_rounds) {
@@ -495,12 +454,6 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
   for (int extra = 0; extra < kSkewRounds; ++extra) {
     ++rep.rounds;
     if (!optimizer.round(out, rep, true) || optimizer.skewed_left() == 0) break;
-  }
-  if (!optimizer.settle(out, rep)) {
-    // Cannot happen (every state settled back to was a valid diagram): the raw diagram.
-    set = initial;
-    out = *raw;
-    rep.kept = 0;
   }
   out.h_ref = h_ref;
   return rep;
