@@ -43,7 +43,8 @@ struct CellInfo {
   // with a guard point): fixed while the cell lives (a cell never changes its vertices).
   bool has_common = false, guard = false;
   std::array<int, 4> key{};
-  std::vector<int32_t> common;
+  int n_common = 0;          // 0, 1 or 2 (two or more: recomputed when used, rare)
+  int32_t common_node = -1;  // the shared node when n_common == 1
 };
 using Cb = CGAL::Triangulation_cell_base_with_info_3<CellInfo, K, Cbb>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
@@ -271,22 +272,28 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
     for (int k = class_begin[cls]; k < class_begin[cls + 1]; ++k) {
       const int a = class_members[k];
       CellInfo& cell = cells[a]->info();
+      auto shared_nodes = [&] {
+        std::vector<int32_t> common = set.sites[cell.key[0]].vertices;
+        for (int i = 1; i < 4 && !common.empty(); ++i) common = intersect(common, set.sites[cell.key[i]].vertices);
+        return common;
+      };
       if (!cell.has_common) {
         cell.has_common = true;
         for (int i = 0; i < 4; ++i) cell.key[i] = cells[a]->vertex(i)->info();
         std::sort(cell.key.begin(), cell.key.end());
-        for (int i = 0; i < 4 && !cell.guard; ++i) {
-          if (is_guard(cell.key[i])) cell.guard = true;
-          else cell.common = i == 0 ? set.sites[cell.key[i]].vertices : intersect(cell.common, set.sites[cell.key[i]].vertices);
+        cell.guard = is_guard(cell.key[3]);  // guards have the largest ids
+        if (!cell.guard) {
+          const std::vector<int32_t> common = shared_nodes();
+          cell.n_common = std::min<int>(static_cast<int>(common.size()), 2);
+          if (common.size() == 1) cell.common_node = common[0];
         }
-        if (cell.guard) cell.common.clear();
       }
       const std::array<int, 4>& key = cell.key;
       if (first || key < ci.key) ci.key = key, rep_cell = a, first = false;
-      const std::vector<int32_t>& common = cell.common;
       if (cell.guard) continue;
-      if (common.size() == 1) candidates.push_back(common[0]);
-      else if (common.size() > 1) {
+      if (cell.n_common == 1) candidates.push_back(cell.common_node);
+      else if (cell.n_common > 1) {
+        const std::vector<int32_t> common = shared_nodes();
         ++ci.ambiguous, candidates.insert(candidates.end(), common.begin(), common.end());
       }
     }
