@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -193,6 +194,29 @@ std::vector<int> sites_in_duplicate_faces(const SiteSet& set, const TransitionCe
 std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                    const std::vector<PolygonFrame>& frames, TransitionCells& out,
                                    const BoundaryImages& images = {});
+
+/// A cavity's regular triangulation kept across the optimiser's rounds (CGAL inside the
+/// .cpp): each call brings it to the sites of `set` by removing and inserting again only the
+/// sites whose point or weight changed since the last call (from scratch the first time, when
+/// the live sites changed, or after a site was hidden), then extracts the cells as
+/// build_power_cells does (no boundary images). RT cells that no move touched keep their power
+/// centres. Same result as build_power_cells on the same sites, up to the choice among equal
+/// triangulations of co-spherical sites.
+class PowerDiagram {
+ public:
+  PowerDiagram();
+  ~PowerDiagram();
+  PowerDiagram(const PowerDiagram&) = delete;
+  PowerDiagram& operator=(const PowerDiagram&) = delete;
+  std::vector<int> cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                         const std::vector<PolygonFrame>& frames, TransitionCells& out);
+  int moved_last() const { return moved_; }  ///< sites moved incrementally by the last call
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int moved_ = 0;
+};
 
 /// The site optimiser (transition_optimize.cpp): rounds of independent site moves that
 /// remove or expand short edges, each followed by a rebuild of the exact diagram; `out` is a

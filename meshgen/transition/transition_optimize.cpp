@@ -118,7 +118,7 @@ class SiteOptimizer {
   Vec3 node(const TransitionCells& t, int32_t v) const {
     return v >= t.base_node_id ? t.new_nodes[v - t.base_node_id] : coords_[v];
   }
-  bool rebuild(TransitionCells& fresh, int32_t base) const;
+  bool rebuild(TransitionCells& fresh, int32_t base);
   // A diagram's submesh (local node ids, `global` mapping them back), Q_S per cell, skewed
   // faces (worst first), their count and the worst skewness per cell.
   struct Measured {
@@ -159,14 +159,15 @@ class SiteOptimizer {
   const std::vector<double>& h_ref_;
   const TransitionOptions& opt_;
   std::set<std::array<int, 9>> refused_;
+  PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   int skewed_left_ = 0;
   std::optional<Measured> next_;  // the measurement of the diagram the last round left in `out`
 };
 
-bool SiteOptimizer::rebuild(TransitionCells& fresh, int32_t base) const {
+bool SiteOptimizer::rebuild(TransitionCells& fresh, int32_t base) {
   fresh = TransitionCells{};
   fresh.base_node_id = base;
-  if (!build_power_cells(set_, cavity_, coords_, frames_, fresh).empty()) return false;
+  if (!diagram_.cells(set_, cavity_, coords_, frames_, fresh).empty()) return false;
   const TransitionReport& r = fresh.report;
   if (r.unmatched_external_faces > 0 || r.missing_polygons > 0) return false;
   for (const auto& cell : fresh.cells)

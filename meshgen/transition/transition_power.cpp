@@ -6,16 +6,19 @@
 // vertex whose four sites share exactly one constrained node IS that node. Only what is
 // left on the external faces is snapped to the nearest constrained vertex (5.7).
 #include <CGAL/Cartesian_converter.h>
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
+#include <CGAL/Simple_cartesian.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Regular_triangulation_3.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -29,27 +32,41 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Vbb = CGAL::Regular_triangulation_vertex_base_3<K>;
 using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K, Vbb>;
 using Cbb = CGAL::Regular_triangulation_cell_base_3<K>;
-using Cb = CGAL::Triangulation_cell_base_with_info_3<int, K, Cbb>;
+// Per RT cell: its index in one extraction, and its power centre once computed. A cell that
+// a site move leaves in place keeps its centre: the optimiser recomputes only the cells that
+// the moves created (PowerDiagram).
+struct CellInfo {
+  int index = -1;
+  bool has_center = false, exact = false;
+  Vec3 center;
+  // The sorted site ids of the cell, and the constrained nodes its four sites share (none
+  // with a guard point): fixed while the cell lives (a cell never changes its vertices).
+  bool has_common = false, guard = false;
+  std::array<int, 4> key{};
+  int n_common = 0;          // 0, 1 or 2 (two or more: recomputed when used, rare)
+  int32_t common_node = -1;  // the shared node when n_common == 1
+};
+using Cb = CGAL::Triangulation_cell_base_with_info_3<CellInfo, K, Cbb>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
 using Regular = CGAL::Regular_triangulation_3<K, Tds>;
 using WPoint = K::Weighted_point_3;
 using BPoint = K::Point_3;
-using EK = CGAL::Exact_predicates_exact_constructions_kernel;
+// Exact rational arithmetic, without the lazy kernel's bookkeeping (the point is rounded at once).
+using QK = CGAL::Simple_cartesian<CGAL::Exact_rational>;
 
 // The power vertex of a cell. Co-spherical sites make many nearly flat cells, on which the
 // double formula loses up to 1e-8 relative; those (|det| of the edge vectors below 1e-4 of
 // the product of their lengths) are computed exactly and rounded once. Well-shaped cells
 // keep the fast double formula (error about cond x 1e-16).
 Vec3 exact_power_center(const Regular::Cell_handle& c) {
-  const CGAL::Cartesian_converter<K, EK> to_exact;
-  const EK::Point_3 p = EK().construct_weighted_circumcenter_3_object()(
+  const CGAL::Cartesian_converter<K, QK> to_exact;
+  const QK::Point_3 p = QK().construct_weighted_circumcenter_3_object()(
       to_exact(c->vertex(0)->point()), to_exact(c->vertex(1)->point()), to_exact(c->vertex(2)->point()),
       to_exact(c->vertex(3)->point()));
-  return Vec3{CGAL::to_double(CGAL::exact(p.x())), CGAL::to_double(CGAL::exact(p.y())),
-              CGAL::to_double(CGAL::exact(p.z()))};
+  return Vec3{CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
 }
 
-Vec3 power_center(const Regular& rt, const Regular::Cell_handle& c, int* exact_count) {
+Vec3 computed_power_center(const Regular& rt, const Regular::Cell_handle& c, bool* exact) {
   auto at = [&](int i) {
     const auto& p = c->vertex(i)->point().point();
     return Vec3{p.x(), p.y(), p.z()};
@@ -60,8 +77,15 @@ Vec3 power_center(const Regular& rt, const Regular::Cell_handle& c, int* exact_c
     const BPoint p = rt.dual(c);
     return Vec3{p.x(), p.y(), p.z()};
   }
-  ++*exact_count;
+  *exact = true;
   return exact_power_center(c);
+}
+
+Vec3 power_center(const Regular& rt, const Regular::Cell_handle& c, int* exact_count) {
+  CellInfo& ci = c->info();
+  if (!ci.has_center) ci.center = computed_power_center(rt, c, &ci.exact), ci.has_center = true;
+  if (ci.exact) ++*exact_count;
+  return ci.center;
 }
 
 struct UnionFind {
@@ -153,15 +177,11 @@ SiteSet with_images(const SiteSet& real, const BoundaryImages& images) {
 }
 }  // namespace
 
-std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity, const std::vector<Vec3>& coords,
-                                   const std::vector<PolygonFrame>& frames, TransitionCells& out,
-                                   const BoundaryImages& images) {
-  const SiteSet imaged = images.empty() ? SiteSet{} : with_images(real_set, images);
-  const SiteSet& set = images.empty() ? real_set : imaged;
-  const int n_real = static_cast<int>(real_set.sites.size());
+namespace {
+// The regular triangulation of the live sites of `set` plus 8 far guard points of weight 0
+// (ids ns .. ns + 7), vertex info = site id.
+void triangulate(const SiteSet& set, Regular& rt) {
   const int ns = static_cast<int>(set.sites.size());
-  TransitionReport& rep = out.report;
-  // ---- regular triangulation of the sites plus 8 far guard points of weight 0
   std::vector<std::pair<WPoint, int>> points;
   Vec3 lo{kInf, kInf, kInf}, hi = -lo;
   for (int s = 0; s < ns; ++s) {
@@ -177,8 +197,17 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
                                       (c & 4) ? hi.z + margin : lo.z - margin),
                                0.0),
                         ns + c);
-  Regular rt(points.begin(), points.end());
+  rt.clear();
+  rt.insert(points.begin(), points.end());
+}
 
+// Power cells of the internal sites of `set` (the real sites first, n_real of them, then
+// their images) from its regular triangulation `rt`: what build_power_cells returns.
+std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real, const Cavity& cavity,
+                                     const std::vector<Vec3>& coords, const std::vector<PolygonFrame>& frames,
+                                     TransitionCells& out, const BoundaryImages& images) {
+  const int ns = static_cast<int>(set.sites.size());
+  TransitionReport& rep = out.report;
   std::vector<Regular::Vertex_handle> vertex_of(ns + 8);
   for (auto v : rt.finite_vertex_handles()) vertex_of[v->info()] = v;
   std::vector<int> hidden;
@@ -194,7 +223,7 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
   // ---- power vertices: merge cells with the same power sphere (exact), union-find
   std::vector<Regular::Cell_handle> cells;
   for (auto c : rt.finite_cell_handles()) {
-    c->info() = static_cast<int>(cells.size());
+    c->info().index = static_cast<int>(cells.size());
     cells.push_back(c);
   }
   const int nc = static_cast<int>(cells.size());
@@ -205,11 +234,11 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
     const Regular::Cell_handle c = cells[a];
     for (int i = 0; i < 4; ++i) {
       const Regular::Cell_handle n = c->neighbor(i);
-      if (rt.is_infinite(n) || n->info() < a) continue;
+      if (rt.is_infinite(n) || n->info().index < a) continue;
       const Regular::Vertex_handle opp = n->vertex(n->index(c));
       if (power_side(c->vertex(0)->point(), c->vertex(1)->point(), c->vertex(2)->point(), c->vertex(3)->point(),
                         opp->point()) == CGAL::ON_ORIENTED_BOUNDARY)
-        merged_count += uf.unite(a, n->info()) ? 1 : 0;
+        merged_count += uf.unite(a, n->info().index) ? 1 : 0;
     }
   }
   rep.merged_cells = merged_count;
@@ -242,19 +271,29 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
     std::vector<int32_t> candidates;
     for (int k = class_begin[cls]; k < class_begin[cls + 1]; ++k) {
       const int a = class_members[k];
-      std::array<int, 4> key;
-      for (int i = 0; i < 4; ++i) key[i] = cells[a]->vertex(i)->info();
-      std::sort(key.begin(), key.end());
-      if (first || key < ci.key) ci.key = key, rep_cell = a, first = false;
-      std::vector<int32_t> common;
-      bool has_guard = false;
-      for (int i = 0; i < 4; ++i) {
-        if (is_guard(key[i])) { has_guard = true; break; }
-        common = i == 0 ? set.sites[key[i]].vertices : intersect(common, set.sites[key[i]].vertices);
+      CellInfo& cell = cells[a]->info();
+      auto shared_nodes = [&] {
+        std::vector<int32_t> common = set.sites[cell.key[0]].vertices;
+        for (int i = 1; i < 4 && !common.empty(); ++i) common = intersect(common, set.sites[cell.key[i]].vertices);
+        return common;
+      };
+      if (!cell.has_common) {
+        cell.has_common = true;
+        for (int i = 0; i < 4; ++i) cell.key[i] = cells[a]->vertex(i)->info();
+        std::sort(cell.key.begin(), cell.key.end());
+        cell.guard = is_guard(cell.key[3]);  // guards have the largest ids
+        if (!cell.guard) {
+          const std::vector<int32_t> common = shared_nodes();
+          cell.n_common = std::min<int>(static_cast<int>(common.size()), 2);
+          if (common.size() == 1) cell.common_node = common[0];
+        }
       }
-      if (has_guard) continue;
-      if (common.size() == 1) candidates.push_back(common[0]);
-      else if (common.size() > 1) {
+      const std::array<int, 4>& key = cell.key;
+      if (first || key < ci.key) ci.key = key, rep_cell = a, first = false;
+      if (cell.guard) continue;
+      if (cell.n_common == 1) candidates.push_back(cell.common_node);
+      else if (cell.n_common > 1) {
+        const std::vector<int32_t> common = shared_nodes();
         ++ci.ambiguous, candidates.insert(candidates.end(), common.begin(), common.end());
       }
     }
@@ -287,7 +326,7 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
     bool unbounded = false;
     do {
       if (rt.is_infinite(circ)) { unbounded = true; break; }
-      f.classes.push_back(uf.find(circ->info()));
+      f.classes.push_back(uf.find(circ->info().index));
     } while (++circ != done);
     const int inner = si ? s : t, other = si ? t : s;
     if (unbounded || is_guard(other)) {
@@ -342,19 +381,33 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
     scale = norm(chi - clo);
   }
   const double eps = kCoincidence * scale;
-  std::vector<int> by_x = used;
-  std::sort(by_x.begin(), by_x.end(), [&](int a, int b) {
-    const double xa = cell_class_info(a).point.x, xb = cell_class_info(b).point.x;
-    return xa != xb ? xa < xb : a < b;
-  });
+  // Buckets of side eps (a lattice puts many vertices on one coordinate plane, so a sweep
+  // along one axis would compare them all): each vertex meets those of the 27 buckets around.
+  struct Bucketed {
+    std::array<int64_t, 3> cell;
+    int cls;
+    bool operator<(const Bucketed& o) const { return cell != o.cell ? cell < o.cell : cls < o.cls; }
+  };
+  std::vector<Bucketed> grid;
+  grid.reserve(used.size());
+  for (int cls : used) {
+    const Vec3 p = cell_class_info(cls).point;
+    grid.push_back({{static_cast<int64_t>(std::floor(p.x / eps)), static_cast<int64_t>(std::floor(p.y / eps)),
+                     static_cast<int64_t>(std::floor(p.z / eps))},
+                    cls});
+  }
+  std::sort(grid.begin(), grid.end());
   int coincident = 0;
-  for (size_t i = 0; i < by_x.size(); ++i) {
-    const Vec3 pi = cell_class_info(by_x[i]).point;
-    for (size_t j = i + 1; j < by_x.size(); ++j) {
-      const Vec3 pj = cell_class_info(by_x[j]).point;
-      if (pj.x - pi.x > eps) break;
-      if (norm(pj - pi) <= eps) coincident += uf.unite(by_x[i], by_x[j]) ? 1 : 0;
-    }
+  for (const Bucketed& b : grid) {
+    const Vec3 pi = cell_class_info(b.cls).point;
+    for (int64_t dx = -1; dx <= 1; ++dx)
+      for (int64_t dy = -1; dy <= 1; ++dy) {
+        const Bucketed lo{{b.cell[0] + dx, b.cell[1] + dy, b.cell[2] - 1}, std::numeric_limits<int>::min()};
+        for (auto it = std::lower_bound(grid.begin(), grid.end(), lo);
+             it != grid.end() && it->cell[0] == lo.cell[0] && it->cell[1] == lo.cell[1] && it->cell[2] <= b.cell[2] + 1; ++it)
+          if (it->cls > b.cls && norm(cell_class_info(it->cls).point - pi) <= eps)
+            coincident += uf.unite(b.cls, it->cls) ? 1 : 0;
+      }
   }
   rep.coincident_vertices = coincident;
   // Merged classes: smallest key, its point; identified node if any member has one.
@@ -632,6 +685,69 @@ std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity
   }
   (void)frames;
   return {};
+}
+}  // namespace
+
+std::vector<int> build_power_cells(const SiteSet& real_set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                   const std::vector<PolygonFrame>& frames, TransitionCells& out,
+                                   const BoundaryImages& images) {
+  const SiteSet imaged = images.empty() ? SiteSet{} : with_images(real_set, images);
+  const SiteSet& set = images.empty() ? real_set : imaged;
+  Regular rt;
+  triangulate(set, rt);
+  return extract_power_cells(rt, set, static_cast<int>(real_set.sites.size()), cavity, coords, frames, out, images);
+}
+
+struct PowerDiagram::Impl {
+  Regular rt;
+  bool ready = false;
+  std::vector<Regular::Vertex_handle> vertex;  // per site, null if not in rt
+  std::vector<Vec3> p;                        // the point and weight each site has in rt
+  std::vector<double> w2;
+  std::vector<char> alive;
+};
+
+PowerDiagram::PowerDiagram() : impl_(std::make_unique<Impl>()) {}
+PowerDiagram::~PowerDiagram() = default;
+
+std::vector<int> PowerDiagram::cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                     const std::vector<PolygonFrame>& frames, TransitionCells& out) {
+  Impl& d = *impl_;
+  const int ns = static_cast<int>(set.sites.size());
+  auto live = [&](int s) { return set.sites[s].alive && set.sites[s].kind != SiteKind::Guard; };
+  bool fresh = !d.ready || static_cast<int>(d.p.size()) != ns;
+  for (int s = 0; s < ns && !fresh; ++s) fresh = (live(s) ? 1 : 0) != d.alive[s];
+  moved_ = 0;
+  // Incrementally: remove and insert again each site whose point or weight changed. A move
+  // that hides a site (or whose site is hidden) changes the vertex count: then from scratch
+  // (the extraction reports the hidden sites).
+  for (int s = 0; s < ns && !fresh; ++s) {
+    if (!d.alive[s] || (set.sites[s].p == d.p[s] && set.sites[s].w2 == d.w2[s])) continue;
+    const Site& site = set.sites[s];
+    const Regular::Vertex_handle v = d.vertex[s];
+    const size_t count = d.rt.number_of_vertices();
+    // A cell outside v's star survives its removal: the hint for the insertion.
+    const Regular::Cell_handle hint = v->cell()->neighbor(v->cell()->index(v));
+    d.rt.remove(v);
+    const Regular::Vertex_handle nv = d.rt.insert(WPoint(BPoint(site.p.x, site.p.y, site.p.z), site.w2), hint);
+    fresh = nv == Regular::Vertex_handle() || d.rt.number_of_vertices() != count;
+    if (!fresh) nv->info() = s, d.vertex[s] = nv, ++moved_;
+  }
+  if (fresh) {
+    triangulate(set, d.rt);
+    d.vertex.assign(ns, Regular::Vertex_handle());
+    for (auto v : d.rt.finite_vertex_handles())
+      if (v->info() < ns) d.vertex[v->info()] = v;
+  }
+  d.p.resize(ns), d.w2.resize(ns), d.alive.resize(ns);
+  int expected = 8;
+  for (int s = 0; s < ns; ++s) {
+    d.p[s] = set.sites[s].p, d.w2[s] = set.sites[s].w2, d.alive[s] = live(s) ? 1 : 0;
+    expected += d.alive[s];
+  }
+  // Hidden sites after a fresh triangulation: the next call starts from scratch again.
+  d.ready = static_cast<int>(d.rt.number_of_vertices()) == expected;
+  return extract_power_cells(d.rt, set, ns, cavity, coords, frames, out, {});
 }
 
 }  // namespace hm::transition_detail

@@ -1,0 +1,137 @@
+// The regular triangulation the optimiser keeps across its rounds (PowerDiagram): moving a few
+// sites in it and extracting the cells gives the diagram that build_power_cells builds from
+// scratch on the same sites (same cells, same faces, same node numbering, the same power
+// vertices to rounding), it moves only the sites that changed, and a move that hides a site is
+// reported as build_power_cells reports it, after which the next call starts afresh.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "../transition/synthetic_cavity.hpp"
+#include "meshgen/transition/transition_internal.hpp"
+
+using namespace hm;
+using namespace hm::transition_detail;
+using namespace hm::testing;
+
+namespace {
+
+// The box-in-box cavity of the transition tests (a block of reservoir cells around an inner
+// block), its frames and its corrected sites: a cavity with constrained polygons on both sides.
+struct Sites {
+  Scene sc;
+  SiteSet set;
+  std::vector<PolygonFrame> frames;
+  const Cavity& cavity = sc.cavity;
+  const std::vector<Vec3>& coords = sc.coords;
+};
+
+void make_sites_box(Sites& s) {
+  const std::vector<double> x{0, 8, 14, 19, 23, 27, 32, 38, 46}, y{0, 5, 11, 16, 20, 25, 31, 36, 44},
+      z{0, 4, 9, 13, 16, 20, 24, 29, 35};
+  InnerBlock b;
+  b.center = {23, 20, 16};
+  b.half = 2.5;
+  build_scene(s.sc, x, y, z, [](int i, int j, int k) { return i >= 2 && i <= 5 && j >= 2 && j <= 5 && k >= 2 && k <= 5; },
+              {b});
+  std::vector<std::string> notes;
+  for (const ConstrainedFace& f : s.sc.cavity.faces) s.frames.push_back(fit_polygon(f.nodes, s.sc.coords));
+  attach_voronoi_edges(s.sc.cavity, s.sc.coords, s.frames, notes);
+  s.set = make_sites(s.sc.cavity, s.sc.coords, s.sc.grid, s.frames, notes);
+}
+
+// The same diagram: same sites per cell, same faces with the same node ids, free power
+// vertices within `tol` of each other.
+void expect_same(const TransitionCells& a, const TransitionCells& b, double tol) {
+  ASSERT_EQ(a.cells.size(), b.cells.size());
+  EXPECT_EQ(a.cell_site, b.cell_site);
+  for (size_t c = 0; c < a.cells.size(); ++c) {
+    ASSERT_EQ(a.cells[c].size(), b.cells[c].size()) << "cell " << c;
+    for (size_t f = 0; f < a.cells[c].size(); ++f) EXPECT_EQ(a.cells[c][f].nodes, b.cells[c][f].nodes) << "cell " << c;
+  }
+  ASSERT_EQ(a.new_nodes.size(), b.new_nodes.size());
+  EXPECT_EQ(a.new_node_sites, b.new_node_sites);
+  double worst = 0;
+  for (size_t v = 0; v < a.new_nodes.size(); ++v) worst = std::max(worst, norm(a.new_nodes[v] - b.new_nodes[v]));
+  EXPECT_LE(worst, tol);
+}
+
+TransitionCells from_scratch(const Sites& s) {
+  TransitionCells out;
+  out.base_node_id = 100;
+  EXPECT_TRUE(build_power_cells(s.set, s.cavity, s.coords, s.frames, out).empty());
+  return out;
+}
+
+}  // namespace
+
+TEST(PowerDiagram, MovedSitesGiveTheDiagramBuiltFromScratch) {
+  Sites s;
+  make_sites_box(s);
+  PowerDiagram d;
+  TransitionCells first;
+  first.base_node_id = 100;
+  ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, first).empty());
+  EXPECT_EQ(d.moved_last(), 0);  // the first call triangulates
+  expect_same(first, from_scratch(s), 0.0);
+  ASSERT_GT(first.cells.size(), 20u);
+
+  // Move three polygon sites along their dual lines (each moves its reflection too: six
+  // sites), incrementally, then back.
+  const std::vector<Site> before = s.set.sites;
+  int moved = 0;
+  for (size_t q = 0; q < s.set.internal_of.size() && moved < 3; q += 7) {
+    const int i = s.set.internal_of[q];
+    if (i < 0 || s.set.sites[i].kind != SiteKind::InternalPolygon || s.set.external_of[q] < 0 ||
+        s.set.sites[s.set.external_of[q]].kind != SiteKind::ExternalMirror)
+      continue;
+    place_polygon_site(s.set, i, 0.9 * s.set.sites[i].t, s.cavity, s.coords, s.frames);
+    ++moved;
+  }
+  ASSERT_EQ(moved, 3);
+  TransitionCells after;
+  after.base_node_id = 100;
+  ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, after).empty());
+  EXPECT_EQ(d.moved_last(), 6);  // three sites and their reflections
+  const TransitionCells scratch = from_scratch(s);
+  expect_same(after, scratch, 1e-12 * 46);
+  // Something did change (the test would pass vacuously otherwise).
+  double shift = 0;
+  for (size_t c = 0; c < first.sites.size(); ++c) shift = std::max(shift, norm(first.sites[c] - after.sites[c]));
+  EXPECT_GT(shift, 0.0);
+
+  s.set.sites = before;
+  TransitionCells back;
+  back.base_node_id = 100;
+  ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, back).empty());
+  EXPECT_EQ(d.moved_last(), 6);
+  expect_same(back, first, 1e-12 * 46);
+}
+
+TEST(PowerDiagram, HiddenSiteIsReportedThenRecovered) {
+  Sites s;
+  make_sites_box(s);
+  PowerDiagram d;
+  TransitionCells out;
+  ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, out).empty());
+  // Put an internal site onto its neighbour with a much smaller weight: it has no power cell.
+  int a = -1, b = -1;
+  for (int i = 0; i < static_cast<int>(s.set.sites.size()) && b < 0; ++i)
+    if (s.set.sites[i].alive && s.set.sites[i].kind == SiteKind::InternalPolygon) (a < 0 ? a : b) = i;
+  ASSERT_GE(b, 0);
+  const Site saved = s.set.sites[b];
+  s.set.sites[b].p = s.set.sites[a].p + Vec3{1e-3, 0, 0};
+  s.set.sites[b].w2 = 1e-6 * s.set.sites[a].w2;
+  TransitionCells hidden_out, scratch_out;
+  const std::vector<int> hidden = d.cells(s.set, s.cavity, s.coords, s.frames, hidden_out);
+  EXPECT_EQ(hidden, build_power_cells(s.set, s.cavity, s.coords, s.frames, scratch_out));
+  ASSERT_EQ(hidden, std::vector<int>{b});
+  EXPECT_TRUE(hidden_out.cells.empty());
+  // Back to a valid site set: the next call starts from scratch and gives the same diagram.
+  s.set.sites[b] = saved;
+  TransitionCells again;
+  again.base_node_id = 100;
+  ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, again).empty());
+  EXPECT_EQ(d.moved_last(), 0);
+  expect_same(again, from_scratch(s), 0.0);
+}
