@@ -97,12 +97,17 @@ double area_block_radius(Vec3 scale, Vec3 t, double R) {
 
 namespace {
 
+// Relative gain below which the area radius is not taken: the inscribed block is kept where the
+// two nearly agree (a vertical well in kx = ky rock has a circular scaled cross-section, where they
+// are equal up to round-off: its mesh stays bit-identical).
+constexpr double kAreaRadiusMinGain = 0.01;
+
 // The single-well rule of scaled_case: the area radius when the block keeps, in the scaled box,
 // the same fit as with the inscribed radius (no throw, not squeezed, same ends and caps);
 // else the inscribed radius.
 double fitted_block_radius(const ReservoirSpec& scaled_reservoir, WellSpec w, double inscribed, double area,
                            const std::string& key) {
-  if (!(area > inscribed)) return inscribed;
+  if (!(area > inscribed * (1 + kAreaRadiusMinGain))) return inscribed;
   w.drainage_radius = inscribed;
   const MeshedTrajectory small = meshed_trajectory(scaled_reservoir, w, key, false);
   w.drainage_radius = area;

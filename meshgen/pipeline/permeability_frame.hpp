@@ -50,9 +50,10 @@ double area_block_radius(Vec3 scale, Vec3 unit_axis, double R);
 
 /// The case as meshed in frame f: reservoir axes and trajectories scaled; per well, radius =
 /// length-weighted mean over the legs of equivalent_radius; drainage_radius = for a case with one
-/// well the length-weighted mean over the legs of area_block_radius when that block fits the
-/// scaled box as the inscribed one does (no refusal, not squeezed, the same ends and caps), else
-/// (and with several wells) scaled_block_radius; segment_length times the scaled/physical trajectory length ratio,
+/// well the length-weighted mean over the legs of area_block_radius when it exceeds the inscribed
+/// radius by more than 1 % and that block fits the scaled box as the inscribed one does (no
+/// refusal, not squeezed, the same ends and caps), else (and with several wells)
+/// scaled_block_radius; segment_length times the scaled/physical trajectory length ratio,
 /// trajectory_md the physical measured depths (perforations keep their meaning). The
 /// rock (per cell or uniform) stays physical. Throws InputError when the scaled radius is not
 /// below the scaled drainage radius.
