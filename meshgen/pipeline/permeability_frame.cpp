@@ -1,5 +1,7 @@
 #include "permeability_frame.hpp"
 
+#include "meshgen/case/meshed_trajectory.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -64,21 +66,63 @@ void complete_basis(Vec3 t, Vec3* u, Vec3* w) {
   *w = cross(t, *u);
 }
 
-}  // namespace
-
-double equivalent_radius(Vec3 scale, Vec3 t, double r) {
+// Gram matrix (g11, g22, g12) of [P S^-1 u, P S^-1 w]: the scaled cross-section (normal to the
+// scaled axis) of the unit circle about the physical unit axis t; its singular values are the
+// semi-axes a, b of that ellipse.
+Vec3 cross_section_gram(Vec3 scale, Vec3 t) {
   Vec3 u, w;
   complete_basis(t, &u, &w);
   const Vec3 ts = normalized(divided(t, scale));
   auto project = [&](Vec3 v) { return v - dot(v, ts) * ts; };
-  // Semi-axes of the scaled cross-section: the singular values of [P S^-1 u, P S^-1 w].
   const Vec3 a = project(divided(u, scale)), b = project(divided(w, scale));
-  const double g11 = dot(a, a), g22 = dot(b, b), g12 = dot(a, b);
-  const double sum = std::sqrt(g11 + g22 + 2 * std::sqrt(std::max(0.0, g11 * g22 - g12 * g12)));
+  return {dot(a, a), dot(b, b), dot(a, b)};
+}
+
+}  // namespace
+
+double equivalent_radius(Vec3 scale, Vec3 t, double r) {
+  const Vec3 g = cross_section_gram(scale, t);
+  // a + b = sqrt(g11 + g22 + 2 sqrt(det G)).
+  const double sum = std::sqrt(g.x + g.y + 2 * std::sqrt(std::max(0.0, g.x * g.y - g.z * g.z)));
   return 0.5 * r * sum;
 }
 
 double scaled_block_radius(Vec3 scale, double R) { return R / std::max({scale.x, scale.y, scale.z}); }
+
+double area_block_radius(Vec3 scale, Vec3 t, double R) {
+  const Vec3 g = cross_section_gram(scale, t);
+  // a b = sqrt(det G).
+  return R * std::sqrt(std::sqrt(std::max(0.0, g.x * g.y - g.z * g.z)));
+}
+
+namespace {
+
+// Relative gain below which the area radius is not taken: the inscribed block is kept where the
+// two nearly agree (a vertical well in kx = ky rock has a circular scaled cross-section, where they
+// are equal up to round-off: its mesh stays bit-identical).
+constexpr double kAreaRadiusMinGain = 0.01;
+
+// The single-well rule of scaled_case: the area radius when the block keeps, in the scaled box,
+// the same fit as with the inscribed radius (no throw, not squeezed, same ends and caps);
+// else the inscribed radius.
+double fitted_block_radius(const ReservoirSpec& scaled_reservoir, WellSpec w, double inscribed, double area,
+                           const std::string& key) {
+  if (!(area > inscribed * (1 + kAreaRadiusMinGain))) return inscribed;
+  w.drainage_radius = inscribed;
+  const MeshedTrajectory small = meshed_trajectory(scaled_reservoir, w, key, false);
+  w.drainage_radius = area;
+  try {
+    const MeshedTrajectory big = meshed_trajectory(scaled_reservoir, w, key, true);
+    if (big.drainage_radius == area && big.ends == small.ends && big.caps_fit == small.caps_fit &&
+        big.points.size() == small.points.size())
+      return area;
+  } catch (const InputError&) {
+    // The enlarged block does not fit the box: the inscribed one does (the physical checks).
+  }
+  return inscribed;
+}
+
+}  // namespace
 
 CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
   CaseSpec out = cs;
@@ -89,19 +133,24 @@ CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
   for (double& v : r.z) v = f.origin.z + (v - f.origin.z) / f.scale.z;
   for (size_t i = 0; i < out.wells.size(); ++i) {
     WellSpec& w = out.wells[i];
-    double length = 0, scaled_length = 0, radius_sum = 0;
+    double length = 0, scaled_length = 0, radius_sum = 0, area_radius_sum = 0;
     for (size_t j = 0; j + 1 < w.trajectory.size(); ++j) {
       const Vec3 d = w.trajectory[j + 1] - w.trajectory[j];
       const double l = norm(d);
       length += l;
       scaled_length += norm(divided(d, f.scale));
       radius_sum += l * equivalent_radius(f.scale, d / l, w.radius);
+      area_radius_sum += l * area_block_radius(f.scale, d / l, w.drainage_radius);
     }
     // Measured depths stay the physical ones (perforations are given in them).
     if (w.trajectory_md.empty()) w.trajectory_md = well_measured_depths(w);
     for (Vec3& p : w.trajectory) p = to_scaled(f, p);
     w.radius = radius_sum / length;
-    w.drainage_radius = scaled_block_radius(f.scale, w.drainage_radius);
+    const double inscribed = scaled_block_radius(f.scale, w.drainage_radius);
+    w.drainage_radius = out.wells.size() == 1
+                            ? fitted_block_radius(r, w, inscribed, area_radius_sum / length,
+                                                  "wells[" + std::to_string(i) + "]")
+                            : inscribed;
     w.segment_length *= scaled_length / length;
     if (!(w.radius < w.drainage_radius))
       throw InputError("wells[" + std::to_string(i) + "].drainage_radius: too small for this anisotropy (metric: " +

@@ -41,9 +41,19 @@ double equivalent_radius(Vec3 scale, Vec3 unit_axis, double r);
 /// the other wells still hold).
 double scaled_block_radius(Vec3 scale, double R);
 
+/// Radius in the scaled frame of a block whose physical cross-section (an ellipse about the
+/// physical unit axis) has the area pi R^2 of the user's circular block: R sqrt(a b), a, b the
+/// semi-axes of the scaled image of the unit circle about the axis. >= scaled_block_radius;
+/// equal to it for an axis along z with kx = ky (and for isotropic K). The physical block then
+/// reaches beyond R in the direction of the largest s (docs/anisotropy.md, "Block radius R").
+double area_block_radius(Vec3 scale, Vec3 unit_axis, double R);
+
 /// The case as meshed in frame f: reservoir axes and trajectories scaled; per well, radius =
-/// length-weighted mean over the legs of equivalent_radius, drainage_radius =
-/// scaled_block_radius, segment_length times the scaled/physical trajectory length ratio,
+/// length-weighted mean over the legs of equivalent_radius; drainage_radius = for a case with one
+/// well the length-weighted mean over the legs of area_block_radius when it exceeds the inscribed
+/// radius by more than 1 % and that block fits the scaled box as the inscribed one does (no
+/// refusal, not squeezed, the same ends and caps), else (and with several wells)
+/// scaled_block_radius; segment_length times the scaled/physical trajectory length ratio,
 /// trajectory_md the physical measured depths (perforations keep their meaning). The
 /// rock (per cell or uniform) stays physical. Throws InputError when the scaled radius is not
 /// below the scaled drainage radius.

@@ -107,8 +107,13 @@ TEST(MeshFilePermeabilityFrame, ReadBackGivesTheDecksTransmissibilitiesExactly) 
   EXPECT_EQ(r.mesh.metric_scale, h.mesh.metric_scale);
   const Connections file = connections_of(r.mesh, nw);
   EXPECT_EQ(file.negative, 0);
-  EXPECT_LE(max_rel_diff(deck.pairs, file.pairs), 1e-12);
-  EXPECT_LE(max_rel_diff(deck.wells, file.wells), 1e-12);
+  // Round-off bound 1e-11, not the Euclidean meshes' 1e-12: the file holds the physical nodes,
+  // the deck's transmissibilities come from the mesh mapped from the scaled frame, and reading
+  // back maps them to that frame again (x' = o + (x - o) / s, coordinates ~1e3 m): on the inner
+  // ring cells (1e-4 m3) that round-off is 1.2e-12 relative (measured, the block of the user's
+  // area, docs/anisotropy.md). A wrong radius or frame is off by > 1e-3 (fail half below).
+  EXPECT_LE(max_rel_diff(deck.pairs, file.pairs), 1e-11);
+  EXPECT_LE(max_rel_diff(deck.wells, file.wells), 1e-11);
   std::printf("[ figures  ] paper_single_well, metric permeability: max rel diff %.3g / %.3g\n",
               max_rel_diff(deck.pairs, file.pairs), max_rel_diff(deck.wells, file.wells));
   hm::PolyMesh euclidean = r.mesh;

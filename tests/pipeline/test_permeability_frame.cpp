@@ -85,6 +85,79 @@ TEST(PermeabilityFrame, EquivalentRadiusOfADeviatedWellMatchesTheSampledEllipse)
   EXPECT_GT(std::fabs((1 / s.x + 1 / s.y + 1 / s.z) / 3 - 0.5 * (rmin + rmax)), 1e-3);
 }
 
+// The area radius R sqrt(a b) of the block (a, b the semi-axes of the sampled scaled ellipse): the
+// scaled circle of that radius maps back to an ellipse of the user's area pi R^2. It is the
+// inscribed radius R / max(s) for a vertical well with kx = ky, and 3.2 times it for a horizontal
+// well at kv/kh 0.01 (sqrt(s_y / s_z) = 0.01^-1/4), the fail half of "the block keeps its area".
+TEST(PermeabilityFrame, AreaBlockRadiusKeepsTheUsersCrossSectionArea) {
+  const Vec3 s = frame_scale({300, 100, 3});
+  const Vec3 t = normalized(Vec3{1, 2, 3});
+  const Vec3 u = normalized(cross(t, {1, 0, 0})), w = cross(t, u);
+  const Vec3 ts = normalized(Vec3{t.x / s.x, t.y / s.y, t.z / s.z});
+  double rmin = 1e300, rmax = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const double phi = 2 * M_PI * i / 200000.0;
+    Vec3 q = std::cos(phi) * u + std::sin(phi) * w;
+    q = {q.x / s.x, q.y / s.y, q.z / s.z};
+    q = q - dot(q, ts) * ts;
+    rmin = std::min(rmin, norm(q));
+    rmax = std::max(rmax, norm(q));
+  }
+  const double R = 8;
+  const double Rs = area_block_radius(s, t, R);
+  EXPECT_NEAR(Rs, R * std::sqrt(rmin * rmax), 1e-7 * R);
+  // Physical area of the scaled disc of radius Rs: pi Rs^2 / (a b) = pi R^2.
+  EXPECT_NEAR(M_PI * Rs * Rs / (rmin * rmax), M_PI * R * R, 1e-6 * R * R);
+  EXPECT_GT(Rs, scaled_block_radius(s, R) * (1 + 1e-3));
+
+  const Vec3 sv = frame_scale({100, 100, 1});
+  EXPECT_NEAR(area_block_radius(sv, {0, 0, 1}, R), scaled_block_radius(sv, R), 1e-14 * R);
+  EXPECT_NEAR(area_block_radius(sv, {1, 0, 0}, R) / scaled_block_radius(sv, R), std::pow(0.01, -0.25), 1e-12);
+}
+
+namespace {
+
+// A horizontal well along x at kv/kh 0.01 in a box half_width (y) either side of it.
+CaseSpec horizontal_case(double half_width) {
+  CaseSpec cs;
+  cs.metric = MeshMetric::Permeability;
+  cs.reservoir.x = {0, 200};
+  cs.reservoir.y = {100 - half_width, 100 + half_width};
+  cs.reservoir.z = {900, 1100};
+  cs.reservoir.permeability = {100, 100, 1};
+  WellSpec w;
+  w.trajectory = {{70, 100, 1000}, {130, 100, 1000}};
+  w.radius = 0.1;
+  w.drainage_radius = 8;
+  w.end_caps = EndCaps::Hemisphere;
+  cs.wells.push_back(w);
+  return cs;
+}
+
+}  // namespace
+
+// scaled_case's block radius: the area radius where that block fits the scaled box as the
+// inscribed one does; the inscribed radius where it does not (a box 11 m either side of the well:
+// in the scaled frame 5.1 m, below 1.25 x the area radius 11.7 m) and with two wells.
+TEST(PermeabilityFrame, ScaledCaseTakesTheAreaRadiusWhereItFitsElseTheInscribedOne) {
+  const Vec3 x{1, 0, 0};
+  CaseSpec wide = horizontal_case(100);
+  const PermeabilityFrame f = permeability_frame(wide);
+  const double area = area_block_radius(f.scale, x, 8), inscribed = scaled_block_radius(f.scale, 8);
+  EXPECT_NEAR(scaled_case(wide, f).wells[0].drainage_radius, area, 1e-12 * area);
+
+  CaseSpec narrow = horizontal_case(11);
+  EXPECT_EQ(scaled_case(narrow, permeability_frame(narrow)).wells[0].drainage_radius, inscribed);
+
+  CaseSpec two = wide;
+  two.wells.push_back(two.wells[0]);
+  two.wells[1].name = "W2";
+  for (Vec3& p : two.wells[1].trajectory) p.y += 60;
+  const CaseSpec scaled_two = scaled_case(two, permeability_frame(two));
+  EXPECT_EQ(scaled_two.wells[0].drainage_radius, inscribed);
+  EXPECT_EQ(scaled_two.wells[1].drainage_radius, inscribed);
+}
+
 // The case as meshed keeps the physical measured depths (perforations are given in them) and the
 // physical volumes of its wellbore (det S = 1: only its shape changes).
 TEST(PermeabilityFrame, ScaledCaseKeepsMeasuredDepths) {
@@ -205,7 +278,7 @@ TEST(PermeabilityFrameMesh, ReservoirNodesAreTheUsersVolumesArePreservedAndFvche
   EXPECT_TRUE(fv.k_metric);
   for (const RegionQuality& rq : fv.by_region) {
     EXPECT_EQ(rq.k_angle.count, rq.cells);
-    if (rq.region == kReservoir) EXPECT_LT(rq.k_angle.max, 1e-9);
+    if (rq.region == kReservoir) { EXPECT_LT(rq.k_angle.max, 1e-9); }
   }
   const Transmissibilities t = compute_transmissibilities(h.mesh, h.geometry);
   EXPECT_EQ(t.negative, 0);
