@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "meshgen/case/grdecl.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 #include "staged_files.hpp"
 #include "text_out.hpp"
@@ -45,6 +46,13 @@ void write_zcorn(TextOut& o, int nx, int ny, int nz, const std::vector<double>& 
   o.eclipse_array("ZCORN", z);
 }
 
+// A corner-point model's own COORD and ZCORN, as OPM read them (the user's geometry, in the frame of
+// the deck: MAPAXES is not repeated, the wells of the deck are on cells).
+void write_model_geometry(TextOut& o, const CornerPointModel& m) {
+  o.eclipse_array("COORD", m.coord);
+  o.eclipse_array("ZCORN", m.zcorn);
+}
+
 std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::string* error) {
   const int nx = static_cast<int>(res.x.size()) - 1, ny = static_cast<int>(res.y.size()) - 1,
             nz = static_cast<int>(res.z.size()) - 1;
@@ -79,8 +87,12 @@ std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::str
   o << "-- Structured reservoir of the hybrid mesh (HybridMesh). Cells replaced by the\n"
     << "-- near-well (cavity) mesh have ACTNUM 0. Units: METRIC (m, mD); depth positive down.\n"
     << "SPECGRID\n" << nx << ' ' << ny << ' ' << nz << " 1 F /\n\n";
-  write_coord(o, res.x, res.y, res.z.front(), res.z.back());
-  write_zcorn(o, nx, ny, nz, top, bottom);
+  if (res.corner_point) {
+    write_model_geometry(o, *res.corner_point);
+  } else {
+    write_coord(o, res.x, res.y, res.z.front(), res.z.back());
+    write_zcorn(o, nx, ny, nz, top, bottom);
+  }
   o.eclipse_array("ACTNUM", actnum);
   o.eclipse_array("PORO", poro);
   o.eclipse_array("PERMX", kx);
@@ -226,8 +238,16 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       o << ", separator column " << L.nx + 1 << " (inactive), well/transition cells in columns " << L.nx + 2 << ".."
         << L.deck_nx << " (thin boxes at their FV-centre depth, on every other I and J)";
     o << ".\n\n";
-    write_coord(o, L.pillar_x, L.pillar_y, L.pillar_top, L.pillar_bottom);
-    write_zcorn(o, L.deck_nx, L.ny, L.nz, L.top, L.bottom);
+    if (L.corner_point) {
+      o << "-- The model's own corner-point geometry; every transmissibility below is HybridMesh's: the\n"
+        << "-- multipliers 0 remove flow's geometric ones (fault connections included), EDIT and NNC give ours.\n";
+      write_model_geometry(o, *cs.reservoir.corner_point);
+      o << "MULTX\n" << static_cast<long long>(nd) << "*0 /\nMULTY\n" << static_cast<long long>(nd) << "*0 /\nMULTZ\n"
+        << static_cast<long long>(nd) << "*0 /\n\n";
+    } else {
+      write_coord(o, L.pillar_x, L.pillar_y, L.pillar_top, L.pillar_bottom);
+      write_zcorn(o, L.deck_nx, L.ny, L.nz, L.top, L.bottom);
+    }
     std::vector<int> actnum(nd, 0);
     std::vector<double> poro(nd, 0.0), kx(nd, 0.0), ky(nd, 0.0), kz(nd, 0.0);
     for (size_t g = 0; g < nd; ++g) {

@@ -74,6 +74,9 @@ struct EclipseLayout {
   /// deck_nx + 1 pillar x positions; pillar y positions are the lattice's y.
   std::vector<double> pillar_x, pillar_y;
   double pillar_top = 0, pillar_bottom = 0;  ///< depth range of the vertical pillars
+  /// The reservoir is a corner-point model: the deck's grid is the model's COORD/ZCORN (top, bottom
+  /// and pillars above are then unused) and it has no extra columns.
+  bool corner_point = false;
 
   int n_deck_cells() const { return deck_nx * ny * nz; }
   std::array<int, 3> deck_ijk(int32_t g) const { return {g % deck_nx, (g / deck_nx) % ny, g / (deck_nx * ny)}; }

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "eclipse_deck.hpp"
+#include "meshgen/case/grdecl.hpp"
 
 namespace hm {
 
@@ -57,8 +58,14 @@ bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const E
       *error = cell_text(c) + " and " + cell_text(res_cell[r]) + " have the same (i,j,k)";
       return false;
     }
-    // Flow takes a reservoir cell's depth from its corner points: the FV centre must be there.
-    const double zc = 0.5 * (res.z[ijk[2]] + res.z[ijk[2] + 1]);
+    // Flow takes a reservoir cell's depth from its corner points: the FV centre must be there
+    // (a corner-point model's cell: the mean of its 8 ZCORN depths, as OPM's cell depth).
+    double zc = 0.5 * (res.z[ijk[2]] + res.z[ijk[2] + 1]);
+    if (res.corner_point) {
+      zc = 0;
+      for (int q = 0; q < 8; ++q) zc += corner_depth(*res.corner_point, ijk[0] + L.nx * (ijk[1] + L.ny * ijk[2]), q);
+      zc /= 8;
+    }
     if (std::abs(mesh.cell_fv_center[c].z - zc) > 1e-9 * (std::abs(zc) + 1.0)) {
       std::ostringstream s;
       s.precision(17);
@@ -70,6 +77,13 @@ bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const E
     res_cell[r] = c;
   }
 
+  if (res.corner_point) {
+    L.corner_point = true;
+    if (!extra.empty()) {
+      *error = "near-well cells in a corner-point model's deck are not written yet (the case's cells are the model's)";
+      return false;
+    }
+  }
   // Pack the extra cells by depth: a min-heap of open columns keyed by their current bottom. Cells
   // come in increasing depth, so if the column with the shallowest bottom cannot take a cell, no
   // open column can, and a new one is opened (greedy interval colouring: the fewest columns).

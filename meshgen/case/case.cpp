@@ -275,9 +275,14 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
     if (f.get(k)) fail(f.path(k), "not with reservoir.grdecl (the model gives the grid and its rock)");
   std::string path = read_string(f.required("grdecl"), f.path("grdecl"));
   if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
-  const CornerPointModel model = read_corner_point_model(path, f.path("grdecl"));
-  ReservoirSpec r = rectilinear_reservoir(model, f.path("grdecl"));
+  auto shared = std::make_shared<const CornerPointModel>(read_corner_point_model(path, f.path("grdecl")));
+  const CornerPointModel& model = *shared;
+  // Axis-aligned boxes, all active: the rectilinear grid (the same mesh as the box form); else the
+  // model's own cells (meshgen/grids/corner_point_grid.hpp).
+  ReservoirSpec r = is_rectilinear(model) ? rectilinear_reservoir(model, f.path("grdecl"))
+                                          : corner_point_reservoir(shared, f.path("grdecl"));
   for (size_t c = 0; c < r.cell_poro.size(); ++c) {
+    if (!model.actnum[c]) continue;  // inactive cells carry no rock
     const std::string cell = f.path("grdecl") + ": cell " + std::to_string(c);
     require(r.cell_poro[c] > 0 && r.cell_poro[c] <= 1, cell, "porosity x NTG must be in (0, 1], got " + fmt(r.cell_poro[c]));
     require(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0, cell, "permeability must be > 0");

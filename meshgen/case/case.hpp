@@ -3,6 +3,7 @@
 #pragma once
 #include <array>
 #include <stdexcept>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,8 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+struct CornerPointModel;
+
 struct ReservoirSpec {
   std::vector<double> x, y, z;        ///< node coordinates, strictly increasing, >= 2 each
   Vec3 permeability{100, 100, 10};    ///< kx, ky, kz (mD), > 0
@@ -26,6 +29,10 @@ struct ReservoirSpec {
   /// a model read from `reservoir.grdecl` (PERMX/PERMY x NTG, PERMZ in mD; PORO x NTG).
   std::vector<double> cell_permx, cell_permy, cell_permz, cell_poro;
   std::string grdecl;                 ///< the model file the grid came from, or empty
+  /// A true corner-point model (grdecl whose cells are not all axis-aligned boxes): its cells are
+  /// the mesh's reservoir cells (meshgen/grids/corner_point_grid.hpp); x/y/z are then only its
+  /// bounding box divided into nx, ny, nz. Null for a rectilinear reservoir.
+  std::shared_ptr<const CornerPointModel> corner_point;
   /// The model's MAPAXES (grdecl): the map position of grid point (0, 0) and of the grid's unit x
   /// and y directions (z: unused). Well paths in the case file are in map coordinates and are
   /// brought into the grid frame with it (OPM's convention: COORD is in the grid frame).

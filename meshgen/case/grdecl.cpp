@@ -10,6 +10,7 @@
 #include <opm/input/eclipse/Parser/Parser.hpp>
 #include <opm/input/eclipse/Units/Units.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -79,6 +80,12 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
       }
       m.actnum[c] = grid.cellActive(c) ? 1 : 0;
     }
+    m.coord = grid.getCOORD();
+    m.zcorn = grid.getZCORN();
+    m.opm_volume.resize(n);
+    for (size_t c = 0; c < n; ++c) m.opm_volume[c] = grid.getCellVolume(c);
+    if (m.coord.size() != 6 * size_t(m.nx + 1) * (m.ny + 1) || m.zcorn.size() != 8 * n)
+      throw InputError(key + ": the grid is not given as COORD/ZCORN (or SPECGRID does not match them)");
     const Opm::FieldPropsManager& fp = state.fieldProps();
     for (const char* kw : {"PERMX", "PORO"})
       if (!fp.has_double(kw)) throw InputError(key + ": the model has no " + std::string(kw));
@@ -118,6 +125,115 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
   return m;
 }
 
+namespace {
+
+// Rock per cell as the mesh carries it: NTG folded into the porosity and the horizontal
+// permeabilities (OPM's pore volumes and TRANX/TRANY).
+void set_rock(const CornerPointModel& m, ReservoirSpec& r) {
+  const size_t n = m.corners.size();
+  r.cell_permx.resize(n);
+  r.cell_permy.resize(n);
+  r.cell_poro.resize(n);
+  for (size_t c = 0; c < n; ++c) {
+    r.cell_permx[c] = m.permx[c] * m.ntg[c];
+    r.cell_permy[c] = m.permy[c] * m.ntg[c];
+    r.cell_poro[c] = m.poro[c] * m.ntg[c];
+  }
+  r.cell_permz = m.permz;
+}
+
+}  // namespace
+
+size_t zcorn_index(const CornerPointModel& m, int i, int j, int k, int q) {
+  const size_t nx = m.nx, ny = m.ny;
+  return 2 * size_t(i) + (q & 1) + 2 * nx * (2 * size_t(j) + ((q >> 1) & 1)) +
+         4 * nx * ny * (2 * size_t(k) + ((q >> 2) & 1));
+}
+
+double corner_depth(const CornerPointModel& m, int c, int q) {
+  const int i = c % m.nx, j = (c / m.nx) % m.ny, k = c / (m.nx * m.ny);
+  return m.zcorn[zcorn_index(m, i, j, k, q)];
+}
+
+Vec3 pillar_point(const CornerPointModel& m, int p, double z) {
+  const double* a = &m.coord[6 * size_t(p)];
+  const double dz = a[5] - a[2];
+  if (dz == 0) return {a[0], a[1], z};
+  const double t = (z - a[2]) / dz;
+  return {a[0] + t * (a[3] - a[0]), a[1] + t * (a[4] - a[1]), z};
+}
+
+bool is_rectilinear(const CornerPointModel& m) {
+  try {
+    rectilinear_reservoir(m, "");
+    return true;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+void check_corner_point_geometry(const CornerPointModel& m, const std::string& key) {
+  const int nx = m.nx, ny = m.ny;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      int above = -1;  // the previous active cell of the column
+      for (int k = 0; k < m.nz; ++k) {
+        const int c = i + nx * (j + ny * k);
+        if (!m.actnum[c]) continue;
+        for (int q = 0; q < 4; ++q) {
+          const double top = corner_depth(m, c, q), bottom = corner_depth(m, c, q + 4);
+          if (!(top <= bottom))
+            throw InputError(key + ": " + cell_name(c, nx, ny) + ": its top corner lies below its bottom corner on pillar " +
+                             std::to_string(q) + " (ZCORN " + std::to_string(top) + " > " + std::to_string(bottom) + ")");
+          if (above >= 0 && !(corner_depth(m, above, q + 4) <= top))
+            throw InputError(key + ": " + cell_name(c, nx, ny) + " overlaps the active cell above it (" +
+                             cell_name(above, nx, ny) + ") on one of its pillars: cells of a column must not overlap");
+        }
+        above = c;
+      }
+    }
+}
+
+ReservoirSpec corner_point_reservoir(std::shared_ptr<const CornerPointModel> model, const std::string& key) {
+  const CornerPointModel& m = *model;
+  check_corner_point_geometry(m, key);
+  ReservoirSpec r;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (size_t c = 0; c < m.corners.size(); ++c)
+    if (m.actnum[c])
+      for (const Vec3& p : m.corners[c]) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      }
+  auto axis = [](double a, double b, int n) {
+    std::vector<double> v(n + 1);
+    for (int i = 0; i <= n; ++i) v[i] = i == n ? b : a + (b - a) * i / n;
+    return v;
+  };
+  r.x = axis(lo.x, hi.x, m.nx);
+  r.y = axis(lo.y, hi.y, m.ny);
+  r.z = axis(lo.z, hi.z, m.nz);
+  for (const auto* a : {&r.x, &r.y, &r.z})
+    for (size_t i = 1; i < a->size(); ++i)
+      if (!((*a)[i] > (*a)[i - 1])) throw InputError(key + ": the model's active cells have no extent in x, y or z");
+  set_rock(m, r);
+  r.corner_point = std::move(model);
+  return r;
+}
+
+CornerPointModel translated_model(const CornerPointModel& m, Vec3 shift) {
+  CornerPointModel out = m;
+  for (size_t p = 0; p < out.coord.size(); p += 3) {
+    out.coord[p] += shift.x;
+    out.coord[p + 1] += shift.y;
+    out.coord[p + 2] += shift.z;
+  }
+  for (double& z : out.zcorn) z += shift.z;
+  for (auto& cell : out.corners)
+    for (Vec3& p : cell) p += shift;
+  return out;
+}
+
 ReservoirSpec rectilinear_reservoir(const CornerPointModel& m, const std::string& key) {
   ReservoirSpec r;
   const int nx = m.nx, ny = m.ny;
@@ -149,17 +265,7 @@ ReservoirSpec rectilinear_reservoir(const CornerPointModel& m, const std::string
     if (!(r.y[a] > r.y[a - 1])) throw InputError(key + ": grid y not increasing along j (GDORIENT?)");
   for (size_t a = 1; a < r.z.size(); ++a)
     if (!(r.z[a] > r.z[a - 1])) throw InputError(key + ": layer " + std::to_string(a) + " has zero thickness");
-  // NTG scales the pore volume and the horizontal flow areas (OPM's TRANX/TRANY), so it is folded
-  // into the porosity and the horizontal permeabilities the mesh carries.
-  r.cell_permx.resize(n);
-  r.cell_permy.resize(n);
-  r.cell_poro.resize(n);
-  for (size_t c = 0; c < n; ++c) {
-    r.cell_permx[c] = m.permx[c] * m.ntg[c];
-    r.cell_permy[c] = m.permy[c] * m.ntg[c];
-    r.cell_poro[c] = m.poro[c] * m.ntg[c];
-  }
-  r.cell_permz = m.permz;
+  set_rock(m, r);
   return r;
 }
 

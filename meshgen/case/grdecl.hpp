@@ -3,6 +3,7 @@
 // (INCLUDE, MULTIPLY, BOX, EQUALS, MINPV, PINCH, ...) means what it means in OPM Flow.
 #pragma once
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,11 @@ struct CornerPointModel {
   std::vector<int> actnum;                     ///< 1 active, 0 inactive (ACTNUM after MINPV/PINCH)
   std::vector<double> permx, permy, permz;     ///< mD
   std::vector<double> poro, ntg;               ///< NTG is 1 where the deck has none
+  /// The deck's geometry as OPM holds it (EclipseGrid::getCOORD/getZCORN): 6 numbers per pillar
+  /// (top x y z, bottom x y z; pillar (i, j) at i + (nx+1) j) and 8 depths per cell (Eclipse order,
+  /// `zcorn_index`). The mesh's model cells and the exported deck's COORD/ZCORN come from these.
+  std::vector<double> coord, zcorn;
+  std::vector<double> opm_volume;              ///< EclipseGrid::getCellVolume per cell (m3), for comparisons
   bool has_mapaxes = false;
   /// MAPAXES as OPM applies it: the map (world) position of grid point (0, 0) and of the
   /// unit grid x and y directions (origin, unit_x, unit_y), for has_mapaxes.
@@ -38,5 +44,32 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
 /// rock (porosity x NTG). Decided by exact equality of the corner coordinates, no tolerance. Throws
 /// InputError naming `key` and the first cell that is not (corner-point geometry is not meshed yet).
 ReservoirSpec rectilinear_reservoir(const CornerPointModel& model, const std::string& key);
+
+/// Whether every cell is an axis-aligned box on common axes and active (exact equality, no tolerance):
+/// such a model is meshed as the rectilinear grid of `rectilinear_reservoir`.
+bool is_rectilinear(const CornerPointModel& model);
+
+/// Index in ZCORN of corner q (bit 0 = +i, bit 1 = +j, bit 2 = +k) of cell (i, j, k).
+size_t zcorn_index(const CornerPointModel& m, int i, int j, int k, int q);
+/// Depth of corner q of cell c (natural index).
+double corner_depth(const CornerPointModel& m, int c, int q);
+/// The point of pillar p (i + (nx+1) j) at depth z (linear along the pillar; a pillar whose two
+/// COORD points have the same depth is vertical through its top point), as OPM places corners.
+Vec3 pillar_point(const CornerPointModel& m, int p, double z);
+
+/// Geometry a model must have to be meshed as a corner-point reservoir: in every active cell the
+/// top corner is not below the bottom corner on any of its 4 pillars, and an active cell does not
+/// reach into the next active cell below it in its column (bottom depth <= that cell's top depth on
+/// each pillar). Exact comparisons of the ZCORN values. Throws InputError naming `key` and the cell.
+void check_corner_point_geometry(const CornerPointModel& model, const std::string& key);
+
+/// The reservoir of a true corner-point model (meshgen/grids/corner_point_grid.hpp meshes its cells):
+/// per-cell rock as `rectilinear_reservoir`, `corner_point` = the model, and x/y/z = the model's
+/// bounding box divided uniformly into nx, ny, nz (index arithmetic and the box limits only; the
+/// geometry is the model's).
+ReservoirSpec corner_point_reservoir(std::shared_ptr<const CornerPointModel> model, const std::string& key);
+
+/// The model moved by `shift` (COORD x, y, z; ZCORN z): the local frame of meshgen.
+CornerPointModel translated_model(const CornerPointModel& m, Vec3 shift);
 
 }  // namespace hm

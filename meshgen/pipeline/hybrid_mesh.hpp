@@ -84,6 +84,9 @@ class MeshingError : public std::runtime_error {
 /// With `metric: permeability` and anisotropic rock the job meshes scaled_case(cs, frame) and
 /// maps the mesh back (permeability_frame.hpp, docs/anisotropy.md).
 HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts = {});
+/// The job for a true corner-point reservoir (`ReservoirSpec::corner_point`): the model's active cells
+/// as the mesh (no wells yet: a case with wells is an InputError). build_hybrid_mesh calls it.
+HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& opts = {});
 /// The job in the case's own coordinates, orthogonal in the Euclidean sense.
 HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& cs, const PipelineOptions& opts = {});
 

@@ -19,6 +19,7 @@ std::string fmt_scale(double v) {
 }  // namespace
 
 HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
+  if (cs.reservoir.corner_point) return build_corner_point_mesh(cs, opts);
   const PermeabilityFrame frame = permeability_frame(cs);
   if (frame.identity()) {
     HybridMesh out = build_hybrid_mesh_euclidean(cs, opts);

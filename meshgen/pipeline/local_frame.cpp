@@ -1,5 +1,7 @@
 #include "local_frame.hpp"
 
+#include "meshgen/case/grdecl.hpp"
+
 namespace hm {
 
 // z (depth) stays: depths are below 1e4 m, where a double resolves 2e-12 m, and keeping them
@@ -12,6 +14,8 @@ CaseSpec translated_case(const CaseSpec& cs, Vec3 shift) {
   for (double& v : out.reservoir.x) v += shift.x;
   for (double& v : out.reservoir.y) v += shift.y;
   for (double& v : out.reservoir.z) v += shift.z;
+  if (cs.reservoir.corner_point)
+    out.reservoir.corner_point = std::make_shared<const CornerPointModel>(translated_model(*cs.reservoir.corner_point, shift));
   for (WellSpec& w : out.wells)
     for (Vec3& p : w.trajectory) p += shift;
   return out;

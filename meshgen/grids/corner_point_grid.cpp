@@ -1,0 +1,480 @@
+#include "corner_point_grid.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+namespace hm {
+
+namespace {
+
+// A pillar pair (the two pillars a column face lies on) seen as the strip s in [0, 1] (s = 0 on its
+// first pillar) x depth z. Every cell face on it is the band between the cell's top line and its
+// bottom line, each line the straight edge between the cell's corner depths on the two pillars,
+// identified by those two exact ZCORN values. A point (s, z) of the strip is the point at parameter
+// s between the two pillars' points at depth z. Two lines of the two sides of a fault that cross
+// inside the strip meet at a crossing node; every node lying on a line (its two pillar ends and its
+// crossings) is a station of it, and every face edge along the line names all the stations it
+// passes (no hanging node).
+constexpr int kAbove = -1;  // the line z = -infinity (a gap band above a column's first cell)
+constexpr int kBelow = -2;  // z = +infinity
+
+struct Station {
+  double s;
+  int32_t node;
+};
+
+struct PillarPair {
+  int pillar[2];
+  std::vector<std::array<double, 2>> lines;  // depth on pillar[0], pillar[1]
+  std::map<std::array<double, 2>, int> line_of;
+  std::vector<std::vector<Station>> stations;  // per line, in increasing s
+  std::map<std::pair<int, int>, Station> crossing;
+};
+
+int sgn(double a, double b) { return (a > b) - (a < b); }
+
+struct Band {
+  int top, bottom;  // line ids (or kAbove / kBelow)
+};
+
+class CornerPointMesher {
+ public:
+  CornerPointMesher(const CornerPointModel& m, const std::vector<char>& active, MeshBuilder& b) : m_(m), b_(b) {
+    const int n = m.nx * m.ny * m.nz;
+    meshed_.assign(n, 0);
+    for (int c = 0; c < n; ++c) {
+      if (!m.actnum[c] || !active[c]) continue;
+      bool thick = false;
+      for (int q = 0; q < 4; ++q) thick = thick || corner_depth(m, c, q) != corner_depth(m, c, q + 4);
+      if (thick) meshed_[c] = 1;
+      else ++zero_volume_;
+    }
+    make_pillar_nodes();
+    make_pairs();
+  }
+
+  CornerPointCells add_cells(const ReservoirSpec& rock, int32_t boundary_patch) {
+    const int n = m_.nx * m_.ny * m_.nz;
+    std::vector<std::vector<CellFace>> faces(n);
+    for (size_t p = 0; p < pairs_.size(); ++p) pair_faces(static_cast<int>(p), boundary_patch, faces);
+    const bool flip = left_handed();
+    CornerPointCells out;
+    out.cell_id.assign(n, -1);
+    out.zero_volume_cells = zero_volume_;
+    out.fault_faces = fault_faces_;
+    out.crossing_nodes = crossings_;
+    for (int c = 0; c < n; ++c) {
+      if (!meshed_[c]) continue;
+      top_bottom_faces(c, boundary_patch, faces[c]);
+      if (flip)
+        for (CellFace& f : faces[c]) std::reverse(f.nodes.begin(), f.nodes.end());
+      CellAttributes at;
+      at.region = kReservoir;
+      Vec3 centre{0, 0, 0};
+      for (int q = 0; q < 8; ++q) centre += corner_point(c, q);
+      at.fv_center = centre / 8.0;
+      at.ijk = {c % m_.nx, (c / m_.nx) % m_.ny, c / (m_.nx * m_.ny)};
+      at.perm = reservoir_permeability(rock, c);
+      at.porosity = reservoir_porosity(rock, c);
+      out.cell_id[c] = b_.add_cell(faces[c], at);
+    }
+    return out;
+  }
+
+ private:
+  const CornerPointModel& m_;
+  MeshBuilder& b_;
+  std::vector<char> meshed_;
+  int64_t zero_volume_ = 0, fault_faces_ = 0, crossings_ = 0;
+  std::vector<std::vector<double>> pillar_depth_;
+  std::vector<std::vector<int32_t>> pillar_node_;
+  std::vector<PillarPair> pairs_;
+  std::map<std::array<int32_t, 4>, int32_t> face_centre_;  // centre node of a split top/bottom face, by its corners
+
+  // The face cycles above are outward when (i, j, depth) is a right-handed frame, i.e. when the
+  // columns turn counter-clockwise in plan from +i to +j (x east, y north with j). Many models number
+  // j the other way (southward): the sign of their summed plan area (the pillars' top points,
+  // shoelace) says so, and every cycle is reversed.
+  bool left_handed() const {
+    double area = 0;
+    for (int j = 0; j < m_.ny; ++j)
+      for (int i = 0; i < m_.nx; ++i) {
+        const int p[4] = {i + (m_.nx + 1) * j, i + 1 + (m_.nx + 1) * j, i + 1 + (m_.nx + 1) * (j + 1), i + (m_.nx + 1) * (j + 1)};
+        for (int e = 0; e < 4; ++e) {
+          const double* a = &m_.coord[6 * size_t(p[e])];
+          const double* b = &m_.coord[6 * size_t(p[(e + 1) % 4])];
+          area += a[0] * b[1] - a[1] * b[0];
+        }
+      }
+    return area < 0;
+  }
+
+  int pillar_of(int c, int q) const {
+    const int i = c % m_.nx + (q & 1), j = (c / m_.nx) % m_.ny + ((q >> 1) & 1);
+    return i + (m_.nx + 1) * j;
+  }
+  Vec3 corner_point(int c, int q) const { return pillar_point(m_, pillar_of(c, q), corner_depth(m_, c, q)); }
+
+  void make_pillar_nodes() {
+    const int np = (m_.nx + 1) * (m_.ny + 1);
+    pillar_depth_.assign(np, {});
+    pillar_node_.assign(np, {});
+    for (int c = 0; c < static_cast<int>(meshed_.size()); ++c)
+      if (meshed_[c])
+        for (int q = 0; q < 8; ++q) pillar_depth_[pillar_of(c, q)].push_back(corner_depth(m_, c, q));
+    for (int p = 0; p < np; ++p) {
+      auto& d = pillar_depth_[p];
+      std::sort(d.begin(), d.end());
+      d.erase(std::unique(d.begin(), d.end()), d.end());
+      for (double z : d) pillar_node_[p].push_back(b_.add_node(pillar_point(m_, p, z)));
+    }
+  }
+  int32_t pillar_node(int p, double z) const {
+    const auto& d = pillar_depth_[p];
+    return pillar_node_[p][std::lower_bound(d.begin(), d.end(), z) - d.begin()];
+  }
+
+  // Pair ids: i-pairs (the plane between columns i-1 and i, pillars (I, j) and (I, j+1)) first, then
+  // j-pairs (pillars (i, J) and (i+1, J)).
+  int n_ipairs() const { return (m_.nx + 1) * m_.ny; }
+  int ipair(int I, int j) const { return I + (m_.nx + 1) * j; }
+  int jpair(int i, int J) const { return n_ipairs() + i + m_.nx * J; }
+  // Side 0 -i, 1 +i, 2 -j, 3 +j of cell c: its pair, and the corners (s = 0, s = 1) of its top edge
+  // there (the bottom edge: the same + 4).
+  int side_pair(int c, int side) const {
+    const int i = c % m_.nx, j = (c / m_.nx) % m_.ny;
+    switch (side) {
+      case 0: return ipair(i, j);
+      case 1: return ipair(i + 1, j);
+      case 2: return jpair(i, j);
+      default: return jpair(i, j + 1);
+    }
+  }
+  static std::array<int, 2> side_corners(int side) {
+    static const int kCorners[4][2] = {{0, 2}, {1, 3}, {0, 1}, {2, 3}};
+    return {kCorners[side][0], kCorners[side][1]};
+  }
+  int line_id(int c, int side, bool bottom) const {
+    const auto q = side_corners(side);
+    const int off = bottom ? 4 : 0;
+    const PillarPair& pp = pairs_[side_pair(c, side)];
+    return pp.line_of.at({corner_depth(m_, c, q[0] + off), corner_depth(m_, c, q[1] + off)});
+  }
+
+  void make_pairs() {
+    const int nx = m_.nx, ny = m_.ny;
+    pairs_.resize(n_ipairs() + nx * (ny + 1));
+    for (int j = 0; j < ny; ++j)
+      for (int I = 0; I <= nx; ++I) pairs_[ipair(I, j)].pillar[0] = I + (nx + 1) * j, pairs_[ipair(I, j)].pillar[1] = I + (nx + 1) * (j + 1);
+    for (int J = 0; J <= ny; ++J)
+      for (int i = 0; i < nx; ++i) pairs_[jpair(i, J)].pillar[0] = i + (nx + 1) * J, pairs_[jpair(i, J)].pillar[1] = i + 1 + (nx + 1) * J;
+    for (int c = 0; c < static_cast<int>(meshed_.size()); ++c) {
+      if (!meshed_[c]) continue;
+      for (int side = 0; side < 4; ++side) {
+        PillarPair& pp = pairs_[side_pair(c, side)];
+        const auto q = side_corners(side);
+        for (int off : {0, 4}) {
+          const std::array<double, 2> l{corner_depth(m_, c, q[0] + off), corner_depth(m_, c, q[1] + off)};
+          if (pp.line_of.emplace(l, static_cast<int>(pp.lines.size())).second) pp.lines.push_back(l);
+        }
+      }
+    }
+    for (PillarPair& pp : pairs_) make_stations(pp);
+  }
+
+  // Crossings: two lines whose order on the two pillars is strictly opposite (exact comparisons of
+  // their ZCORN values) cross inside the strip. Only lines of the two different sides can: in a
+  // column the lines are ordered on both pillars (check_corner_point_geometry).
+  void make_stations(PillarPair& pp) {
+    const int nl = static_cast<int>(pp.lines.size());
+    pp.stations.assign(nl, {});
+    for (int a = 0; a < nl; ++a)
+      for (int b = a + 1; b < nl; ++b) {
+        const auto& la = pp.lines[a];
+        const auto& lb = pp.lines[b];
+        if (sgn(la[0], lb[0]) * sgn(la[1], lb[1]) >= 0) continue;
+        const double d0 = la[0] - lb[0], d1 = la[1] - lb[1];
+        const double s = d0 / (d0 - d1);
+        // Each line is the straight edge between its two corners; where the pillars are not parallel
+        // the two edges pass at one depth at s a little apart: the node is their midpoint there.
+        auto edge = [&](const std::array<double, 2>& l) {
+          return (1 - s) * pillar_point(m_, pp.pillar[0], l[0]) + s * pillar_point(m_, pp.pillar[1], l[1]);
+        };
+        const Vec3 p = 0.5 * (edge(la) + edge(lb));
+        const Station st{s, b_.add_node(p)};
+        ++crossings_;
+        pp.crossing[{a, b}] = st;
+        pp.stations[a].push_back(st);
+        pp.stations[b].push_back(st);
+      }
+    for (int l = 0; l < nl; ++l) {
+      auto& st = pp.stations[l];
+      std::sort(st.begin(), st.end(), [](const Station& x, const Station& y) { return x.s < y.s || (x.s == y.s && x.node < y.node); });
+      st.insert(st.begin(), Station{0.0, pillar_node(pp.pillar[0], pp.lines[l][0])});
+      st.push_back(Station{1.0, pillar_node(pp.pillar[1], pp.lines[l][1])});
+    }
+  }
+
+  static double depth(const PillarPair& pp, int line, int end) {
+    if (line == kAbove) return -std::numeric_limits<double>::infinity();
+    if (line == kBelow) return std::numeric_limits<double>::infinity();
+    return pp.lines[line][end];
+  }
+  static const Station& crossing(const PillarPair& pp, int a, int b) {
+    return pp.crossing.at({std::min(a, b), std::max(a, b)});
+  }
+  // Appends the stations of `line` after node `from` up to node `to` (included).
+  static void along(const PillarPair& pp, int line, int32_t from, int32_t to, std::vector<int32_t>& out) {
+    const auto& st = pp.stations[line];
+    int a = -1, b = -1;
+    for (int k = 0; k < static_cast<int>(st.size()); ++k) {
+      if (st[k].node == from) a = k;
+      if (st[k].node == to) b = k;
+    }
+    if (a < 0 || b < 0) throw std::logic_error("corner-point grid: a face vertex is not a station of its edge");
+    const int step = b > a ? 1 : -1;
+    for (int k = a + step; k != b + step; k += step) out.push_back(st[k].node);
+  }
+  // Appends the pillar nodes after depth z_from up to depth z_to (included).
+  void along_pillar(int p, double z_from, double z_to, std::vector<int32_t>& out) const {
+    const auto& d = pillar_depth_[p];
+    int a = static_cast<int>(std::lower_bound(d.begin(), d.end(), z_from) - d.begin());
+    int b = static_cast<int>(std::lower_bound(d.begin(), d.end(), z_to) - d.begin());
+    const int step = b > a ? 1 : -1;
+    if (a == b) return;
+    for (int k = a + step; k != b + step; k += step) out.push_back(pillar_node_[p][k]);
+  }
+
+  // The part of the strip in both bands, {max(tops) <= z <= min(bottoms)}: a convex polygon whose
+  // vertex cycle runs along its upper boundary in increasing s, down the s = 1 pillar, back along
+  // its lower boundary and up the s = 0 pillar (outward for the i-pair's -i column and the j-pair's
+  // +j column). Empty when the bands share no area. The decisions (empty, which line bounds where)
+  // are exact comparisons of ZCORN values; only two crossing positions are compared numerically
+  // (a band ending at two crossings, a throw changing sign between the pillars).
+  std::vector<int32_t> band_polygon(const PillarPair& pp, Band x, Band y) const {
+    std::vector<int32_t> out;
+    if (x.top == x.bottom || y.top == y.bottom) return out;
+    struct Limit {  // bottom of one band minus the top of the other
+      int top, bottom, s0, s1;
+    };
+    const Limit lim[2] = {{x.top, y.bottom, sgn(depth(pp, y.bottom, 0), depth(pp, x.top, 0)), sgn(depth(pp, y.bottom, 1), depth(pp, x.top, 1))},
+                          {y.top, x.bottom, sgn(depth(pp, x.bottom, 0), depth(pp, y.top, 0)), sgn(depth(pp, x.bottom, 1), depth(pp, y.top, 1))}};
+    for (const Limit& l : lim) {
+      if (l.s0 == 0 && l.s1 == 0) return out;                              // touching along a line
+      if ((l.s0 < 0 && l.s1 <= 0) || (l.s0 <= 0 && l.s1 < 0)) return out;  // apart (or touching at a pillar)
+    }
+    // Ends: 0 / 1, or the crossing where a limit turns positive (left) or negative (right).
+    const Limit* left = nullptr;
+    const Limit* right = nullptr;
+    for (const Limit& l : lim) {
+      if (l.s0 < 0 && l.s1 > 0 && (!left || crossing(pp, l.top, l.bottom).s > crossing(pp, left->top, left->bottom).s)) left = &l;
+      if (l.s0 > 0 && l.s1 < 0 && (!right || crossing(pp, l.top, l.bottom).s < crossing(pp, right->top, right->bottom).s)) right = &l;
+    }
+    if (left && right && !(crossing(pp, left->top, left->bottom).s < crossing(pp, right->top, right->bottom).s)) return out;
+    // The bounding lines at each end: the deeper top (lo) and the shallower bottom (hi); a tie at
+    // the end is decided at the other end.
+    auto pick = [&](int a, int b, int end, bool deeper) {
+      int d = sgn(depth(pp, a, end), depth(pp, b, end));
+      if (d == 0) d = sgn(depth(pp, a, 1 - end), depth(pp, b, 1 - end));
+      if (!deeper) d = -d;
+      return d >= 0 ? a : b;
+    };
+    const int lo_l = left ? left->top : pick(x.top, y.top, 0, true);
+    const int hi_l = left ? left->bottom : pick(x.bottom, y.bottom, 0, false);
+    const int lo_r = right ? right->top : pick(x.top, y.top, 1, true);
+    const int hi_r = right ? right->bottom : pick(x.bottom, y.bottom, 1, false);
+    const int32_t lo_left = left ? crossing(pp, lo_l, hi_l).node : pillar_node(pp.pillar[0], depth(pp, lo_l, 0));
+    const int32_t hi_left = left ? lo_left : pillar_node(pp.pillar[0], depth(pp, hi_l, 0));
+    const int32_t lo_right = right ? crossing(pp, lo_r, hi_r).node : pillar_node(pp.pillar[1], depth(pp, lo_r, 1));
+    const int32_t hi_right = right ? lo_right : pillar_node(pp.pillar[1], depth(pp, hi_r, 1));
+    out.push_back(lo_left);
+    if (lo_l != lo_r) {
+      const int32_t k = crossing(pp, lo_l, lo_r).node;
+      along(pp, lo_l, lo_left, k, out);
+      along(pp, lo_r, k, lo_right, out);
+    } else {
+      along(pp, lo_l, lo_left, lo_right, out);
+    }
+    if (!right) along_pillar(pp.pillar[1], depth(pp, lo_r, 1), depth(pp, hi_r, 1), out);
+    if (hi_r != hi_l) {
+      const int32_t k = crossing(pp, hi_r, hi_l).node;
+      along(pp, hi_r, hi_right, k, out);
+      along(pp, hi_l, k, hi_left, out);
+    } else {
+      along(pp, hi_r, hi_right, hi_left, out);
+    }
+    if (!left) along_pillar(pp.pillar[0], depth(pp, hi_l, 0), depth(pp, lo_l, 0), out);
+    // Close the cycle; collapsed edges (a pinched corner) leave repeated nodes.
+    std::vector<int32_t> cyc;
+    for (int32_t v : out)
+      if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
+    while (cyc.size() > 1 && cyc.back() == cyc.front()) cyc.pop_back();
+    if (cyc.size() < 3) cyc.clear();
+    return cyc;
+  }
+
+  // The meshed cells of a column (bottom to top order is k), and the gap bands between them.
+  std::vector<int> column_cells(int i, int j) const {
+    std::vector<int> cells;
+    if (i < 0 || j < 0 || i >= m_.nx || j >= m_.ny) return cells;
+    for (int k = 0; k < m_.nz; ++k) {
+      const int c = i + m_.nx * (j + m_.ny * k);
+      if (meshed_[c]) cells.push_back(c);
+    }
+    return cells;
+  }
+  std::vector<Band> gaps(const std::vector<int>& cells, int side) const {
+    std::vector<Band> g;
+    int top = kAbove;
+    for (int c : cells) {
+      g.push_back({top, line_id(c, side, false)});
+      top = line_id(c, side, true);
+    }
+    g.push_back({top, kBelow});
+    return g;
+  }
+
+  void pair_faces(int p, int32_t boundary_patch, std::vector<std::vector<CellFace>>& faces) {
+    const PillarPair& pp = pairs_[p];
+    const bool is_i = p < n_ipairs();
+    // Side A: the column on the -i (-j) side, whose +i (+j) face lies here; B: the other.
+    int ia, ja, ib, jb;
+    if (is_i) {
+      const int I = p % (m_.nx + 1), j = p / (m_.nx + 1);
+      ia = I - 1, ja = j, ib = I, jb = j;
+    } else {
+      const int q = p - n_ipairs(), i = q % m_.nx, J = q / m_.nx;
+      ia = i, ja = J - 1, ib = i, jb = J;
+    }
+    const int side_a = is_i ? 1 : 3, side_b = is_i ? 0 : 2;
+    const std::vector<int> ca = column_cells(ia, ja), cb = column_cells(ib, jb);
+    auto band = [&](int c, int side) { return Band{line_id(c, side, false), line_id(c, side, true)}; };
+    // The walk is outward for A on i-pairs, for B on j-pairs. A piece that is a cell's whole face
+    // (all 4 corners of its band) is fanned about that face's own centre (split_face), on both sides.
+    auto whole = [&](const std::vector<int32_t>& poly, Band bd, std::array<int32_t, 4>* corner, Vec3* centre) {
+      *corner = {pillar_node(pp.pillar[0], depth(pp, bd.top, 0)), pillar_node(pp.pillar[1], depth(pp, bd.top, 1)),
+                 pillar_node(pp.pillar[1], depth(pp, bd.bottom, 1)), pillar_node(pp.pillar[0], depth(pp, bd.bottom, 0))};
+      if (poly.size() <= 4) return false;
+      for (int32_t v : *corner)
+        if (std::find(poly.begin(), poly.end(), v) == poly.end()) return false;
+      *centre = 0.25 * (pillar_point(m_, pp.pillar[0], depth(pp, bd.top, 0)) + pillar_point(m_, pp.pillar[1], depth(pp, bd.top, 1)) +
+                        pillar_point(m_, pp.pillar[1], depth(pp, bd.bottom, 1)) + pillar_point(m_, pp.pillar[0], depth(pp, bd.bottom, 0)));
+      return true;
+    };
+    // poly in walk orientation; `split`: the face is the whole face of one of its cells (corner, centre).
+    auto add = [&](int c, bool c_is_a, std::vector<int32_t> poly, int32_t patch, bool split,
+                   const std::array<int32_t, 4>& corner, Vec3 centre) {
+      if (c_is_a != is_i) std::reverse(poly.begin(), poly.end());
+      if (split) split_face(poly, corner, centre, patch, faces[c]);
+      else faces[c].push_back(CellFace{std::move(poly), patch});
+    };
+    for (int a : ca)
+      for (int b : cb) {
+        std::vector<int32_t> poly = band_polygon(pp, band(a, side_a), band(b, side_b));
+        if (poly.empty()) continue;
+        if (!(band(a, side_a).top == band(b, side_b).top && band(a, side_a).bottom == band(b, side_b).bottom)) ++fault_faces_;
+        std::array<int32_t, 4> corner;
+        Vec3 centre;
+        const bool split = whole(poly, band(a, side_a), &corner, &centre) || whole(poly, band(b, side_b), &corner, &centre);
+        add(a, true, poly, kInteriorFace, split, corner, centre);
+        add(b, false, std::move(poly), kInteriorFace, split, corner, centre);
+      }
+    const std::vector<Band> ga = gaps(ca, side_a), gb = gaps(cb, side_b);
+    for (int a : ca)
+      for (const Band& g : gb)
+        if (auto poly = band_polygon(pp, band(a, side_a), g); !poly.empty()) {
+          std::array<int32_t, 4> corner;
+          Vec3 centre;
+          const bool split = whole(poly, band(a, side_a), &corner, &centre);
+          add(a, true, std::move(poly), boundary_patch, split, corner, centre);
+        }
+    for (int b : cb)
+      for (const Band& g : ga)
+        if (auto poly = band_polygon(pp, band(b, side_b), g); !poly.empty()) {
+          std::array<int32_t, 4> corner;
+          Vec3 centre;
+          const bool split = whole(poly, band(b, side_b), &corner, &centre);
+          add(b, false, std::move(poly), boundary_patch, split, corner, centre);
+        }
+  }
+
+  // Top {0, 2, 3, 1} and bottom {4, 5, 7, 6} faces (outward), every station of their edges named.
+  // A face with stations besides its 4 corners (edges crossed on a fault) is split into the triangles
+  // from its centre (the mean of its 4 corners) to each of its edges: the surface is then the 4-triangle
+  // fan of the plain quad whatever the stations (the mesh's fan of a polygon turns about the mean of
+  // all its nodes, which moves with them: on a thin twisted cell the top and bottom fans then crossed
+  // and the volume came out negative).
+  void top_bottom_faces(int c, int32_t boundary_patch, std::vector<CellFace>& faces) {
+    struct Edge {
+      int side;
+      bool forward;  // s from 0 to 1
+    };
+    static const Edge kTop[4] = {{0, true}, {3, true}, {1, false}, {2, false}};
+    static const Edge kBottom[4] = {{2, true}, {1, true}, {3, false}, {0, false}};
+    const int i = c % m_.nx, j = (c / m_.nx) % m_.ny;
+    const std::vector<int> col = column_cells(i, j);
+    const auto at = std::find(col.begin(), col.end(), c);
+    for (bool bottom : {false, true}) {
+      std::vector<int32_t> cyc;
+      for (const Edge& e : bottom ? kBottom : kTop) {
+        const PillarPair& pp = pairs_[side_pair(c, e.side)];
+        const auto& st = pp.stations[line_id(c, e.side, bottom)];
+        if (e.forward)
+          for (size_t k = 1; k < st.size(); ++k) cyc.push_back(st[k].node);
+        else
+          for (size_t k = st.size() - 1; k-- > 0;) cyc.push_back(st[k].node);
+      }
+      std::vector<int32_t> face;
+      for (int32_t v : cyc)
+        if (face.empty() || face.back() != v) face.push_back(v);
+      while (face.size() > 1 && face.back() == face.front()) face.pop_back();
+      if (face.size() < 3) continue;
+      // Interior when the next meshed cell of the column above (below) has this face's corners.
+      int32_t patch = boundary_patch;
+      const bool has_next = bottom ? (at + 1 != col.end()) : (at != col.begin());
+      if (has_next) {
+        const int o = bottom ? *(at + 1) : *(at - 1);
+        bool same = true;
+        for (int q = 0; q < 4; ++q)
+          same = same && corner_depth(m_, c, q + (bottom ? 4 : 0)) == corner_depth(m_, o, q + (bottom ? 0 : 4));
+        if (same) patch = kInteriorFace;
+      }
+      if (face.size() == 4) {
+        faces.push_back(CellFace{std::move(face), patch});
+        continue;
+      }
+      static const int kQuad[2][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}};
+      std::array<int32_t, 4> corner;
+      Vec3 centre{0, 0, 0};
+      for (int e = 0; e < 4; ++e) {
+        const int q = kQuad[bottom][e];
+        corner[e] = pillar_node(pillar_of(c, q), corner_depth(m_, c, q));
+        centre += corner_point(c, q);
+      }
+      split_face(face, corner, centre / 4.0, patch, faces);
+    }
+  }
+
+  // A cell face (4 corners) whose cycle has more nodes than its corners, as the triangles from its
+  // centre (one node per face, found by its corners) to each of its edges.
+  void split_face(const std::vector<int32_t>& cycle, std::array<int32_t, 4> corner, Vec3 centre, int32_t patch,
+                  std::vector<CellFace>& faces) {
+    std::sort(corner.begin(), corner.end());
+    auto [it, added] = face_centre_.emplace(corner, -1);
+    if (added) it->second = b_.add_node(centre);
+    for (size_t e = 0; e < cycle.size(); ++e)
+      faces.push_back(CellFace{{it->second, cycle[e], cycle[(e + 1) % cycle.size()]}, patch});
+  }
+};
+
+}  // namespace
+
+CornerPointCells add_corner_point_cells(const CornerPointModel& model, const ReservoirSpec& rock,
+                                        const std::vector<char>& active, MeshBuilder& builder, int32_t boundary_patch) {
+  CornerPointMesher mesher(model, active, builder);
+  return mesher.add_cells(rock, boundary_patch);
+}
+
+}  // namespace hm
