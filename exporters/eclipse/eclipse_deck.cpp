@@ -211,17 +211,17 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
                        " days) needs a run beyond flow's calendar: the deck ends at 130000 days");
     end_days = 130000;
   }
-  if (conn.negative_faces > 0)
+  if (conn.negative_faces > 0 && !L.corner_point)
     warnings.push_back(std::to_string(conn.negative_faces) +
                        " interior faces have a negative or non-finite transmissibility (written as computed)");
-  if (conn.below_flow_threshold > 0) {
+  if (conn.below_flow_threshold > 0 && !L.corner_point) {
     std::ostringstream w;
     w << conn.below_flow_threshold << " NNC records have T < " << kFlowNncThreshold
       << " cP.rm3/day/bar, which OPM Flow ignores (sum " << conn.below_flow_threshold_sum << " of a total "
       << conn.total << ")";
     warnings.push_back(w.str());
   }
-  if (conn.zero_faces > 0)
+  if (conn.zero_faces > 0 && !L.corner_point)
     warnings.push_back(std::to_string(conn.zero_faces) + " interior faces have a zero transmissibility (no connection)");
 
   const size_t nd = static_cast<size_t>(L.n_deck_cells());
@@ -239,11 +239,15 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
         << L.deck_nx << " (thin boxes at their FV-centre depth, on every other I and J)";
     o << ".\n\n";
     if (L.corner_point) {
-      o << "-- The model's own corner-point geometry; every transmissibility below is HybridMesh's: the\n"
-        << "-- multipliers 0 remove flow's geometric ones (fault connections included), EDIT and NNC give ours.\n";
+      o << "-- The model's own corner-point geometry (COORD/ZCORN as OPM read them). flow computes the\n"
+        << "-- connections between the model's cells itself, fault NNCs included, with OPM's multipliers\n"
+        << "-- of the model (MULTX..MULTZ-, FAULTS/MULTFLT folded in, as TransMult gives them).\n";
       write_model_geometry(o, *cs.reservoir.corner_point);
-      o << "MULTX\n" << static_cast<long long>(nd) << "*0 /\nMULTY\n" << static_cast<long long>(nd) << "*0 /\nMULTZ\n"
-        << static_cast<long long>(nd) << "*0 /\n\n";
+      static const char* kMult[6] = {"MULTX", "MULTX-", "MULTY", "MULTY-", "MULTZ", "MULTZ-"};
+      for (int d = 0; d < 6; ++d) {
+        const std::vector<double>& v = cs.reservoir.corner_point->trans_mult[d];
+        if (std::any_of(v.begin(), v.end(), [](double x) { return x != 1.0; })) o.eclipse_array(kMult[d], v);
+      }
     } else {
       write_coord(o, L.pillar_x, L.pillar_y, L.pillar_top, L.pillar_bottom);
       write_zcorn(o, L.deck_nx, L.ny, L.nz, L.top, L.bottom);
@@ -274,7 +278,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     TextOut o;
     o << "-- Non-neighbour connections (I1 J1 K1 I2 J2 K2 T), T in cP.rm3/day/bar, from HybridMesh's\n"
       << "-- two-point transmissibilities (faces joining the same two cells summed).\n";
-    if (!conn.nnc.empty()) {
+    if (!conn.nnc.empty() && !L.corner_point) {
       o << "NNC\n";
       for (const auto& r : conn.nnc) {
         const auto a = L.deck_ijk(r.a), b = L.deck_ijk(r.b);
@@ -289,7 +293,9 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   // ---- EDIT include: pore volumes and transmissibilities replace flow's geometric ones.
   std::string edit_text;
   int tran_connections = 0;
-  {
+  if (L.corner_point) {
+    edit_text = "-- A corner-point model's cells: flow's own pore volumes and transmissibilities (GRID include).\n";
+  } else {
     TextOut o;
     std::vector<double> porv(nd, 0.0);
     for (int c = 0; c < nc; ++c) porv[L.cell_deck_index[c]] = geo.cell_volume[c] * mesh.cell_porosity[c];
@@ -401,8 +407,9 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
         << "-- The run is the case's transient from its initial pressure to the steady state, "
         << end_days << " days = " << kAsTypedRelaxationTimes << " x the\n"
         << "-- estimated relaxation time " << relaxation << " days (docs/export-eclipse.md).\n"
-        << "-- Re-open any well flow shut because it could not flow at its BHP, as soon as it can:\n"
-        << "WTEST\n'*' 0.01 'P' /\n/\n\n"
+        << (n_wells > 0 ? "-- Re-open any well flow shut because it could not flow at its BHP, as soon as it can:\n"
+                          "WTEST\n'*' 0.01 'P' /\n/\n\n"
+                        : "-- No wells (flow refuses WTEST '*' matching none).\n")
         << "TSTEP\n" << first_step << ' ' << end_days - first_step << " /\n\nEND\n";
     }
     data_text = std::move(o.text);
@@ -425,7 +432,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     info->data_file = (out / (name + ".DATA")).string();
     info->files = files.paths();
     info->layout = std::move(L);
-    info->nnc = static_cast<int>(conn.nnc.size());
+    info->nnc = L.corner_point ? 0 : static_cast<int>(conn.nnc.size());
     info->tran_connections = tran_connections;
     info->well_connections = wells;
     info->warnings = warnings;

@@ -4,7 +4,9 @@
 #include <opm/input/eclipse/EclipseState/EclipseState.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/EclipseGrid.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/FieldPropsManager.hpp>
+#include <opm/input/eclipse/EclipseState/Grid/FaceDir.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/MapAxes.hpp>
+#include <opm/input/eclipse/EclipseState/Grid/TransMult.hpp>
 #include <opm/input/eclipse/Parser/ErrorGuard.hpp>
 #include <opm/input/eclipse/Parser/ParseContext.hpp>
 #include <opm/input/eclipse/Parser/Parser.hpp>
@@ -84,6 +86,13 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
     m.zcorn = grid.getZCORN();
     m.opm_volume.resize(n);
     for (size_t c = 0; c < n; ++c) m.opm_volume[c] = grid.getCellVolume(c);
+    const Opm::TransMult& mult = state.getTransMult();
+    const Opm::FaceDir::DirEnum dirs[6] = {Opm::FaceDir::XPlus, Opm::FaceDir::XMinus, Opm::FaceDir::YPlus,
+                                           Opm::FaceDir::YMinus, Opm::FaceDir::ZPlus, Opm::FaceDir::ZMinus};
+    for (int d = 0; d < 6; ++d) {
+      m.trans_mult[d].resize(n);
+      for (size_t c = 0; c < n; ++c) m.trans_mult[d][c] = mult.getMultiplier(c, dirs[d]);
+    }
     if (m.coord.size() != 6 * size_t(m.nx + 1) * (m.ny + 1) || m.zcorn.size() != 8 * n)
       throw InputError(key + ": the grid is not given as COORD/ZCORN (or SPECGRID does not match them)");
     const Opm::FieldPropsManager& fp = state.fieldProps();

@@ -28,6 +28,9 @@ struct CornerPointModel {
   /// `zcorn_index`). The mesh's model cells and the exported deck's COORD/ZCORN come from these.
   std::vector<double> coord, zcorn;
   std::vector<double> opm_volume;              ///< EclipseGrid::getCellVolume per cell (m3), for comparisons
+  /// OPM's transmissibility multipliers per cell and face direction (TransMult::getMultiplier: MULTX,
+  /// MULTX-, ..., MULTZ with FAULTS/MULTFLT folded in), in the order +x, -x, +y, -y, +z, -z.
+  std::array<std::vector<double>, 6> trans_mult;
   bool has_mapaxes = false;
   /// MAPAXES as OPM applies it: the map (world) position of grid point (0, 0) and of the
   /// unit grid x and y directions (origin, unit_x, unit_y), for has_mapaxes.

@@ -7,8 +7,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
+#include "../exporters/flow_test_support.hpp"
+#include "exporters/eclipse/eclipse_deck.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
@@ -455,4 +458,58 @@ TEST(CornerPoint, ReekMeshesAsItsCells) {
               above_0p1_percent);
   EXPECT_NEAR(mesh_volume / opm_volume, 1.0, 1e-5);
   EXPECT_LT(worst, 0.02);
+}
+
+// The exported deck is the model: OPM Flow reads the model's COORD/ZCORN and computes its own
+// connections (fault NNCs included). Every cell pair flow connects is a pair of mesh cells sharing a
+// face, and every face-sharing pair is connected by flow except across a layer of zero thickness,
+// which OPM connects only with PINCH (the mesh's cells touch there).
+TEST(CornerPoint, FlowConnectsExactlyTheCellsTheMeshJoins) {
+  REQUIRE_FLOW();
+  TempDir tmp;
+  CpgRun r = mesh_of(tmp, SyntheticCpg{}.text());
+  const fs::path deck = tmp.path / "deck";
+  const Transmissibilities trans = compute_transmissibilities(r.out.mesh, r.out.geometry);
+  EclipseDeckInfo info;
+  ASSERT_TRUE(write_eclipse_deck(deck.string(), r.cs, r.out.mesh, r.out.geometry, trans, {}, &info).ok);
+  const std::string grid = hmtest::read_text(deck / "CPG_GRID.INC");
+  EXPECT_NE(grid.find("ZCORN"), std::string::npos);
+  const hmtest::FlowRun run = hmtest::run_flow(deck, "CPG");
+  ASSERT_EQ(run.flow.exit_code, 0) << run.flow.output.substr(0, 2000);
+  ASSERT_FALSE(run.results.is_null());
+  const CornerPointModel& m = *r.cs.reservoir.corner_point;
+  const int nx = m.nx, nxy = m.nx * m.ny;
+  std::set<std::pair<int, int>> mesh_pairs, flow_pairs;
+  for (int f = 0; f < r.out.mesh.n_faces(); ++f)
+    if (r.out.mesh.face_neighbour[f] >= 0) {
+      const int a = r.out.reservoir_cell_of[r.out.mesh.face_owner[f]], b = r.out.reservoir_cell_of[r.out.mesh.face_neighbour[f]];
+      mesh_pairs.insert({std::min(a, b), std::max(a, b)});
+    }
+  std::vector<int> active;
+  for (size_t c = 0; c < info.layout.deck_cell.size(); ++c)
+    if (info.layout.deck_cell[c] >= 0) active.push_back(static_cast<int>(c));
+  const auto& init = run.results["init"];
+  const char* keys[3] = {"tranx", "trany", "tranz"};
+  const int step[3] = {1, nx, nxy};
+  for (int d = 0; d < 3; ++d) {
+    ASSERT_EQ(init[keys[d]].size(), active.size());
+    for (size_t a = 0; a < active.size(); ++a)
+      if (init[keys[d]][a].get<double>() > 0) flow_pairs.insert({active[a], active[a] + step[d]});
+  }
+  for (size_t k = 0; k < init["trannnc"].size(); ++k)
+    if (init["trannnc"][k].get<double>() > 0) {
+      const int a = init["nnc1"][k].get<int>() - 1, b = init["nnc2"][k].get<int>() - 1;
+      flow_pairs.insert({std::min(a, b), std::max(a, b)});
+    }
+  int across_pinch = 0;
+  for (const auto& p : mesh_pairs) {
+    if (flow_pairs.count(p)) continue;
+    // Not connected by flow: only across the zero-thickness layer 1 (k 0 and 2 of one column).
+    EXPECT_EQ(p.second - p.first, 2 * nxy) << p.first << " " << p.second;
+    ++across_pinch;
+  }
+  for (const auto& p : flow_pairs) EXPECT_TRUE(mesh_pairs.count(p)) << "flow connects " << p.first << " " << p.second;
+  std::printf("[ figures  ] flow connects %zu cell pairs, the mesh %zu (%d across the pinched-out layer)\n",
+              flow_pairs.size(), mesh_pairs.size(), across_pinch);
+  EXPECT_GT(flow_pairs.size(), 200u);
 }
