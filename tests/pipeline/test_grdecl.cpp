@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -219,6 +220,7 @@ struct SyntheticCpg {
   double throw0 = 8, throw1 = 12;
   double dx = 100, dy = 80;
   bool inactive_cell = true;
+  bool vertical_pillars = false;  // parallel vertical pillars: every column face is planar
 
   double pillar_x(int I) const { return dx * I; }
   double pillar_y(int J) const { return dy * J; }
@@ -237,7 +239,8 @@ struct SyntheticCpg {
     for (int J = 0; J <= ny; ++J)
       for (int I = 0; I <= nx; ++I) {
         const double x = pillar_x(I), y = pillar_y(J);
-        o << num(x) << " " << num(y) << " 1400 " << num(x + 6 + 0.01 * x) << " " << num(y + 3 - 0.005 * y) << " 1700\n";
+        const double bx = vertical_pillars ? x : x + 6 + 0.01 * x, by = vertical_pillars ? y : y + 3 - 0.005 * y;
+        o << num(x) << " " << num(y) << " 1400 " << num(bx) << " " << num(by) << " 1700\n";
       }
     o << "/\nZCORN\n";
     for (int k = 0; k < nz; ++k)
@@ -372,6 +375,93 @@ TEST(CornerPoint, ConstantThrowHasNoCrossingsGrowingThrowHas) {
   b2.finish(&rep2);
   EXPECT_TRUE(rep1.ok);
   EXPECT_TRUE(rep2.ok);
+}
+
+namespace {
+
+using Pt = std::array<double, 2>;
+
+double polygon_area(const std::vector<Pt>& p) {
+  double a = 0;
+  for (size_t i = 0; i < p.size(); ++i) a += p[i][0] * p[(i + 1) % p.size()][1] - p[i][1] * p[(i + 1) % p.size()][0];
+  return 0.5 * a;
+}
+
+// Sutherland-Hodgman: convex polygon p clipped by convex counter-clockwise polygon q.
+std::vector<Pt> clip(std::vector<Pt> p, const std::vector<Pt>& q) {
+  for (size_t e = 0; e < q.size() && !p.empty(); ++e) {
+    const Pt a = q[e], b = q[(e + 1) % q.size()];
+    auto side = [&](const Pt& x) { return (b[0] - a[0]) * (x[1] - a[1]) - (b[1] - a[1]) * (x[0] - a[0]); };
+    std::vector<Pt> out;
+    for (size_t i = 0; i < p.size(); ++i) {
+      const Pt u = p[i], v = p[(i + 1) % p.size()];
+      const double su = side(u), sv = side(v);
+      if (su >= 0) out.push_back(u);
+      if ((su >= 0) != (sv >= 0)) {
+        const double t = su / (su - sv);
+        out.push_back({u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1])});
+      }
+    }
+    p = std::move(out);
+  }
+  return p;
+}
+
+}  // namespace
+
+// With vertical pillars the faces on the fault plane are planar quads in (y, z): the mesh's faces
+// between two cells of the two sides have, together, exactly the area of the two quads' intersection
+// computed independently (polygon clipping), and a pair shares faces exactly when that area is > 0.
+TEST(CornerPoint, FaultFacesAreTheOverlapsOfTheTwoCellsFaces) {
+  TempDir tmp;
+  SyntheticCpg g;
+  g.vertical_pillars = true;
+  g.throw0 = 3;  // throws of 3..17 m along the fault: edges of the two sides cross on it
+  g.throw1 = 17;
+  const CpgRun r = mesh_of(tmp, g.text());
+  const CornerPointModel& m = *r.cs.reservoir.corner_point;
+  std::map<std::pair<int, int>, double> mesh_area;
+  for (int f = 0; f < r.out.mesh.n_faces(); ++f) {
+    if (r.out.mesh.face_neighbour[f] < 0) continue;
+    int a = r.out.reservoir_cell_of[r.out.mesh.face_owner[f]], b = r.out.reservoir_cell_of[r.out.mesh.face_neighbour[f]];
+    if (a % m.nx == g.fault_i) std::swap(a, b);  // a on the -i side
+    if (a % m.nx == g.fault_i - 1 && b % m.nx == g.fault_i) mesh_area[{a, b}] += norm(r.out.geometry.face_area[f]);
+  }
+  // A cell's face on the plane x = fault_i * dx, counter-clockwise in (y, z).
+  auto quad = [&](int c, bool plus_i) {
+    const int j = (c / m.nx) % m.ny;
+    const double y0 = g.pillar_y(j), y1 = g.pillar_y(j + 1);
+    const int o = plus_i ? 1 : 0;
+    std::vector<Pt> q{{y0, corner_depth(m, c, o)}, {y1, corner_depth(m, c, o + 2)}, {y1, corner_depth(m, c, o + 6)}, {y0, corner_depth(m, c, o + 4)}};
+    if (polygon_area(q) < 0) std::reverse(q.begin(), q.end());
+    return q;
+  };
+  auto meshed = [&](int c) { return m.actnum[c] && corner_depth(m, c, 0) + corner_depth(m, c, 1) + corner_depth(m, c, 2) + corner_depth(m, c, 3) <
+                                                       corner_depth(m, c, 4) + corner_depth(m, c, 5) + corner_depth(m, c, 6) + corner_depth(m, c, 7); };
+  int pairs = 0, crossing_pairs = 0;
+  double worst = 0;
+  for (int j = 0; j < m.ny; ++j)
+    for (int ka = 0; ka < m.nz; ++ka)
+      for (int kb = 0; kb < m.nz; ++kb) {
+        const int a = g.fault_i - 1 + m.nx * (j + m.ny * ka), b = g.fault_i + m.nx * (j + m.ny * kb);
+        if (!meshed(a) || !meshed(b)) continue;
+        const double want = std::abs(polygon_area(clip(quad(a, true), quad(b, false))));
+        const auto it = mesh_area.find({a, b});
+        const double got = it == mesh_area.end() ? 0.0 : it->second;
+        if (want < 1e-9 * 400) {
+          EXPECT_EQ(got, 0.0) << "cells " << a << ", " << b << " share " << got << " m2, the overlap is " << want;
+          continue;
+        }
+        ++pairs;
+        crossing_pairs += clip(quad(a, true), quad(b, false)).size() > 4;
+        ASSERT_GT(got, 0) << "cells " << a << " and " << b << " overlap by " << want << " m2 but share no face";
+        worst = std::max(worst, std::abs(got / want - 1));
+      }
+  std::printf("[ figures  ] %d overlapping pairs across the fault (%d with more than 4 vertices), worst area %.2e\n",
+              pairs, crossing_pairs, worst);
+  EXPECT_GT(pairs, 20);
+  EXPECT_GT(crossing_pairs, 0);
+  EXPECT_LT(worst, 1e-9);
 }
 
 // The mesh does not depend on where the model sits: moved by UTM-sized offsets, the same cells
