@@ -91,7 +91,8 @@ class CornerPointMesher {
   std::vector<std::vector<double>> pillar_depth_;
   std::vector<std::vector<int32_t>> pillar_node_;
   std::vector<PillarPair> pairs_;
-  std::map<std::array<int32_t, 4>, int32_t> face_centre_;  // centre node of a split top/bottom face, by its corners
+  std::map<std::array<int32_t, 4>, int32_t> face_centre_;
+  std::vector<Band> band_;  // per cell and side (4 c + side): its top and bottom line on that pillar pair  // centre node of a split top/bottom face, by its corners
 
   // The face cycles above are outward when (i, j, depth) is a right-handed frame, i.e. when the
   // columns turn counter-clockwise in plan from +i to +j (x east, y north with j). Many models number
@@ -157,6 +158,10 @@ class CornerPointMesher {
     return {kCorners[side][0], kCorners[side][1]};
   }
   int line_id(int c, int side, bool bottom) const {
+    const Band& b = band_[4 * size_t(c) + side];
+    return bottom ? b.bottom : b.top;
+  }
+  int find_line_id(int c, int side, bool bottom) const {
     const auto q = side_corners(side);
     const int off = bottom ? 4 : 0;
     const PillarPair& pp = pairs_[side_pair(c, side)];
@@ -182,6 +187,10 @@ class CornerPointMesher {
       }
     }
     for (PillarPair& pp : pairs_) make_stations(pp);
+    band_.assign(4 * meshed_.size(), Band{kAbove, kBelow});
+    for (int c = 0; c < static_cast<int>(meshed_.size()); ++c)
+      if (meshed_[c])
+        for (int side = 0; side < 4; ++side) band_[4 * size_t(c) + side] = {find_line_id(c, side, false), find_line_id(c, side, true)};
   }
 
   // Crossings: two lines whose order on the two pillars is strictly opposite (exact comparisons of

@@ -1,6 +1,7 @@
 // The job for a true corner-point model (reservoir.grdecl that is not a box grid): the model's
 // active cells as the mesh's reservoir cells (meshgen/grids/corner_point_grid.hpp), checked like
 // every mesh. Near-well meshing in such a model is not built yet: a case with wells is refused.
+#include <chrono>
 #include <string>
 
 #include "hybrid_mesh.hpp"
@@ -16,7 +17,11 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
                      "are meshed, but wells in a corner-point model are not meshed yet (docs/case-format.md, grdecl); "
                      "give the case without wells, or a model whose cells are axis-aligned boxes");
   HybridMesh out;
+  auto last = std::chrono::steady_clock::now();
   const auto stage = [&](const std::string& s) {
+    const auto now = std::chrono::steady_clock::now();
+    out.timings_s.push_back({s, std::chrono::duration<double>(now - last).count()});
+    last = now;
     if (opts.on_stage) opts.on_stage(s);
   };
   out.grid = make_reservoir_grid(cs.reservoir);  // index arithmetic only (nx, ny, nz)
@@ -34,6 +39,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
     out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
   }
   out.geometry = compute_geometry(out.mesh);
+  stage("assembly_geometry");
   if (cells.zero_volume_cells > 0)
     out.notes.push_back("reservoir: " + std::to_string(cells.zero_volume_cells) +
                         " active cells of zero thickness on all their pillars are not meshed (OPM Flow drops them: pore "
