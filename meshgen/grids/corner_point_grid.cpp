@@ -12,11 +12,11 @@ namespace {
 // A pillar pair (the two pillars a column face lies on) seen as the strip s in [0, 1] (s = 0 on its
 // first pillar) x depth z. Every cell face on it is the band between the cell's top line and its
 // bottom line, each line the straight edge between the cell's corner depths on the two pillars,
-// identified by those two exact ZCORN values. A point (s, z) of the strip is the point at parameter
-// s between the two pillars' points at depth z. Two lines of the two sides of a fault that cross
-// inside the strip meet at a crossing node; every node lying on a line (its two pillar ends and its
-// crossings) is a station of it, and every face edge along the line names all the stations it
-// passes (no hanging node).
+// identified by those two exact ZCORN values. Two lines of the two sides of a fault that cross
+// inside the strip (their order on the two pillars is opposite) meet at a crossing node, placed
+// where the two straight edges reach the same depth; every node lying on a line (its two pillar
+// ends and its crossings) is a station of it, and every face edge along the line names all the
+// stations it passes (no hanging node).
 constexpr int kAbove = -1;  // the line z = -infinity (a gap band above a column's first cell)
 constexpr int kBelow = -2;  // z = +infinity
 
