@@ -5,6 +5,7 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "transition_internal.hpp"
 
@@ -252,6 +253,89 @@ std::string site_label(const SiteSet& set, int s, const Cavity& cavity, const st
   return (site.kind == SiteKind::ExternalMirror ? "mirror-" : "") + side + (at_min ? "@min" : "");
 }
 
+// Wall columns under an outer-boundary plane (docs/transition.md, "Wall columns"). Two sites of
+// wall polygons stacked along a plane's axis, at heights t_1 (nearer the plane) and t_2 off their
+// wall, compare on the plane at distance x from the wall as pow_2 - pow_1 = -2 x (t_2 - t_1) +
+// (d_2^2 - d_1^2) (d: depths below the plane): with t_2 > t_1 the deeper cell wins the plane far
+// from the wall, its site projecting outside its boundary face there. The height off the wall
+// of every site down a column is held to the smallest one above it (a polygon site is lowered and
+// capped, a box split): the deeper sites then never take the plane from the shallower ones.
+// Returns the number of sites changed.
+int align_wall_columns(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                       const std::vector<PolygonFrame>& frames) {
+  if (cavity.mirrors.empty()) return 0;
+  struct Rect {
+    Vec3 lo, hi;
+  };
+  const int nq = static_cast<int>(cavity.faces.size());
+  std::vector<Rect> rect(nq);
+  std::vector<int> flat(nq, -1);
+  for (int q = 0; q < nq; ++q) {
+    const ConstrainedFace& f = cavity.faces[q];
+    if (f.side != FaceSide::Reservoir || f.nodes.empty()) continue;
+    Rect r{coords[f.nodes[0]], coords[f.nodes[0]]};
+    for (int32_t v : f.nodes)
+      for (int k = 0; k < 3; ++k) r.lo[k] = std::min(r.lo[k], coords[v][k]), r.hi[k] = std::max(r.hi[k], coords[v][k]);
+    rect[q] = r;
+    for (int k = 0; k < 3; ++k)
+      if (r.lo[k] == r.hi[k]) flat[q] = k;
+  }
+  // Height of polygon q's internal site off its wall (a box site: its centre's distance).
+  auto height = [&](int q) {
+    const int s = set.internal_of[q];
+    return dot(set.sites[s].p - frames[q].center, frames[q].normal);
+  };
+  int changed = 0;
+  for (const MirrorPlane& m : cavity.mirrors) {
+    const int a = m.axis;
+    // Wall polygons of this plane (normal across its axis), keyed by their wall, their extent
+    // across the column and the end of their extent along the axis that faces the plane.
+    using Key = std::tuple<int, int, double, double, double, double>;
+    std::map<Key, int> by_near_end;
+    auto key = [&](int q, double end) {
+      const int k = flat[q], b = 3 - a - k;
+      return Key{k, frames[q].normal[k] > 0 ? 1 : -1, rect[q].lo[k], rect[q].lo[b], rect[q].hi[b], end};
+    };
+    const bool plane_above = [&] {  // the plane bounds the cavity from above along its axis
+      for (const ConstrainedFace& f : cavity.faces)  // the polygons: cavity.vertices holds the images too
+        for (int32_t v : f.nodes)
+          if (coords[v][a] > m.value) return false;
+      return true;
+    }();
+    auto near_end = [&](int q) { return plane_above ? rect[q].hi[a] : rect[q].lo[a]; };
+    auto far_end = [&](int q) { return plane_above ? rect[q].lo[a] : rect[q].hi[a]; };
+    std::vector<int> tops;
+    for (int q = 0; q < nq; ++q) {
+      if (flat[q] < 0 || flat[q] == a || set.internal_of[q] < 0) continue;
+      by_near_end[key(q, near_end(q))] = q;
+      if (near_end(q) == m.value) tops.push_back(q);
+    }
+    for (int q : tops) {
+      double lowest = height(q);
+      for (auto it = by_near_end.find(key(q, far_end(q))); it != by_near_end.end();
+           it = by_near_end.find(key(it->second, far_end(it->second)))) {
+        const int below = it->second, s = set.internal_of[below];
+        Site& site = set.sites[s];
+        const double h = height(below);
+        if (h > lowest * (1 + 1e-12)) {
+          if (site.kind == SiteKind::InternalPolygon) {
+            const double t = std::max(lowest, min_t(frames, below));
+            site.t_cap = std::min(site.t_cap, t);
+            place_polygon_site(set, s, t, cavity, coords, frames);
+          } else if (site.kind == SiteKind::InternalBox) {
+            split_box(set, s, cavity, coords, frames);
+          }
+          ++changed;
+        }
+        if (set.sites[set.internal_of[below]].kind == SiteKind::InternalBox && !set.sites[set.internal_of[below]].alive)
+          break;  // split: its polygon sites are placed, the next round walks on
+        lowest = std::min(lowest, height(below));
+      }
+    }
+  }
+  return changed;
+}
+
 }  // namespace
 
 PolygonFrame fit_polygon(const std::vector<int32_t>& nodes, const std::vector<Vec3>& coords) {
@@ -462,6 +546,8 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
   std::map<std::string, int> pair_kinds;  // at the last iteration: "large > small" site labels
   std::vector<int> shrunk_at(set.sites.size(), -1000);
   constexpr int kNoGrowAfterShrink = 3;
+  int column_rounds = 0;
+  constexpr int kMaxColumnRounds = 8;
   for (int it = 1; it <= max_iterations; ++it) {
     *iterations = it;
     // A pair is examined when |Pi Pj|^2 <= max(wi^2, wj^2): each site looks for the others
@@ -517,7 +603,14 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
     }
     corrections += n;
     left = n;
-    if (n == 0) return corrections;
+    if (n == 0) {
+      // Converged: hold the wall columns under boundary planes, and correct again if that moved
+      // a site (a bounded number of times; the self-check judges the mesh either way).
+      if (column_rounds++ == kMaxColumnRounds || align_wall_columns(set, cavity, coords, frames) == 0) return corrections;
+      enforce_empty_spheres(set, cavity, coords, grid, frames);
+      shrunk_at.resize(set.sites.size(), -1000);
+      continue;
+    }
     if (it == max_iterations) {
       stuck.assign(fix.size(), 0);
       for (size_t s = 0; s < fix.size(); ++s) stuck[s] = fix[s] || grow[s] || involved[s];
