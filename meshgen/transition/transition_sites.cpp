@@ -25,6 +25,9 @@ constexpr double kMinT = 1e-3;
 // segment: the mirror image of the ring cell's FV centre, which lies half a segment behind the
 // face (docs/transition.md "Tip sites").
 constexpr double kEndFaceHeight = 0.5;
+// Relative slack of the wall-column rule (align_wall_columns): a site placed at a height is read
+// back through its position, rounded; only a height above this is lowered again.
+constexpr double kColumnSlack = 1e-12;
 
 double shrunk(double t, double alpha, double radius) { return std::max(alpha * t, std::min(t, kMinT * radius)); }
 
@@ -259,8 +262,8 @@ std::string site_label(const SiteSet& set, int s, const Cavity& cavity, const st
 // (d_2^2 - d_1^2) (d: depths below the plane): with t_2 > t_1 the deeper cell wins the plane far
 // from the wall, its site projecting outside its boundary face there. The height off the wall
 // of every site down a column is held to the smallest one above it (a polygon site is lowered and
-// capped, a box split): the deeper sites then never take the plane from the shallower ones.
-// Returns the number of sites changed.
+// capped, a box split, its new sites held at the next round): the deeper sites then never take
+// the plane from the shallower ones. Returns the number of sites changed.
 int align_wall_columns(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                        const std::vector<PolygonFrame>& frames) {
   if (cavity.mirrors.empty()) return 0;
@@ -317,7 +320,7 @@ int align_wall_columns(SiteSet& set, const Cavity& cavity, const std::vector<Vec
         const int below = it->second, s = set.internal_of[below];
         Site& site = set.sites[s];
         const double h = height(below);
-        if (h > lowest * (1 + 1e-12)) {
+        if (h > lowest * (1 + kColumnSlack)) {
           if (site.kind == SiteKind::InternalPolygon) {
             const double t = std::max(lowest, min_t(frames, below));
             site.t_cap = std::min(site.t_cap, t);
@@ -327,8 +330,7 @@ int align_wall_columns(SiteSet& set, const Cavity& cavity, const std::vector<Vec
           }
           ++changed;
         }
-        if (set.sites[set.internal_of[below]].kind == SiteKind::InternalBox && !set.sites[set.internal_of[below]].alive)
-          break;  // split: its polygon sites are placed, the next round walks on
+        // A split box's polygon sites start at their initial heights: the next round holds them.
         lowest = std::min(lowest, height(below));
       }
     }
