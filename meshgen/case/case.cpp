@@ -198,8 +198,9 @@ class Fields {
       if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return name == a; }) == allowed.end()) {
         std::string expected;
         for (const char* a : allowed) expected += (expected.empty() ? "" : ", ") + std::string(a);
-        // An empty key ("": or a bare colon) is named as "" so that the message keeps its key part.
-        fail(key_path(path, name.empty() ? std::string("\"\"") : printable(name)),
+        // A key that is not a plain name (empty, or holding ": " or control bytes) is quoted, so that the
+        // message still reads 'key.path: reason'.
+        fail(key_path(path, matches_name_charset(name) ? name : quoted(name)),
              "unknown key (expected one of: " + expected + ")");
       }
       for (const auto& e : entries_)

@@ -326,11 +326,14 @@ TEST(CaseErrors, MetricKey) {
   EXPECT_EQ(error_of("metric: [permeability]\n" + kBase), "metric: expected permeability or euclidean, got a list");
 }
 
-// Found by fuzz_case: an empty key name must still give "key.path: reason".
-TEST(CaseErrors, EmptyKeyIsNamed) {
+// Found by fuzz_case: a key that is not a plain name (empty, or starting with ": ") is quoted, so that the
+// message still reads "key.path: reason".
+TEST(CaseErrors, OddKeyIsQuoted) {
   EXPECT_EQ(error_of(kBase + "\"\": 1\n"),
-            "\"\": unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
-  EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  \"\": 0.2\n")).rfind("reservoir.\"\": unknown key", 0), 0u);
+            "'': unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
+  EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  \"\": 0.2\n")).rfind("reservoir.'': unknown key", 0), 0u);
+  EXPECT_EQ(error_of(kBase + "\": 1 \": 1\n"),
+            "': 1 ': unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
 }
 
 TEST(CaseErrors, DuplicateKey) {
@@ -738,7 +741,7 @@ TEST(CaseRobustness, MalformedDocumentsGiveOneLineInputErrors) {
 
 TEST(CaseRobustness, UserTextIsEchoedOnOneLine) {
   EXPECT_EQ(error_of("\"na\\nme\": a\n"),
-            "na\\nme: unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
+            "'na\\nme': unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
   EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: \"a\\tb\\x01\"")),
             "reservoir.porosity: expected a number, got 'a\\tb\\x01'");
   EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: " + std::string(100, 'q'))),
