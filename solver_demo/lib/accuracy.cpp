@@ -80,6 +80,12 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
     pb.wellbore_pressure = [&](Vec3 x) { return field.equivalent_wellbore_pressure(x); };
   const Transmissibilities tr = compute_transmissibilities(mesh, geo);
   const FlowSolution sol = solve_tpfa(pb, tr);
+  std::vector<double> residual;
+  if (samples) {
+    std::vector<double> exact_p(mesh.n_cells());
+    for (int c = 0; c < mesh.n_cells(); ++c) exact_p[c] = field.pressure(mesh.cell_fv_center[c]);
+    residual = mass_balance_residual(pb, tr, exact_p);
+  }
 
   AccuracyErrors e;
   e.cells = mesh.n_cells();
@@ -126,6 +132,9 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
       s.exact = exact;
       s.region = mesh.cell_region[c];
       s.in_slab = cp.leg == ref_leg && std::fabs(cp.t - 0.5) * ref_len <= setup.slab_half_width;
+      s.cell = c;
+      s.x = x;
+      s.residual = residual[c] / setup.exact_rate;
       samples->push_back(s);
     }
   }
