@@ -146,7 +146,7 @@ TEST(AccuracyReport, JsonAndSvgAreWritten) {
   std::ifstream csv(dir / "cells.csv");
   std::string line;
   std::getline(csv, line);
-  EXPECT_EQ(line, "cell,region,x,y,z,distance,scaled_distance,pressure,exact,error,residual");
+  EXPECT_EQ(line, "cell,region,x,y,z,distance,scaled_distance,to_end,pressure,exact,error,residual");
   int rows = 0;
   double max_error = 0;
   bool finite = true;
@@ -154,9 +154,9 @@ TEST(AccuracyReport, JsonAndSvgAreWritten) {
     std::vector<std::string> col;
     std::stringstream ls(line);
     for (std::string c; std::getline(ls, c, ',');) col.push_back(c);
-    ASSERT_EQ(col.size(), 11u) << line;
-    max_error = std::max(max_error, std::fabs(std::stod(col[9])));
-    finite = finite && std::isfinite(std::stod(col[10]));
+    ASSERT_EQ(col.size(), 12u) << line;
+    max_error = std::max(max_error, std::fabs(std::stod(col[10])));
+    finite = finite && std::isfinite(std::stod(col[11]));
     ++rows;
   }
   EXPECT_EQ(rows, st.hybrid.near_well_cells);
