@@ -6,13 +6,17 @@ and 0.01 (and kx/ky = 3 at kv/kh = 0.1 for the horizontal well), levels 1..L, on
 under `nice`, each into OUT/<M>/<case>_kvkh<R>_kxky<Q>/ (M = euclidean: today's mesh and the
 Cartesian + Peaceman model; M = permeability: the K-orthogonal mesh), then prints the markdown
 tables of the doc from the accuracy.json files. A run whose accuracy.json exists is not repeated
-(the sweep can be resumed); --table-only only tabulates what is there.
+(the sweep can be resumed); --table-only only tabulates what is there. --cells adds, per
+K-orthogonal run, where the level-1 error is: from its cells.csv, per region (well, transition,
+reservoir) and distance along the trajectory to its nearer end, the largest |error| / drawdown
+and the sum of the cells' exact-pressure residuals / exact rate (docs/anisotropy.md, session 8).
 
 Usage: accuracy_anisotropic.py [--solver BUILD/bin/solver_demo] [--out DIR] [--levels L]
                                [--metrics euclidean,permeability] [--cases vertical,deviated45,...]
-                               [--table-only] [--markdown FILE]
+                               [--table-only] [--cells] [--markdown FILE]
 """
 import argparse
+import csv
 import json
 import os
 import subprocess
@@ -70,6 +74,27 @@ def where(m):
     return "%s, %s, %.2f m" % (w["region"], side, w["distance_to_trajectory"])
 
 
+END_BINS = [("beyond the ends", None), ("0-2 m", 2.0), ("2-6 m", 6.0), ("6-12 m", 12.0), (">12 m", float("inf"))]
+
+
+def cell_table(path, title):
+    """Markdown: per region and distance to the nearer end, max |error| and sum of residuals."""
+    acc = {}
+    for r in csv.DictReader(open(path)):
+        e = float(r["to_end"])
+        b = 0 if e == 0 else next(i for i, (_, hi) in enumerate(END_BINS) if hi is not None and e < hi)
+        v = acc.setdefault((r["region"], b), [0.0, 0.0])
+        v[0] = max(v[0], abs(float(r["error"])))
+        v[1] += float(r["residual"])
+    out = ["%s: max abs error / sum of residuals" % title, "",
+           "| region | " + " | ".join(n for n, _ in END_BINS) + " |", "|---|" + "---|" * len(END_BINS)]
+    for reg in ("well", "transition", "reservoir"):
+        row = ["%.3f %% / %+.3f %%" % (100 * acc[(reg, b)][0], 100 * acc[(reg, b)][1]) if (reg, b) in acc else "-"
+               for b in range(len(END_BINS))]
+        out.append("| %s | %s |" % (reg, " | ".join(row)))
+    return "\n".join(out) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--solver", default=os.path.join(ROOT, "build", "bin", "solver_demo"))
@@ -78,6 +103,7 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--metrics", default="euclidean,permeability")
     ap.add_argument("--table-only", action="store_true")
+    ap.add_argument("--cells", action="store_true")
     ap.add_argument("--markdown", default="")
     a = ap.parse_args()
     runs = []
@@ -142,6 +168,11 @@ def main():
     text = "\n".join(lines) + "\n\n" + "\n".join(diag) + "\n"
     if failed:
         text += "\nMesh failures (no row or a '-' where they are):\n\n" + "\n".join(failed) + "\n"
+    if a.cells:
+        for case, kv, kxky in runs:
+            f = os.path.join(run_dir(a.out, "permeability", case, kv, kxky), "cells.csv")
+            if os.path.exists(f):
+                text += "\n" + cell_table(f, "%s, kv/kh %g, kx/ky %g, level 1, K-orthogonal" % (case, kv, kxky))
     print(text)
     if a.markdown:
         open(a.markdown, "w").write(text)

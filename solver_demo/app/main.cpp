@@ -165,7 +165,8 @@ int run_accuracy(const hm::CaseSpec& cs, const fs::path& out, int levels, const 
   if (const int rc = guarded([&] { st = hm::run_accuracy_study(cs, levels, opt); })) return rc;
   for (const auto& [name, status] :
        {std::pair{std::string("accuracy.json"), hm::write_accuracy_json((out / "accuracy.json").string(), st)},
-        std::pair{std::string("accuracy.svg"), hm::write_accuracy_svg((out / "accuracy.svg").string(), st)}})
+        std::pair{std::string("accuracy.svg"), hm::write_accuracy_svg((out / "accuracy.svg").string(), st)},
+        std::pair{std::string("cells.csv"), hm::write_accuracy_cells_csv((out / "cells.csv").string(), st)}})
     if (!status.ok) {
       std::cerr << "solver_demo: " << status.message << "\n";
       return 2;

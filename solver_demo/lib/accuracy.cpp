@@ -80,6 +80,12 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
     pb.wellbore_pressure = [&](Vec3 x) { return field.equivalent_wellbore_pressure(x); };
   const Transmissibilities tr = compute_transmissibilities(mesh, geo);
   const FlowSolution sol = solve_tpfa(pb, tr);
+  std::vector<double> residual;
+  if (samples) {
+    std::vector<double> exact_p(mesh.n_cells());
+    for (int c = 0; c < mesh.n_cells(); ++c) exact_p[c] = field.pressure(mesh.cell_fv_center[c]);
+    residual = mass_balance_residual(pb, tr, exact_p);
+  }
 
   AccuracyErrors e;
   e.cells = mesh.n_cells();
@@ -94,6 +100,8 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
   const std::vector<Vec3>& traj = field.polyline;
   const int ref_leg = setup.reference.leg;
   const double ref_len = norm(traj[ref_leg + 1] - traj[ref_leg]);
+  std::vector<double> leg_start(traj.size(), 0.0);  // arc length at each polyline point
+  for (size_t k = 1; k < traj.size(); ++k) leg_start[k] = leg_start[k - 1] + norm(traj[k] - traj[k - 1]);
   double sum_v = 0, sum_ve2 = 0;
   for (int c = 0; c < mesh.n_cells(); ++c) {
     if (connected.count(c)) continue;
@@ -126,6 +134,11 @@ AccuracyErrors measure_accuracy(const PolyMesh& mesh, const MeshGeometry& geo,
       s.exact = exact;
       s.region = mesh.cell_region[c];
       s.in_slab = cp.leg == ref_leg && std::fabs(cp.t - 0.5) * ref_len <= setup.slab_half_width;
+      s.cell = c;
+      s.x = x;
+      const double along = leg_start[cp.leg] + cp.t * (leg_start[cp.leg + 1] - leg_start[cp.leg]);
+      s.to_end = std::min(along, leg_start.back() - along);
+      s.residual = residual[c] / setup.exact_rate;
       samples->push_back(s);
     }
   }

@@ -74,6 +74,13 @@ struct PressureSample {
   double pressure = 0, exact = 0;
   int region = 0;
   bool in_slab = false;  ///< projects onto the reference leg within slab_half_width of its midpoint
+  int32_t cell = -1;
+  Vec3 x;                ///< FV centre
+  /// Along the source polyline from its nearer end to the closest point (m); 0 beyond the ends.
+  double to_end = 0;
+  /// Net outflow of the cell with the exact p in every cell (mass_balance_residual), relative to
+  /// the exact rate: the local consistency error the cell feeds into the solution.
+  double residual = 0;
 };
 
 /// Solves the exact-solution problem on a mesh (Dirichlet outer faces, exact p on wellbore faces
@@ -118,5 +125,9 @@ WriteStatus write_accuracy_json(const std::string& path, const AccuracyStudy& st
 /// The plot: pressure vs distance (exact curve, hybrid and Peaceman points in the reference
 /// slab) and the error / drawdown of every near-well cell vs distance.
 WriteStatus write_accuracy_svg(const std::string& path, const AccuracyStudy& study);
+/// cells.csv: one row per near-well cell of the level-1 hybrid mesh (cell, region, FV centre,
+/// distances to the trajectory and along it to its nearer end, pressure, exact, error / drawdown,
+/// exact-pressure residual / exact rate).
+WriteStatus write_accuracy_cells_csv(const std::string& path, const AccuracyStudy& study);
 
 }  // namespace hm

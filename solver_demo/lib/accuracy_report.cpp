@@ -240,4 +240,14 @@ WriteStatus write_accuracy_svg(const std::string& path, const AccuracyStudy& st)
   return write_text(path, o.str());
 }
 
+WriteStatus write_accuracy_cells_csv(const std::string& path, const AccuracyStudy& st) {
+  std::ostringstream o;
+  o << std::setprecision(10) << "cell,region,x,y,z,distance,scaled_distance,to_end,pressure,exact,error,residual\n";
+  for (const PressureSample& p : st.hybrid_samples)
+    o << p.cell << ',' << region_name(p.region) << ',' << p.x.x << ',' << p.x.y << ',' << p.x.z << ',' << p.distance
+      << ',' << p.scaled_distance << ',' << p.to_end << ',' << p.pressure << ',' << p.exact << ','
+      << (p.pressure - p.exact) / st.setup.drawdown << ',' << p.residual << '\n';
+  return write_text(path, o.str());
+}
+
 }  // namespace hm

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "fvcheck/lib/transmissibility.hpp"
@@ -140,6 +141,27 @@ TEST(AccuracyReport, JsonAndSvgAreWritten) {
   EXPECT_NE(text.find("<svg"), std::string::npos);
   EXPECT_NE(text.find("</svg>"), std::string::npos);
   EXPECT_NE(text.find("<polyline"), std::string::npos);  // the exact curve
+  // cells.csv: one row per near-well cell; its error column holds the study's maximum.
+  ASSERT_TRUE(write_accuracy_cells_csv((dir / "cells.csv").string(), st).ok);
+  std::ifstream csv(dir / "cells.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "cell,region,x,y,z,distance,scaled_distance,to_end,pressure,exact,error,residual");
+  int rows = 0;
+  double max_error = 0;
+  bool finite = true;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> col;
+    std::stringstream ls(line);
+    for (std::string c; std::getline(ls, c, ',');) col.push_back(c);
+    ASSERT_EQ(col.size(), 12u) << line;
+    max_error = std::max(max_error, std::fabs(std::stod(col[10])));
+    finite = finite && std::isfinite(std::stod(col[11]));
+    ++rows;
+  }
+  EXPECT_EQ(rows, st.hybrid.near_well_cells);
+  EXPECT_NEAR(max_error, st.hybrid.near_well_pressure_rel_error, 1e-8 * st.hybrid.near_well_pressure_rel_error);
+  EXPECT_TRUE(finite);
   // A writer reports a path it cannot write instead of throwing.
   EXPECT_FALSE(write_accuracy_json((dir / "no_such_dir" / "a.json").string(), st).ok);
   std::filesystem::remove_all(dir);
