@@ -233,3 +233,19 @@ TEST(RealisticSweep, FlatEndsWithLargeRingRatioMeshAndPassFvcheck) {
                 r.seconds);
   }
 }
+
+// The optimiser kept site moves whose rebuilt cells were not convex (full-sweep seed 1009: 2 cells,
+// 1021: 1 cell, both straight from the raw diagram's convex cells); its acceptance now refuses a
+// move that makes a cell fail a shape check of the self-check (transition_optimize.cpp,
+// shape_failures; docs/robustness.md, session 8). Seed 1009 (optimisation on, 5-13 s in Release)
+// must mesh and pass every check.
+TEST(RealisticSweep, OptimiserKeepsTheSelfCheckShapeChecks) {
+  const uint32_t seed = 1009;
+  const RealisticOptions o = sweep_options(seed);
+  ASSERT_TRUE(o.optimize);
+  const RealisticCase rc = make_realistic_case(seed, o);
+  const CaseResult r = mesh_and_check(rc);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+  std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
+              r.seconds);
+}
