@@ -220,11 +220,62 @@ struct Station {
   int bend_point = -1;  // trajectory point of the bend whose wedges it bounds, -1 on straight parts
 };
 
+// The smallest length of an end segment at a flat end that the transition can face: the end
+// annulus quad of the outer ring carries a transition site on the normal through its
+// circumcentre, (r_in + r_out) / (2 cos(pi / n)) from the axis, while the ring cell's FV centre
+// lies half the segment deep at sqrt(r_in r_out): the segment between them is at
+// atan((L / 2 + t) / offset) to the quad (t > 0, the site's height). With a large ring ratio
+// and short segments that is below fvcheck's 45 degrees whatever t the cavity allows
+// (docs/robustness.md, session 8: R 95-130 m, 10 m segments, ratio 3.3: 31 degrees). The end
+// segment is made long enough for kFlatEndAngle at t = 0; inner rings have smaller offsets
+// (the same ratio, smaller radii).
+constexpr double kFlatEndAngle = 50.0 * kPi / 180.0;
+
+double flat_end_min_segment(const std::vector<double>& radii, int sectors) {
+  const double r_in = radii[radii.size() - 2], r_out = radii.back();
+  const double offset = (r_in + r_out) / (2.0 * std::cos(kPi / sectors)) - std::sqrt(r_in * r_out);
+  return 2.0 * offset * std::tan(kFlatEndAngle);
+}
+
+// Positions (distances from the start, increasing, the last = length) of the stations that
+// split a straight part of `length` into segments of about `seg`, the first at least
+// first_min long and the last at least last_min (0: no minimum). Where the minima leave less
+// than half a segment between them, the part is split only at the end segments' boundary,
+// or not at all.
+std::vector<double> straight_stations(double length, double seg, double first_min, double last_min) {
+  if (!(length > 0)) return {};
+  const int n = std::max(1L, std::lround(length / seg));
+  const double uniform = length / n;
+  std::vector<double> out;
+  if (first_min <= uniform && last_min <= uniform) {
+    for (int j = 1; j <= n; ++j) out.push_back(j == n ? length : length * j / n);
+    return out;
+  }
+  // An end with a minimum the middle segments would not reach gets its own end segment.
+  double a = first_min > uniform ? first_min : 0.0, b = last_min > uniform ? last_min : 0.0;
+  const double middle = (length - a - b) / std::max(1L, std::lround((length - a - b) / seg));
+  if (first_min > middle) a = first_min;
+  if (last_min > middle) b = last_min;
+  const double rest = length - a - b;
+  if (rest < 0.5 * seg) {
+    // One segment if the minima overlap, or if only one end has one; else the two end segments.
+    if (a > 0 && b > 0 && rest >= 0) out.push_back(a + rest * a / (a + b));
+    out.push_back(length);
+    return out;
+  }
+  const int mid = std::max(1L, std::lround(rest / seg));
+  if (a > 0) out.push_back(a);
+  for (int j = 1; j <= mid; ++j) out.push_back(j == mid && b == 0 ? length : a + rest * j / mid);
+  if (b > 0) out.push_back(length);
+  return out;
+}
+
 // Stations along the trajectory: straight parts of each leg split into segments of about
 // segment_length, bends replaced by their wedges; with hemispherical caps, the stations of
-// hemisphere_end_grading (case.hpp) at both trajectory ends.
+// hemisphere_end_grading (case.hpp) at both trajectory ends; at a flat end facing the
+// transition, a first (last) segment at least end_min[0] (end_min[1]) long.
 std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& legs,
-                                   const std::vector<BendPlan>& plans) {
+                                   const std::vector<BendPlan>& plans, std::array<double, 2> end_min) {
   const int n_legs = static_cast<int>(legs.size());
   std::vector<const BendPlan*> plan_at(n_legs + 1, nullptr);
   for (const BendPlan& p : plans) plan_at[p.point] = &p;
@@ -247,8 +298,11 @@ std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& l
     if (!lo.empty()) s0 = s0 + lo.back() * g.d;
     if (!hi.empty()) s1 = s1 - hi.back() * g.d;
     const double straight = g.length - t0 - t1 - (lo.empty() ? 0.0 : lo.back()) - (hi.empty() ? 0.0 : hi.back());
-    const int n = straight > 0 ? std::max(1L, std::lround(straight / ws.segment_length)) : 0;
-    for (int j = 1; j <= n; ++j) st.push_back({j == n ? s1 : s0 + (static_cast<double>(j) / n) * (s1 - s0), g.d, g.u, g.v, -1});
+    const double first_min = k == 0 && lo.empty() ? end_min[0] : 0.0;
+    const double last_min = k + 1 == n_legs && hi.empty() ? end_min[1] : 0.0;
+    const std::vector<double> at = straight_stations(straight, ws.segment_length, first_min, last_min);
+    for (size_t j = 0; j < at.size(); ++j)
+      st.push_back({j + 1 == at.size() ? s1 : s0 + (at[j] / straight) * (s1 - s0), g.d, g.u, g.v, -1});
     for (int j = static_cast<int>(hi.size()) - 2; j >= -1; --j)  // hi.back() was s1
       st.push_back({j < 0 ? g.b : g.b - hi[j] * g.d, g.d, g.u, g.v, -1});
     if (k + 1 == n_legs) break;
@@ -500,7 +554,10 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
 
   const std::vector<Leg> legs = make_legs(ws, w);
   const std::vector<BendPlan> plans = plan_bends(ws, w, legs);
-  const std::vector<Station> stations = make_stations(ws, legs, plans);
+  std::array<double, 2> end_min{0.0, 0.0};
+  for (int e = 0; e < 2; ++e)
+    if (ws.end_caps == EndCaps::Flat && !block.boundary_end[e]) end_min[e] = flat_end_min_segment(block.radii, sectors);
+  const std::vector<Station> stations = make_stations(ws, legs, plans, end_min);
   const int n_layers = static_cast<int>(stations.size());
   block.layers = n_layers;
   for (const Station& st : stations) {

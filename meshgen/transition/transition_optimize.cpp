@@ -19,7 +19,9 @@
 #include <optional>
 #include <set>
 
+#include "fvcheck/lib/checks.hpp"
 #include "meshgen/core/fv_quality.hpp"
+#include "meshgen/core/geometry.hpp"
 #include "transition_internal.hpp"
 
 namespace hm::transition_detail {
@@ -102,6 +104,37 @@ std::vector<int> skewed_faces_of_cells(const PolyMesh& sub, std::vector<int>* sk
   return per_cell;
 }
 
+// The transition cells of a diagram's submesh that fail a shape check the self-check applies to
+// the written mesh (meshgen/pipeline/self_check.cpp, fvcheck's checks at their defaults):
+// convexity, the FV centre (the site) inside, orthogonality of the faces between two transition
+// cells. The faces on the cavity's polygons are the submesh's boundary and not measured here (the
+// segment ends on the cell beyond, which the submesh does not hold). The checks report the cells
+// they fail through worst_ids (at most 10); `complete` is false when a check failed more.
+struct ShapeFailures {
+  std::vector<char> cell;
+  bool complete = true;
+  int64_t count = 0;
+};
+
+ShapeFailures shape_failures(const PolyMesh& sub) {
+  ShapeFailures out;
+  out.cell.assign(sub.n_cells(), 0);
+  const MeshGeometry geo = compute_geometry(sub);
+  const CheckOptions opt;
+  for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)}) {
+    out.count += r.violations;
+    out.complete = out.complete && r.violations <= static_cast<int64_t>(r.worst_ids.size());
+    for (size_t i = 0; i < r.worst_ids.size() && static_cast<int64_t>(i) < r.violations; ++i) out.cell[r.worst_ids[i]] = 1;
+  }
+  const std::vector<double> qo = face_orthogonality(sub, geo);
+  for (int f = 0; f < sub.n_faces(); ++f)
+    if (sub.face_neighbour[f] >= 0 && qo[f] < opt.min_orthogonality_deg) {
+      out.cell[sub.face_owner[f]] = out.cell[sub.face_neighbour[f]] = 1;
+      ++out.count;
+    }
+  return out;
+}
+
 class SiteOptimizer {
  public:
   SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -126,13 +159,34 @@ class SiteOptimizer {
     std::vector<int32_t> global;
     std::vector<double> qs, max_skew;
     std::vector<int> skewed, skewed_faces;
+    ShapeFailures failing;
   };
   Measured measure(const TransitionCells& t) const {
     Measured m;
     m.sub = transition_submesh(t, coords_, &m.global);
     m.qs = cell_shape_quality(m.sub, h_ref_);
     m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
+    m.failing = shape_failures(m.sub);
     return m;
+  }
+  // The cells of `after` (a diagram of the same sites, so the same cell per site) that fail a
+  // shape check while the same site's cell in `before` did not; all of them when the failures
+  // of `after` are not all known and outnumber those of `before`.
+  static std::vector<char> new_failures(const TransitionCells& t_before, const Measured& before,
+                                        const TransitionCells& t_after, const Measured& after) {
+    std::vector<char> bad_site;
+    for (size_t c = 0; c < t_before.cell_site.size(); ++c)
+      if (before.failing.cell[c]) {
+        if (bad_site.size() <= static_cast<size_t>(t_before.cell_site[c])) bad_site.resize(t_before.cell_site[c] + 1, 0);
+        bad_site[t_before.cell_site[c]] = 1;
+      }
+    const bool unknown = !after.failing.complete && after.failing.count > before.failing.count;
+    std::vector<char> out(after.failing.cell.size(), 0);
+    for (size_t c = 0; c < out.size(); ++c) {
+      const size_t site = static_cast<size_t>(t_after.cell_site[c]);
+      out[c] = unknown || (after.failing.cell[c] && !(site < bad_site.size() && bad_site[site]));
+    }
+    return out;
   }
   static std::array<int, 4> key_of(const TransitionCells& t, int32_t v) {
     return v >= t.base_node_id ? t.new_node_sites[v - t.base_node_id] : std::array<int, 4>{-1, -1, -1, v};
@@ -405,19 +459,30 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   const std::vector<double>& qs2 = after.qs;
   const std::vector<int>& skewed2 = after.skewed;
   const std::vector<double>& max_skew2 = after.max_skew;
+  // No move may make a cell fail a shape check of the self-check (shape_failures): one whose
+  // region holds a newly failing cell is refused, and all of them when such a cell lies in no
+  // move's region.
+  const std::vector<char> worse = new_failures(out, now, fresh, after);
+  std::vector<char> covered(worse.size(), 0);
+  for (const Move& m : moves)
+    for (int c : m.region) covered[c] = 1;
+  bool stray = false;
+  for (size_t c = 0; c < worse.size(); ++c) stray = stray || (worse[c] && !covered[c]);
   std::vector<Move> kept;
   for (const Move& m : moves) {
     double before = 0, after = 0;
     int skew_before = 0, skew_after = 0;
     double worst_before = 0, worst_after = 0;
+    bool fails = stray;
+    for (int c : m.region) fails = fails || worse[c];
     for (int c : m.region) {
       before += qs[c], after += qs2[c], skew_before += skewed[c], skew_after += skewed2[c];
       worst_before = std::max(worst_before, max_skew[c]), worst_after = std::max(worst_after, max_skew2[c]);
     }
     // A step against skewness must lower the count of skewed faces around, or their worst
     // skewness; a short-edge move must raise Q_S without adding a skewed face.
-    const bool better = m.skew ? skew_after < skew_before || (skew_after == skew_before && worst_after < worst_before)
-                               : skew_after <= skew_before && after > before + 1e-12;
+    const bool better = !fails && (m.skew ? skew_after < skew_before || (skew_after == skew_before && worst_after < worst_before)
+                                          : skew_after <= skew_before && after > before + 1e-12);
     if (better) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
@@ -425,14 +490,23 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   if (kept.empty()) {
     return unchanged();
   }
-  if (kept.size() < moves.size() && !rebuild(fresh, out.base_node_id)) {
-    for (const Move& m : kept) restore(m.site, m.before);
-    rep.invalid += static_cast<int>(kept.size());
-    return unchanged();
+  if (kept.size() < moves.size()) {
+    // Rebuilt with the kept moves alone: valid, and no cell failing that did not before.
+    bool ok = rebuild(fresh, out.base_node_id);
+    if (ok) {
+      after = measure(fresh);
+      const std::vector<char> worse_kept = new_failures(out, now, fresh, after);
+      ok = std::find(worse_kept.begin(), worse_kept.end(), 1) == worse_kept.end();
+    }
+    if (!ok) {
+      for (const Move& m : kept) restore(m.site, m.before);
+      rep.invalid += static_cast<int>(kept.size());
+      return unchanged();
+    }
   }
   rep.kept += static_cast<int>(kept.size());
   out = std::move(fresh);
-  if (kept.size() == moves.size()) next_ = std::move(after);  // else rebuilt with fewer moves: measured anew
+  next_ = std::move(after);
   return true;
 }
 

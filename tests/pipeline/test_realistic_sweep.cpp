@@ -75,8 +75,18 @@ TEST(RealisticSweep, FullSweepTable) {
   const char* log_path = std::getenv("HM_SWEEP_LOG");
   const bool only_bent = env_int("HM_SWEEP_ONLY_BENT", 0) == 1;  // rerun only the cases with a bent well
   const bool only_cross = env_int("HM_SWEEP_ONLY_CROSS", 0) == 1;  // only the wells through the top (and bottom)
-  // HM_SWEEP_DUMP=DIR: every case's file as DIR/seed_<seed>.yaml, to rerun with `meshgen FILE -o OUT`.
+  // HM_SWEEP_DUMP=DIR: every case's file as DIR/seed_<seed>.yaml, to rerun with `meshgen FILE -o OUT`
+  // (HM_SWEEP_DUMP_ONLY=1: write the files, mesh nothing).
   const char* dump_dir = std::getenv("HM_SWEEP_DUMP");
+  const bool dump_only = dump_dir && env_int("HM_SWEEP_DUMP_ONLY", 0) == 1;
+  // HM_SWEEP_SEEDS=S1,S2,...: only those seeds of the range (the failures of a previous run).
+  std::vector<uint32_t> only_seeds;
+  if (const char* v = std::getenv("HM_SWEEP_SEEDS"))
+    for (const char* p = v; *p;) {
+      char* end = nullptr;
+      only_seeds.push_back(static_cast<uint32_t>(std::strtoul(p, &end, 10)));
+      p = *end ? end + 1 : end;
+    }
   std::ofstream log;
   if (log_path) log.open(log_path);
   struct Row {
@@ -92,10 +102,12 @@ TEST(RealisticSweep, FullSweepTable) {
     const RealisticCase rc = make_realistic_case(seed, o);
     if (only_bent && rc.bends == 0) continue;
     if (only_cross && !o.cross_top_bottom) continue;
+    if (!only_seeds.empty() && std::find(only_seeds.begin(), only_seeds.end(), seed) == only_seeds.end()) continue;
     if (dump_dir) {
       std::ofstream yaml(std::string(dump_dir) + "/seed_" + std::to_string(seed) + ".yaml");
       yaml << rc.yaml;
       EXPECT_TRUE(yaml.good()) << "HM_SWEEP_DUMP: cannot write into " << dump_dir;
+      if (dump_only) continue;
     }
     const CaseResult r = mesh_and_check_isolated(rc, timeout);
     for (Row* row : {&rows[shape_class(rc)], &all}) {
@@ -202,4 +214,38 @@ TEST(RealisticSweep, ThinLayersReproducerMeshes) {
   const CaseResult r = mesh_and_check(rc);
   EXPECT_EQ(r.outcome, Outcome::Meshed) << r.reason;
   for (const std::string& n : r.notes) EXPECT_EQ(n.find("so that the transition mesh can be built"), std::string::npos) << n;
+}
+
+// Flat ends of wells with a large ring ratio (R 60-130 m, 10 m segments, r_out / r_in = 3.3 with 6
+// rings): the end annulus quad of the outer ring faced its transition site at 31 degrees from the
+// ring cell's FV centre (seed 1070, 24 faces, no optimisation), or just above 45 degrees, which the
+// optimiser then took below (seed 1069, 2 faces). The block's end segments are now long enough for
+// that pair (well_block.cpp, flat_end_min_segment; docs/robustness.md, session 8). Both full-sweep
+// seeds must mesh with their flat ends and pass every check (2-3 s each in Release).
+TEST(RealisticSweep, FlatEndsWithLargeRingRatioMeshAndPassFvcheck) {
+  for (uint32_t seed : {1070u, 1069u}) {
+    const RealisticOptions o = sweep_options(seed);
+    const RealisticCase rc = make_realistic_case(seed, o);
+    ASSERT_GE(rc.drainage_radius, 60.0) << rc.label;  // the generator still draws the large-R case
+    const CaseResult r = mesh_and_check(rc);
+    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+    std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
+                r.seconds);
+  }
+}
+
+// The optimiser kept site moves whose rebuilt cells were not convex (full-sweep seed 1009: 2 cells,
+// 1021: 1 cell, both straight from the raw diagram's convex cells); its acceptance now refuses a
+// move that makes a cell fail a shape check of the self-check (transition_optimize.cpp,
+// shape_failures; docs/robustness.md, session 8). Seed 1009 (optimisation on, 5-13 s in Release)
+// must mesh and pass every check.
+TEST(RealisticSweep, OptimiserKeepsTheSelfCheckShapeChecks) {
+  const uint32_t seed = 1009;
+  const RealisticOptions o = sweep_options(seed);
+  ASSERT_TRUE(o.optimize);
+  const RealisticCase rc = make_realistic_case(seed, o);
+  const CaseResult r = mesh_and_check(rc);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+  std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
+              r.seconds);
 }
