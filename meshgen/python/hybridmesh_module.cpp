@@ -21,6 +21,7 @@
 #include "meshgen/core/cli.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "meshgen/pipeline/summary.hpp"
 
 namespace py = pybind11;
@@ -210,7 +211,13 @@ PYBIND11_MODULE(hybridmesh, mod) {
         opts.optimize = optimize;
         opts.build_transition = transition;
         py::gil_scoped_release unlock;
-        m->result = hm::build_hybrid_mesh(cs, opts);
+        // As meshgen: mesh in the local frame (meshgen/pipeline/local_frame.hpp), then give the mesh and its
+        // geometry back in the case's coordinates.
+        const hm::Vec3 origin = hm::case_origin(cs);
+        m->result = hm::build_hybrid_mesh(hm::translated_case(cs, -origin), opts);
+        hm::translate_mesh(m->result.mesh, origin);
+        for (hm::Vec3& p : m->result.geometry.face_centroid) p += origin;
+        for (hm::Vec3& p : m->result.geometry.cell_centroid) p += origin;
         return m;
       },
       py::arg("case"), py::arg("optimize") = true, py::arg("transition") = true,

@@ -119,6 +119,45 @@ class BuiltMesh(unittest.TestCase):
         self.assertEqual(sum(s["cells"][k] for k in ("reservoir", "transition", "well")), self.mesh.n_cells)
 
 
+def shifted_readme_case(dx, dy):
+    """The README case's text moved by (dx, dy): its x and y axes and every trajectory point."""
+    out = []
+    for line in read_text(README_CASE).splitlines():
+        key = line.strip().split(":")[0]
+        if key in ("x", "y"):
+            d = dx if key == "x" else dy
+            values = line.split("[")[1].split("]")[0].split(",")
+            line = "  %s: [%s]" % (key, ", ".join(repr(float(v) + d) for v in values))
+        elif key == "trajectory":
+            points = line.split("[[")[1].split("]]")[0].split("], [")
+            moved = []
+            for p in points:
+                x, y, z = (float(v) for v in p.split(","))
+                moved.append("[%r, %r, %r]" % (x + dx, y + dy, z))
+            line = "    trajectory: [%s]" % ", ".join(moved)
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+class FieldCoordinates(unittest.TestCase):
+    """build() meshes in the local frame as meshgen does: a case moved to UTM values gives the same mesh."""
+
+    def test_translated_case_gives_the_same_mesh(self):
+        dx, dy = 452000.0, 6780000.0
+        local = hybridmesh.build(hybridmesh.parse_case(shifted_readme_case(0.0, 0.0)), optimize=False)
+        field = hybridmesh.build(hybridmesh.parse_case(shifted_readme_case(dx, dy)), optimize=False)
+        self.assertEqual(field.n_cells, local.n_cells)
+        self.assertEqual(field.n_faces, local.n_faces)
+        np.testing.assert_array_equal(field.face_nodes, local.face_nodes)
+        np.testing.assert_array_equal(field.face_owner, local.face_owner)
+        shift = np.array([dx, dy, 0.0])
+        # The nodes come back in the case's coordinates: the local mesh's plus the shift, to round-off at 7e6.
+        np.testing.assert_allclose(field.nodes - shift, local.nodes, rtol=0, atol=1e-8)
+        np.testing.assert_allclose(field.face_centroids - shift, local.face_centroids, rtol=0, atol=1e-8)
+        np.testing.assert_allclose(field.volumes, local.volumes, rtol=1e-9)
+        self.assertTrue(hybridmesh.check(field)["ok"])
+
+
 class BadInput(unittest.TestCase):
     def test_bad_value_names_the_key(self):
         text = read_text(README_CASE).replace("radius: 0.1", "radius: -0.1")
