@@ -36,6 +36,7 @@ std::string num(double v) { return hmtest::grdecl_number(v); }
 struct TiltedModel {
   int nx = 9, ny = 9, nz = 16, fault_i = -1;
   double dx = 20, dy = 20, dz = 4.5, dip_deg = 5, throw_m = 0;
+  bool inclined_pillars = false;  // non-parallel pillars: the column faces are not planar either
 
   double depth(int i_col, int I, int J, int k) const {
     const double x = dx * I, y = dy * J;
@@ -48,7 +49,11 @@ struct TiltedModel {
     o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
     for (int J = 0; J <= ny; ++J)
       for (int I = 0; I <= nx; ++I)
-        o << num(dx * I) << " " << num(dy * J) << " 900 " << num(dx * I) << " " << num(dy * J) << " 1200\n";
+      {
+        const double x = dx * I, y = dy * J;
+        const double bx = inclined_pillars ? x + 6 + 0.01 * x : x, by = inclined_pillars ? y + 3 - 0.005 * y : y;
+        o << num(x) << " " << num(y) << " 900 " << num(bx) << " " << num(by) << " 1200\n";
+      }
     o << "/\nZCORN\n";
     hmtest::write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
     const int n = nx * ny * nz;
@@ -189,6 +194,28 @@ TEST(CornerPointWells, VerticalWellInTiltedLayersMeshes) {
   }
   expect_sound_mesh(cs, out);
   for (const Cavity& cav : out.cavities.cavities) EXPECT_FALSE(cav.cells_are_boxes);
+  // Deterministic: the same case meshes to the same mesh.
+  const HybridMesh again = build_hybrid_mesh(cs);
+  EXPECT_EQ(again.mesh.face_nodes, out.mesh.face_nodes);
+  EXPECT_EQ(again.mesh.cell_faces, out.mesh.cell_faces);
+  EXPECT_EQ(again.mesh.nodes, out.mesh.nodes);
+}
+
+// A deviated well across columns, with inclined, non-parallel pillars (no model face is planar).
+TEST(CornerPointWells, DeviatedWellWithInclinedPillarsMeshes) {
+  TempDir tmp("cpwells");
+  TiltedModel g;
+  g.nz = 22, g.inclined_pillars = true;
+  const std::string well = "wells:\n  - {name: P1, trajectory: [[90, 90, 1055], [110, 90, 1068]], radius: 0.1, "
+                           "drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+  const CaseSpec cs = case_of(tmp, g, well);
+  HybridMesh out;
+  try {
+    out = build_hybrid_mesh(cs);
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+  expect_sound_mesh(cs, out);
 }
 
 // A well whose cavity reaches the model's top is refused (exit 2) with the reason.
