@@ -49,12 +49,8 @@ std::vector<ResTriangle> reservoir_triangles(const CornerPointCellFaces& cells, 
   std::vector<ResTriangle> out;
   for (size_t c = 0; c < cells.faces.size(); ++c) {
     if (!cells.meshed[c] || !active[c]) continue;
-    for (size_t f = 0; f < cells.faces[c].size(); ++f) {
-      const int32_t nb = cells.neighbour[c][f];
-      if (nb < 0 || active[nb]) continue;
-      for (auto& t : cavity_face_triangles(cells, static_cast<int>(c), f, coords))
-        out.push_back({std::move(t), static_cast<int32_t>(c), nb});
-    }
+    for (CavityTriangle& t : cavity_triangles(cells, static_cast<int>(c), active, coords))
+      out.push_back({std::move(t.nodes), static_cast<int32_t>(c), t.inside});
   }
   return out;
 }

@@ -1,7 +1,7 @@
 // Cavities in a corner-point model (docs/corner-point.md): the model cells meeting a dilated
 // well block are deactivated (and grown for the Gabriel condition, as in cavity.hpp); the
 // boundary is made of the model faces between an active and a deactivated cell (fault
-// overlaps included), each as its constrained triangles (cavity_face_triangles), which the
+// overlaps included), each as its constrained triangles (cavity_triangles), which the
 // active cell gets as its faces too: no new node, exact conformity.
 #pragma once
 #include <memory>

@@ -71,6 +71,8 @@ class CornerPointMesher {
     CornerPointCellFaces out;
     out.faces.assign(n, {});
     out.neighbour.assign(n, {});
+    group_.assign(n, {});
+    groups_.clear();
     for (size_t p = 0; p < pairs_.size(); ++p) pair_faces(static_cast<int>(p), boundary_patch, out.faces, out.neighbour);
     const bool flip = left_handed();
     for (int c = 0; c < n; ++c) {
@@ -79,6 +81,10 @@ class CornerPointMesher {
       if (flip)
         for (CellFace& f : out.faces[c]) std::reverse(f.nodes.begin(), f.nodes.end());
     }
+    if (flip)
+      for (auto& g : groups_) std::reverse(g.begin(), g.end());
+    out.group = std::move(group_);
+    out.groups = std::move(groups_);
     out.meshed = meshed_;
     out.zero_volume_cells = zero_volume_;
     out.fault_faces = fault_faces_;
@@ -94,6 +100,8 @@ class CornerPointMesher {
   std::vector<std::vector<double>> pillar_depth_;
   std::vector<std::vector<int32_t>> pillar_node_;
   std::vector<PillarPair> pairs_;
+  std::vector<std::vector<int32_t>> group_;   // per cell and face: its split group, -1 none
+  std::vector<std::vector<int32_t>> groups_;  // the cycle each split group fans
   std::map<std::array<int32_t, 4>, int32_t> face_centre_;
   std::vector<Band> band_;  // per cell and side (4 c + side): its top and bottom line on that pillar pair  // centre node of a split top/bottom face, by its corners
 
@@ -377,8 +385,14 @@ class CornerPointMesher {
     auto add = [&](int c, bool c_is_a, std::vector<int32_t> poly, int32_t patch, bool split,
                    const std::array<int32_t, 4>& corner, Vec3 centre, int32_t across) {
       if (c_is_a != is_i) std::reverse(poly.begin(), poly.end());
-      if (split) split_face(poly, corner, centre, patch, faces[c]);
-      else faces[c].push_back(CellFace{std::move(poly), patch});
+      if (split) {
+        split_face(poly, corner, centre, patch, faces[c]);
+        group_[c].resize(faces[c].size(), static_cast<int32_t>(groups_.size()));
+        groups_.push_back(poly);
+      } else {
+        faces[c].push_back(CellFace{std::move(poly), patch});
+      }
+      group_[c].resize(faces[c].size(), -1);
       neighbour[c].resize(faces[c].size(), across);
     };
     for (int a : ca)
@@ -455,6 +469,7 @@ class CornerPointMesher {
       if (face.size() == 4) {
         faces.push_back(CellFace{std::move(face), patch});
         neighbour.resize(faces.size(), across);
+        group_[c].resize(faces.size(), -1);
         continue;
       }
       static const int kQuad[2][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}};
@@ -467,6 +482,8 @@ class CornerPointMesher {
       }
       split_face(face, corner, centre / 4.0, patch, faces);
       neighbour.resize(faces.size(), across);
+      group_[c].resize(faces.size(), static_cast<int32_t>(groups_.size()));
+      groups_.push_back(face);
     }
   }
 
@@ -572,10 +589,20 @@ std::vector<std::array<int32_t, 3>> face_triangles(const std::vector<int32_t>& c
   return tris;
 }
 
-std::vector<std::vector<int32_t>> cavity_face_triangles(const CornerPointCellFaces& cells, int c, size_t f,
-                                                        const std::vector<Vec3>& coords) {
-  std::vector<std::vector<int32_t>> out;
-  for (const auto& t : face_triangles(cells.faces[c][f].nodes, coords)) out.push_back({t[0], t[1], t[2]});
+std::vector<CavityTriangle> cavity_triangles(const CornerPointCellFaces& cells, int c, const std::vector<char>& active,
+                                             const std::vector<Vec3>& coords) {
+  std::vector<CavityTriangle> out;
+  for (size_t f = 0; f < cells.faces[c].size(); ++f) {
+    const int32_t nb = cells.neighbour[c][f], g = cells.group[c][f];
+    if (nb < 0 || active[nb]) continue;
+    // A fanned face (split_face) is triangulated from its cycle, once, without the fan's centre: a
+    // centre node in the middle of a cavity wall lies in the spheres of the triangles beside it.
+    bool seen = false;
+    for (size_t e = 0; e < f && g >= 0 && !seen; ++e) seen = cells.group[c][e] == g;
+    if (seen) continue;
+    const std::vector<int32_t>& cycle = g >= 0 ? cells.groups[g] : cells.faces[c][f].nodes;
+    for (const auto& t : face_triangles(cycle, coords)) out.push_back({{t[0], t[1], t[2]}, nb});
+  }
   return out;
 }
 
@@ -595,12 +622,10 @@ CornerPointCells add_corner_point_cells(const CornerPointModel& model, const Cor
     std::vector<CellFace> faces;
     for (size_t f = 0; f < cells.faces[c].size(); ++f) {
       const int32_t nb = cells.neighbour[c][f];
-      if (nb >= 0 && !active[nb]) {  // toward a cavity: its constrained triangles
-        for (auto& t : cavity_face_triangles(cells, c, f, coords)) faces.push_back(CellFace{std::move(t), kInteriorFace});
-      } else {
-        faces.push_back(cells.faces[c][f]);
-      }
+      if (!(nb >= 0 && !active[nb])) faces.push_back(cells.faces[c][f]);
     }
+    for (CavityTriangle& t : cavity_triangles(cells, c, active, coords))  // toward a cavity
+      faces.push_back(CellFace{std::move(t.nodes), kInteriorFace});
     CellAttributes at;
     at.region = kReservoir;
     Vec3 centre{0, 0, 0};

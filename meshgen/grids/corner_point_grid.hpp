@@ -26,6 +26,10 @@ struct CornerPointCells {
 struct CornerPointCellFaces {
   std::vector<std::vector<CellFace>> faces;
   std::vector<std::vector<int32_t>> neighbour;
+  /// Per face: the split group it belongs to (a face fanned about its centre node), -1 none; and per
+  /// group the cycle it fans (outward for its cell).
+  std::vector<std::vector<int32_t>> group;
+  std::vector<std::vector<int32_t>> groups;
   std::vector<char> meshed;  ///< per model cell: present, active and of non-zero thickness
   int64_t zero_volume_cells = 0, fault_faces = 0, crossing_nodes = 0;
 };
@@ -41,13 +45,20 @@ CornerPointCellFaces corner_point_cell_faces(const CornerPointModel& model, cons
 /// Newell normal, the ear of the largest smallest angle first; deterministic, same orientation.
 std::vector<std::array<int32_t, 3>> face_triangles(const std::vector<int32_t>& cycle, const std::vector<Vec3>& coords);
 
-/// Face f of model cell c as the constrained triangles of a cavity behind it (face_triangles):
-/// the cavity and the active cell use this one list, so they conform exactly.
-std::vector<std::vector<int32_t>> cavity_face_triangles(const CornerPointCellFaces& cells, int c, size_t f,
-                                                        const std::vector<Vec3>& coords);
+/// A constrained triangle of a cavity: on the face of an active cell toward deactivated cell `inside`.
+struct CavityTriangle {
+  std::vector<int32_t> nodes;  ///< outward for the active cell (into the cavity)
+  int32_t inside = -1;
+};
+
+/// The faces of active model cell c toward cells with active == 0, as constrained triangles
+/// (face_triangles of each face; a fanned face's cycle without its centre). The cavity and the
+/// active cell use this one list, so they conform exactly.
+std::vector<CavityTriangle> cavity_triangles(const CornerPointCellFaces& cells, int c, const std::vector<char>& active,
+                                             const std::vector<Vec3>& coords);
 
 /// Adds the meshed cells with active[c] != 0 (attributes as below); a face toward a meshed cell
-/// that is not active (a cavity's) is added as its cavity_face_triangles, interior.
+/// that is not active (a cavity's) is added as its cavity_triangles, interior.
 CornerPointCells add_corner_point_cells(const CornerPointModel& model, const CornerPointCellFaces& cells,
                                         const ReservoirSpec& rock, const std::vector<char>& active,
                                         MeshBuilder& builder);
