@@ -44,10 +44,9 @@ double box_polyline_dist(Vec3 lo, Vec3 hi, const std::vector<Vec3>& line) {
   return d;
 }
 
-// Makes the boundary of the deactivated set a 2-manifold: around every lattice node, the
-// deactivated cells and the active cells of its 2x2x2 neighbourhood must each be
-// face-connected; otherwise all of them are deactivated. Returns cells added.
-int regularize(const ReservoirGrid& g, std::vector<char>& active) {
+}  // namespace
+
+int regularize_deactivated(const ReservoirGrid& g, std::vector<char>& active) {
   int added = 0;
   bool changed = true;
   while (changed) {
@@ -91,12 +90,55 @@ int regularize(const ReservoirGrid& g, std::vector<char>& active) {
   return added;
 }
 
+namespace {
+
 struct EdgeKey {
   int32_t a, b;
   bool operator<(const EdgeKey& o) const { return a < o.a || (a == o.a && b < o.b); }
 };
 
 }  // namespace
+
+double box_polyline_distance(Vec3 lo, Vec3 hi, const std::vector<Vec3>& line) { return box_polyline_dist(lo, hi, line); }
+
+WellSurfaces well_surfaces(const std::vector<WellBlock>& blocks, const std::vector<std::vector<int32_t>>& well_node_ids) {
+  WellSurfaces out;
+  std::set<int32_t> verts;
+  std::set<EdgeKey> edges;
+  for (size_t w = 0; w < blocks.size(); ++w)
+    for (const auto& poly : blocks[w].surface_faces) {
+      std::vector<int32_t> g;
+      for (size_t i = 0; i < poly.size(); ++i) {
+        const int32_t a = well_node_ids[w][poly[i]], b = well_node_ids[w][poly[(i + 1) % poly.size()]];
+        verts.insert(a);
+        edges.insert({std::min(a, b), std::max(a, b)});
+        g.push_back(a);
+      }
+      out.polygons.push_back(std::move(g));
+    }
+  out.vertices.assign(verts.begin(), verts.end());
+  for (const EdgeKey& e : edges) out.edges.push_back({e.a, e.b});
+  return out;
+}
+
+void add_well_polygons(Cavity& cav, const std::vector<WellBlock>& blocks,
+                       const std::vector<std::vector<int32_t>>& well_node_ids) {
+  for (int w : cav.wells) {
+    const WellBlock& b = blocks[w];
+    for (size_t s = 0; s < b.surface_faces.size(); ++s) {
+      ConstrainedFace f;
+      for (int32_t v : b.surface_faces[s]) f.nodes.push_back(well_node_ids[w][v]);
+      f.side = FaceSide::Well;
+      f.outside_cell = b.surface_cell[s];
+      f.well = b.well;
+      f.patch = b.surface_patch[s];
+      cav.faces.push_back(std::move(f));
+    }
+  }
+  std::set<int32_t> verts;
+  for (const auto& f : cav.faces) verts.insert(f.nodes.begin(), f.nodes.end());
+  cav.vertices.assign(verts.begin(), verts.end());
+}
 
 CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
                          const std::vector<int32_t>& reservoir_node_ids,
@@ -127,32 +169,14 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
   }
   for (int32_t c : extra_deactivated)
     if (c >= 0 && c < nc) active[c] = 0;
-  int regularized = regularize(grid, active);
+  int regularized = regularize_deactivated(grid, active);
 
   // The well side of the Gabriel test: outer-surface edges and vertices of every block.
   auto res_node = [&](int lattice) { return reservoir_node_ids[lattice]; };
-  std::vector<int32_t> well_vertices;
-  std::vector<std::array<int32_t, 2>> well_edges;
-  {
-    std::set<int32_t> verts;
-    std::set<EdgeKey> edges;
-    for (size_t w = 0; w < blocks.size(); ++w)
-      for (const auto& poly : blocks[w].surface_faces)
-        for (size_t i = 0; i < poly.size(); ++i) {
-          const int32_t a = well_node_ids[w][poly[i]], b = well_node_ids[w][poly[(i + 1) % poly.size()]];
-          verts.insert(a);
-          edges.insert({std::min(a, b), std::max(a, b)});
-        }
-    well_vertices.assign(verts.begin(), verts.end());
-    for (const EdgeKey& e : edges) well_edges.push_back({e.a, e.b});
-  }
-  std::vector<std::vector<int32_t>> well_polygons;
-  for (size_t w = 0; w < blocks.size(); ++w)
-    for (const auto& poly : blocks[w].surface_faces) {
-      std::vector<int32_t> g;
-      for (int32_t v : poly) g.push_back(well_node_ids[w][v]);
-      well_polygons.push_back(std::move(g));
-    }
+  const WellSurfaces well_side = well_surfaces(blocks, well_node_ids);
+  const std::vector<int32_t>& well_vertices = well_side.vertices;
+  const std::vector<std::array<int32_t, 2>>& well_edges = well_side.edges;
+  const std::vector<std::vector<int32_t>>& well_polygons = well_side.polygons;
   const int lattice_nx = grid.nx() + 1, lattice_ny = grid.ny() + 1;
   std::vector<int32_t> lattice_of(node_coords.size(), -1);  // builder id -> lattice node
   for (int n = 0; n < grid.n_nodes(); ++n) lattice_of[reservoir_node_ids[n]] = n;
@@ -248,7 +272,7 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
     if (grow.empty()) break;  // violations between two wells: nothing in the reservoir to change
     for (int c : grow) active[c] = 0;
     repaired_cells += static_cast<int>(grow.size());
-    regularized += regularize(grid, active);
+    regularized += regularize_deactivated(grid, active);
   }
   out.gabriel_violations_remaining = remaining;
   if (remaining > 0)
@@ -315,21 +339,7 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
         f.inside_cell = c;
         cav.faces.push_back(std::move(f));
       }
-    for (int w : cav.wells) {
-      const WellBlock& b = blocks[w];
-      for (size_t s = 0; s < b.surface_faces.size(); ++s) {
-        ConstrainedFace f;
-        for (int32_t v : b.surface_faces[s]) f.nodes.push_back(well_node_ids[w][v]);
-        f.side = FaceSide::Well;
-        f.outside_cell = b.surface_cell[s];
-        f.well = b.well;
-        f.patch = b.surface_patch[s];
-        cav.faces.push_back(std::move(f));
-      }
-    }
-    std::set<int32_t> verts;
-    for (const auto& f : cav.faces) verts.insert(f.nodes.begin(), f.nodes.end());
-    cav.vertices.assign(verts.begin(), verts.end());
+    add_well_polygons(cav, blocks, well_node_ids);
     // Largest local dilation: the farthest deactivated cell from its nearest well, in drainage radii.
     double dmax = 0;
     for (int c : cav.deactivated_cells) {

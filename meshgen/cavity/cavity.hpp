@@ -5,7 +5,9 @@
 // the outer faces of the well blocks. Wells whose deactivated regions touch share one
 // cavity.
 #pragma once
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,6 +55,14 @@ struct Cavity {
   std::vector<int32_t> vertices;          ///< distinct global node ids of `faces`, sorted
   double dilation_used = 0;               ///< largest local dilation used
   std::vector<MirrorPlane> mirrors;       ///< outer-boundary planes the cavity touches (sorted by axis, value)
+  /// The deactivated cells are axis-aligned boxes (a rectilinear reservoir): the transition may
+  /// use box sites (a cell's centre, its sphere through the 8 corners). False in a corner-point
+  /// model (docs/corner-point.md): every reservoir polygon is a triangle with its own site and
+  /// its mirror.
+  bool cells_are_boxes = true;
+  /// When set, the deactivated cell of this cavity holding x (-1 if none); else the transition
+  /// locates x in the rectilinear grid.
+  std::function<int(Vec3)> locate_cell;
 };
 
 struct CavitySet {
@@ -76,6 +86,28 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
                          const std::vector<std::vector<int32_t>>& well_node_ids,
                          const std::vector<Vec3>& node_coords,
                          const std::vector<int32_t>& extra_deactivated = {});
+
+/// Distance from the axis-aligned box [lo, hi] to a polyline.
+double box_polyline_distance(Vec3 lo, Vec3 hi, const std::vector<Vec3>& line);
+
+/// Makes the boundary of the deactivated set (active[c] == 0) a 2-manifold in the grid's index
+/// space: around every lattice node the deactivated and the active cells of its 2x2x2
+/// neighbourhood must each be face-connected, else all of them are deactivated. Returns cells added.
+int regularize_deactivated(const ReservoirGrid& grid, std::vector<char>& active);
+
+/// The well side of the cavities' Gabriel test: the blocks' outer polygons (builder ids), their
+/// distinct vertices (sorted) and distinct edges (sorted, a < b).
+struct WellSurfaces {
+  std::vector<int32_t> vertices;
+  std::vector<std::array<int32_t, 2>> edges;
+  std::vector<std::vector<int32_t>> polygons;
+};
+WellSurfaces well_surfaces(const std::vector<WellBlock>& blocks, const std::vector<std::vector<int32_t>>& well_node_ids);
+
+/// Appends the outer polygons of the cavity's wells' blocks to its faces (FaceSide::Well) and sets
+/// its vertices (the distinct nodes of all its faces, sorted).
+void add_well_polygons(Cavity& cav, const std::vector<WellBlock>& blocks,
+                       const std::vector<std::vector<int32_t>>& well_node_ids);
 
 /// Closed 2-manifold check of a cavity boundary (OpenMesh): every edge in exactly two
 /// faces with opposite directions, every vertex's fan a single disk; edges lying in one of

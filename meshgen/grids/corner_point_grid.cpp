@@ -1,6 +1,9 @@
 #include "corner_point_grid.hpp"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -17,6 +20,7 @@ namespace {
 // where the two straight edges reach the same depth; every node lying on a line (its two pillar
 // ends and its crossings) is a station of it, and every face edge along the line names all the
 // stations it passes (no hanging node).
+constexpr double kPiValue = 3.14159265358979323846;
 constexpr int kAbove = -1;  // the line z = -infinity (a gap band above a column's first cell)
 constexpr int kBelow = -2;  // z = +infinity
 
@@ -34,6 +38,12 @@ struct PillarPair {
 };
 
 int sgn(double a, double b) { return (a > b) - (a < b); }
+
+// The pillar of corner q of cell c.
+int cell_corner_pillar(const CornerPointModel& m, int c, int q) {
+  const int i = c % m.nx + (q & 1), j = (c / m.nx) % m.ny + ((q >> 1) & 1);
+  return i + (m.nx + 1) * j;
+}
 
 struct Band {
   int top, bottom;  // line ids (or kAbove / kBelow)
@@ -55,31 +65,30 @@ class CornerPointMesher {
     make_pairs();
   }
 
-  CornerPointCells add_cells(const ReservoirSpec& rock, int32_t boundary_patch) {
+  // Every meshed cell's faces (outward), each with the model cell across it (-1: none).
+  CornerPointCellFaces cell_faces(int32_t boundary_patch) {
     const int n = m_.nx * m_.ny * m_.nz;
-    std::vector<std::vector<CellFace>> faces(n);
-    for (size_t p = 0; p < pairs_.size(); ++p) pair_faces(static_cast<int>(p), boundary_patch, faces);
+    CornerPointCellFaces out;
+    out.faces.assign(n, {});
+    out.neighbour.assign(n, {});
+    group_.assign(n, {});
+    groups_.clear();
+    for (size_t p = 0; p < pairs_.size(); ++p) pair_faces(static_cast<int>(p), boundary_patch, out.faces, out.neighbour);
     const bool flip = left_handed();
-    CornerPointCells out;
-    out.cell_id.assign(n, -1);
+    for (int c = 0; c < n; ++c) {
+      if (!meshed_[c]) continue;
+      top_bottom_faces(c, boundary_patch, out.faces[c], out.neighbour[c]);
+      if (flip)
+        for (CellFace& f : out.faces[c]) std::reverse(f.nodes.begin(), f.nodes.end());
+    }
+    if (flip)
+      for (auto& g : groups_) std::reverse(g.begin(), g.end());
+    out.group = std::move(group_);
+    out.groups = std::move(groups_);
+    out.meshed = meshed_;
     out.zero_volume_cells = zero_volume_;
     out.fault_faces = fault_faces_;
     out.crossing_nodes = crossings_;
-    for (int c = 0; c < n; ++c) {
-      if (!meshed_[c]) continue;
-      top_bottom_faces(c, boundary_patch, faces[c]);
-      if (flip)
-        for (CellFace& f : faces[c]) std::reverse(f.nodes.begin(), f.nodes.end());
-      CellAttributes at;
-      at.region = kReservoir;
-      Vec3 centre{0, 0, 0};
-      for (int q = 0; q < 8; ++q) centre += corner_point(c, q);
-      at.fv_center = centre / 8.0;
-      at.ijk = {c % m_.nx, (c / m_.nx) % m_.ny, c / (m_.nx * m_.ny)};
-      at.perm = reservoir_permeability(rock, c);
-      at.porosity = reservoir_porosity(rock, c);
-      out.cell_id[c] = b_.add_cell(faces[c], at);
-    }
     return out;
   }
 
@@ -91,6 +100,8 @@ class CornerPointMesher {
   std::vector<std::vector<double>> pillar_depth_;
   std::vector<std::vector<int32_t>> pillar_node_;
   std::vector<PillarPair> pairs_;
+  std::vector<std::vector<int32_t>> group_;   // per cell and face: its split group, -1 none
+  std::vector<std::vector<int32_t>> groups_;  // the cycle each split group fans
   std::map<std::array<int32_t, 4>, int32_t> face_centre_;
   std::vector<Band> band_;  // per cell and side (4 c + side): its top and bottom line on that pillar pair  // centre node of a split top/bottom face, by its corners
 
@@ -112,10 +123,7 @@ class CornerPointMesher {
     return area < 0;
   }
 
-  int pillar_of(int c, int q) const {
-    const int i = c % m_.nx + (q & 1), j = (c / m_.nx) % m_.ny + ((q >> 1) & 1);
-    return i + (m_.nx + 1) * j;
-  }
+  int pillar_of(int c, int q) const { return cell_corner_pillar(m_, c, q); }
   Vec3 corner_point(int c, int q) const { return pillar_point(m_, pillar_of(c, q), corner_depth(m_, c, q)); }
 
   void make_pillar_nodes() {
@@ -345,7 +353,8 @@ class CornerPointMesher {
     return g;
   }
 
-  void pair_faces(int p, int32_t boundary_patch, std::vector<std::vector<CellFace>>& faces) {
+  void pair_faces(int p, int32_t boundary_patch, std::vector<std::vector<CellFace>>& faces,
+                  std::vector<std::vector<int32_t>>& neighbour) {
     const PillarPair& pp = pairs_[p];
     const bool is_i = p < n_ipairs();
     // Side A: the column on the -i (-j) side, whose +i (+j) face lies here; B: the other.
@@ -374,10 +383,17 @@ class CornerPointMesher {
     };
     // poly in walk orientation; `split`: the face is the whole face of one of its cells (corner, centre).
     auto add = [&](int c, bool c_is_a, std::vector<int32_t> poly, int32_t patch, bool split,
-                   const std::array<int32_t, 4>& corner, Vec3 centre) {
+                   const std::array<int32_t, 4>& corner, Vec3 centre, int32_t across) {
       if (c_is_a != is_i) std::reverse(poly.begin(), poly.end());
-      if (split) split_face(poly, corner, centre, patch, faces[c]);
-      else faces[c].push_back(CellFace{std::move(poly), patch});
+      if (split) {
+        split_face(poly, corner, centre, patch, faces[c]);
+        group_[c].resize(faces[c].size(), static_cast<int32_t>(groups_.size()));
+        groups_.push_back(poly);
+      } else {
+        faces[c].push_back(CellFace{std::move(poly), patch});
+      }
+      group_[c].resize(faces[c].size(), -1);
+      neighbour[c].resize(faces[c].size(), across);
     };
     for (int a : ca)
       for (int b : cb) {
@@ -387,8 +403,8 @@ class CornerPointMesher {
         std::array<int32_t, 4> corner;
         Vec3 centre;
         const bool split = whole(poly, band(a, side_a), &corner, &centre) || whole(poly, band(b, side_b), &corner, &centre);
-        add(a, true, poly, kInteriorFace, split, corner, centre);
-        add(b, false, std::move(poly), kInteriorFace, split, corner, centre);
+        add(a, true, poly, kInteriorFace, split, corner, centre, b);
+        add(b, false, std::move(poly), kInteriorFace, split, corner, centre, a);
       }
     const std::vector<Band> ga = gaps(ca, side_a), gb = gaps(cb, side_b);
     for (int a : ca)
@@ -397,7 +413,7 @@ class CornerPointMesher {
           std::array<int32_t, 4> corner;
           Vec3 centre;
           const bool split = whole(poly, band(a, side_a), &corner, &centre);
-          add(a, true, std::move(poly), boundary_patch, split, corner, centre);
+          add(a, true, std::move(poly), boundary_patch, split, corner, centre, -1);
         }
     for (int b : cb)
       for (const Band& g : ga)
@@ -405,7 +421,7 @@ class CornerPointMesher {
           std::array<int32_t, 4> corner;
           Vec3 centre;
           const bool split = whole(poly, band(b, side_b), &corner, &centre);
-          add(b, false, std::move(poly), boundary_patch, split, corner, centre);
+          add(b, false, std::move(poly), boundary_patch, split, corner, centre, -1);
         }
   }
 
@@ -415,7 +431,7 @@ class CornerPointMesher {
   // fan of the plain quad whatever the stations (the mesh's fan of a polygon turns about the mean of
   // all its nodes, which moves with them: on a thin twisted cell the top and bottom fans then crossed
   // and the volume came out negative).
-  void top_bottom_faces(int c, int32_t boundary_patch, std::vector<CellFace>& faces) {
+  void top_bottom_faces(int c, int32_t boundary_patch, std::vector<CellFace>& faces, std::vector<int32_t>& neighbour) {
     struct Edge {
       int side;
       bool forward;  // s from 0 to 1
@@ -441,17 +457,19 @@ class CornerPointMesher {
       while (face.size() > 1 && face.back() == face.front()) face.pop_back();
       if (face.size() < 3) continue;
       // Interior when the next meshed cell of the column above (below) has this face's corners.
-      int32_t patch = boundary_patch;
+      int32_t patch = boundary_patch, across = -1;
       const bool has_next = bottom ? (at + 1 != col.end()) : (at != col.begin());
       if (has_next) {
         const int o = bottom ? *(at + 1) : *(at - 1);
         bool same = true;
         for (int q = 0; q < 4; ++q)
           same = same && corner_depth(m_, c, q + (bottom ? 4 : 0)) == corner_depth(m_, o, q + (bottom ? 0 : 4));
-        if (same) patch = kInteriorFace;
+        if (same) patch = kInteriorFace, across = o;
       }
       if (face.size() == 4) {
         faces.push_back(CellFace{std::move(face), patch});
+        neighbour.resize(faces.size(), across);
+        group_[c].resize(faces.size(), -1);
         continue;
       }
       static const int kQuad[2][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}};
@@ -463,6 +481,9 @@ class CornerPointMesher {
         centre += corner_point(c, q);
       }
       split_face(face, corner, centre / 4.0, patch, faces);
+      neighbour.resize(faces.size(), across);
+      group_[c].resize(faces.size(), static_cast<int32_t>(groups_.size()));
+      groups_.push_back(face);
     }
   }
 
@@ -480,10 +501,148 @@ class CornerPointMesher {
 
 }  // namespace
 
+namespace {
+
+// Smallest angle of triangle abc (radians), from its edge lengths.
+double min_angle(Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 p[3] = {a, b, c};
+  double best = kPiValue;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+    const double nu = norm(u), nv = norm(v);
+    if (nu == 0 || nv == 0) return 0;
+    best = std::min(best, std::acos(std::clamp(dot(u, v) / (nu * nv), -1.0, 1.0)));
+  }
+  return best;
+}
+
+}  // namespace
+
+Vec3 model_cell_corner(const CornerPointModel& model, int c, int q) {
+  return pillar_point(model, cell_corner_pillar(model, c, q), corner_depth(model, c, q));
+}
+
+CornerPointCellFaces corner_point_cell_faces(const CornerPointModel& model, const std::vector<char>& present,
+                                             MeshBuilder& builder, int32_t boundary_patch) {
+  CornerPointMesher mesher(model, present, builder);
+  return mesher.cell_faces(boundary_patch);
+}
+
+std::vector<std::array<int32_t, 3>> face_triangles(const std::vector<int32_t>& cycle, const std::vector<Vec3>& coords) {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  const size_t n = cycle.size();
+  if (n < 3) return {};
+  if (n == 3) return {{cycle[0], cycle[1], cycle[2]}};
+  // The plane of the face: Newell's normal (follows the cycle's orientation), about its first node.
+  const Vec3 o = coords[cycle[0]];
+  Vec3 nrm{0, 0, 0};
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 a = coords[cycle[i]] - o, b = coords[cycle[(i + 1) % n]] - o;
+    nrm += cross(a, b);
+  }
+  nrm = normalized(nrm);
+  const Vec3 ref = std::abs(nrm.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  const Vec3 u = normalized(cross(nrm, ref)), v = cross(nrm, u);  // (u, v, nrm) right-handed
+  std::vector<K::Point_2> p2(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 d = coords[cycle[i]] - o;
+    p2[i] = K::Point_2(dot(d, u), dot(d, v));
+  }
+  // Ear clipping in that plane: an ear is a strictly convex corner whose triangle holds no other
+  // node (closed); Delaunay ears go first, then the ear with the largest smallest angle (ties: the
+  // first in the cycle). The decisions are exact predicates on the projected nodes.
+  std::vector<size_t> left(n);
+  for (size_t i = 0; i < n; ++i) left[i] = i;
+  std::vector<std::array<int32_t, 3>> tris;
+  while (left.size() > 3) {
+    const size_t m = left.size();
+    size_t best = m;
+    double best_q = -1;
+    for (size_t k = 0; k < m; ++k) {
+      const size_t a = left[(k + m - 1) % m], b = left[k], c = left[(k + 1) % m];
+      if (CGAL::orientation(p2[a], p2[b], p2[c]) != CGAL::LEFT_TURN) continue;
+      bool empty = true;
+      for (size_t r = 0; r < m && empty; ++r) {
+        const size_t x = left[r];
+        if (x == a || x == b || x == c) continue;
+        empty = !(CGAL::orientation(p2[a], p2[b], p2[x]) != CGAL::RIGHT_TURN &&
+                  CGAL::orientation(p2[b], p2[c], p2[x]) != CGAL::RIGHT_TURN &&
+                  CGAL::orientation(p2[c], p2[a], p2[x]) != CGAL::RIGHT_TURN);
+      }
+      if (!empty) continue;
+      // Delaunay ears first (no remaining node strictly inside the ear's circle): a convex
+      // face then gets its Delaunay triangulation (the sites' spheres cut the plane in those circles).
+      bool delaunay = true;
+      for (size_t r = 0; r < m && delaunay; ++r) {
+        const size_t x = left[r];
+        if (x == a || x == b || x == c) continue;
+        delaunay = CGAL::side_of_oriented_circle(p2[a], p2[b], p2[c], p2[x]) != CGAL::ON_POSITIVE_SIDE;
+      }
+      const double q = (delaunay ? kPiValue : 0.0) + min_angle(coords[cycle[a]], coords[cycle[b]], coords[cycle[c]]);
+      if (q > best_q) best_q = q, best = k;
+    }
+    if (best == m) throw std::logic_error("corner-point grid: a cell face has no ear to triangulate (degenerate face)");
+    tris.push_back({cycle[left[(best + m - 1) % m]], cycle[left[best]], cycle[left[(best + 1) % m]]});
+    left.erase(left.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+  tris.push_back({cycle[left[0]], cycle[left[1]], cycle[left[2]]});
+  return tris;
+}
+
+std::vector<CavityTriangle> cavity_triangles(const CornerPointCellFaces& cells, int c, const std::vector<char>& active,
+                                             const std::vector<Vec3>& coords) {
+  std::vector<CavityTriangle> out;
+  for (size_t f = 0; f < cells.faces[c].size(); ++f) {
+    const int32_t nb = cells.neighbour[c][f], g = cells.group[c][f];
+    if (nb < 0 || active[nb]) continue;
+    // A fanned face (split_face) is triangulated from its cycle, once, without the fan's centre: a
+    // centre node in the middle of a cavity wall lies in the spheres of the triangles beside it.
+    bool seen = false;
+    for (size_t e = 0; e < f && g >= 0 && !seen; ++e) seen = cells.group[c][e] == g;
+    if (seen) continue;
+    const std::vector<int32_t>& cycle = g >= 0 ? cells.groups[g] : cells.faces[c][f].nodes;
+    for (const auto& t : face_triangles(cycle, coords)) out.push_back({{t[0], t[1], t[2]}, nb});
+  }
+  return out;
+}
+
+CornerPointCells add_corner_point_cells(const CornerPointModel& model, const CornerPointCellFaces& cells,
+                                        const ReservoirSpec& rock, const std::vector<char>& active,
+                                        MeshBuilder& builder) {
+  const int n = model.nx * model.ny * model.nz;
+  std::vector<Vec3> coords(builder.n_nodes());
+  for (int32_t i = 0; i < builder.n_nodes(); ++i) coords[i] = builder.node(i);
+  CornerPointCells out;
+  out.cell_id.assign(n, -1);
+  out.zero_volume_cells = cells.zero_volume_cells;
+  out.fault_faces = cells.fault_faces;
+  out.crossing_nodes = cells.crossing_nodes;
+  for (int c = 0; c < n; ++c) {
+    if (!cells.meshed[c] || !active[c]) continue;
+    std::vector<CellFace> faces;
+    for (size_t f = 0; f < cells.faces[c].size(); ++f) {
+      const int32_t nb = cells.neighbour[c][f];
+      if (!(nb >= 0 && !active[nb])) faces.push_back(cells.faces[c][f]);
+    }
+    for (CavityTriangle& t : cavity_triangles(cells, c, active, coords))  // toward a cavity
+      faces.push_back(CellFace{std::move(t.nodes), kInteriorFace});
+    CellAttributes at;
+    at.region = kReservoir;
+    Vec3 centre{0, 0, 0};
+    for (int q = 0; q < 8; ++q) centre += model_cell_corner(model, c, q);
+    at.fv_center = centre / 8.0;
+    at.ijk = {c % model.nx, (c / model.nx) % model.ny, c / (model.nx * model.ny)};
+    at.perm = reservoir_permeability(rock, c);
+    at.porosity = reservoir_porosity(rock, c);
+    out.cell_id[c] = builder.add_cell(faces, at);
+  }
+  return out;
+}
+
 CornerPointCells add_corner_point_cells(const CornerPointModel& model, const ReservoirSpec& rock,
                                         const std::vector<char>& active, MeshBuilder& builder, int32_t boundary_patch) {
-  CornerPointMesher mesher(model, active, builder);
-  return mesher.add_cells(rock, boundary_patch);
+  const CornerPointCellFaces cells = corner_point_cell_faces(model, active, builder, boundary_patch);
+  return add_corner_point_cells(model, cells, rock, std::vector<char>(cells.meshed.size(), 1), builder);
 }
 
 }  // namespace hm

@@ -1,50 +1,242 @@
 // The job for a true corner-point model (reservoir.grdecl that is not a box grid): the model's
 // active cells as the mesh's reservoir cells (meshgen/grids/corner_point_grid.hpp), checked like
-// every mesh. Near-well meshing in such a model is not built yet: a case with wells is refused.
+// every mesh. With wells (docs/corner-point.md): well blocks, cavities of model cells whose
+// boundary faces are constrained triangles (meshgen/cavity/cavity_corner_point.hpp), and one
+// transition per cavity with a polygon site and a mirror per triangle (no box site).
+#include <algorithm>
 #include <chrono>
+#include <memory>
 #include <string>
 
 #include "hybrid_mesh.hpp"
+#include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
+#include "perforations.hpp"
 
 namespace hm {
 
-HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
-  const CornerPointModel& model = *cs.reservoir.corner_point;
-  if (!cs.wells.empty())
-    throw InputError("wells: " + cs.reservoir.grdecl +
-                     " is a corner-point model (sloping layers, inclined pillars, faults or inactive cells): its cells "
-                     "are meshed, but wells in a corner-point model are not meshed yet (docs/case-format.md, grdecl); "
-                     "give the case without wells, or a model whose cells are axis-aligned boxes");
-  HybridMesh out;
-  auto last = std::chrono::steady_clock::now();
-  const auto stage = [&](const std::string& s) {
+namespace {
+
+class Stages {
+ public:
+  Stages(HybridMesh& out, const PipelineOptions& opts) : out_(out), opts_(opts) {}
+  void mark(const std::string& s) {
     const auto now = std::chrono::steady_clock::now();
-    out.timings_s.push_back({s, std::chrono::duration<double>(now - last).count()});
-    last = now;
-    if (opts.on_stage) opts.on_stage(s);
-  };
-  out.grid = make_reservoir_grid(cs.reservoir);  // index arithmetic only (nx, ny, nz)
-  MeshBuilder builder;
-  const CornerPointCells cells =
-      add_corner_point_cells(model, cs.reservoir, std::vector<char>(model.actnum.size(), 1), builder);
-  out.mesh = builder.finish(&out.build_report);
-  stage("reservoir_cells");
+    out_.timings_s.push_back({s, std::chrono::duration<double>(now - last_).count()});
+    last_ = now;
+    if (opts_.on_stage) opts_.on_stage(s);
+  }
+
+ private:
+  HybridMesh& out_;
+  const PipelineOptions& opts_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+std::vector<char> all_present(const CornerPointModel& m) { return std::vector<char>(m.actnum.size(), 1); }
+
+void fill_cell_maps(HybridMesh& out, const std::vector<int32_t>& transition_cavity, const std::vector<double>& h_ref) {
   const int nc = out.mesh.n_cells();
   out.cell_cavity.assign(nc, -1);
   out.cell_h_ref.assign(nc, 0.0);
   out.reservoir_cell_of.assign(nc, -1);
-  for (int c = 0; c < nc; ++c) {
+  for (int c = 0, t = 0; c < nc; ++c) {
     const auto& ijk = out.mesh.cell_ijk[c];
-    out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
+    if (out.mesh.cell_region[c] == kReservoir) out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
+    if (out.mesh.cell_region[c] == kTransition) {
+      out.cell_cavity[c] = transition_cavity[t];
+      out.cell_h_ref[c] = h_ref[t];
+      ++t;
+    }
   }
+}
+
+std::string well_names(const CaseSpec& cs, const std::vector<int>& wells) {
+  std::string s;
+  for (int w : wells) s += (s.empty() ? "" : ", ") + ("wells[" + std::to_string(w) + "] (" + cs.wells[w].name + ")");
+  return s;
+}
+
+// Wells in the model: blocks, cavities (enlarged where a transition asks, at most
+// kMaxEnlargements times), transitions; then the mesh is assembled again from the start with the
+// same node ids (the radial cells' rock needs the cavities' model cells).
+HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions& opts) {
+  const CornerPointModel& model = *input.reservoir.corner_point;
+  CaseSpec cs = input;
+  HybridMesh out;
+  Stages stage(out, opts);
+  out.grid = make_reservoir_grid(cs.reservoir);  // index arithmetic only (nx, ny, nz)
+  const int nw = static_cast<int>(cs.wells.size());
+  for (int w = 0; w < nw; ++w) {
+    WellSpec& ws = cs.wells[w];
+    try {
+      out.blocks.push_back(make_gabriel_well_block(cs, w));
+    } catch (const InputError& e) {
+      if (!(ws.end_caps == EndCaps::Hemisphere && ws.end_caps_fallback)) throw;
+      ws.end_caps = EndCaps::Flat;
+      out.notes.push_back("wells[" + std::to_string(w) + "]: closed with flat ends (end_caps: auto): " + e.what());
+      out.blocks.push_back(make_gabriel_well_block(cs, w));
+    }
+  }
+  stage.mark("well_blocks");
+
+  // Nodes: the model's, then each block's (the same ids in both builders).
+  auto add_nodes = [&](MeshBuilder& b, CornerPointCellFaces& faces, std::vector<std::vector<int32_t>>& well_nodes,
+                       const std::vector<WellBlock>& blocks) {
+    faces = corner_point_cell_faces(model, all_present(model), b);
+    well_nodes.clear();
+    for (const WellBlock& blk : blocks) well_nodes.push_back(add_well_block(blk, b));
+  };
+  MeshBuilder scratch;
+  CornerPointCellFaces faces;
+  std::vector<std::vector<int32_t>> well_nodes;
+  add_nodes(scratch, faces, well_nodes, out.blocks);
+  std::vector<Vec3> coords(scratch.n_nodes());
+  for (int32_t i = 0; i < scratch.n_nodes(); ++i) coords[i] = scratch.node(i);
+  const int32_t base = scratch.n_nodes();
+
+  TransitionOptions topts;
+  topts.optimize = opts.optimize && cs.transition.optimize;
+  topts.g_remove = cs.transition.gamma[1];
+  topts.g_expand = cs.transition.gamma[2];
+  constexpr int kMaxEnlargements = 5;
+  std::vector<int32_t> extra;
+  std::string asked_by;  // the latest refusal that enlarged a cavity
+  std::vector<TransitionCells> transitions;
+  for (int round = 0;; ++round) {
+    try {
+      out.cavities = build_corner_point_cavities(cs, model, faces, out.blocks, well_nodes, coords, extra);
+    } catch (const InputError& e) {
+      if (extra.empty()) throw;
+      throw MeshingError("transition", {},
+                         asked_by + "; the cavity enlarged for it cannot be built: " + e.what());
+    }
+    const int nk = static_cast<int>(out.cavities.cavities.size());
+    for (int k = 0; k < nk; ++k) {
+      const auto problems = check_cavity_manifold(out.cavities.cavities[k], coords);
+      if (!problems.empty())
+        throw MeshingError("cavity", out.cavities.cavities[k].wells,
+                           "cavity " + std::to_string(k) + " of " + well_names(cs, out.cavities.cavities[k].wells) +
+                               " in the corner-point model: boundary is not a closed 2-manifold: " + problems[0]);
+    }
+    if (!opts.build_transition) break;
+    transitions.clear();
+    bool refused = false;
+    for (int k = 0; k < nk && !refused; ++k) {
+      const Cavity& cav = out.cavities.cavities[k];
+      ++out.transition_builds;
+      TransitionOutcome o = try_build_transition(cav, coords, out.grid, out.blocks, base, topts);
+      if (o.ok()) {
+        transitions.push_back(std::move(o.cells));
+        continue;
+      }
+      refused = true;
+      if (round >= kMaxEnlargements || o.refusal->cells_to_deactivate.empty())
+        throw MeshingError("transition", cav.wells,
+                           "transition of the cavity of " + well_names(cs, cav.wells) + " in the corner-point model: " +
+                               o.refusal->reason + (round > 0 ? " (after " + std::to_string(round) + " cavity enlargements)" : "") +
+                               " (docs/corner-point.md)");
+      extra.insert(extra.end(), o.refusal->cells_to_deactivate.begin(), o.refusal->cells_to_deactivate.end());
+      asked_by = o.refusal->reason;
+      out.notes.push_back("cavity: " + std::to_string(o.refusal->cells_to_deactivate.size()) +
+                          " model cells deactivated so that the transition of " + well_names(cs, cav.wells) +
+                          " can be built (" + o.refusal->reason + ")");
+    }
+    if (!refused) break;
+  }
+  for (const WellBlock& b : out.blocks)
+    for (const std::string& n : b.notes) out.notes.push_back(n);
+  for (const std::string& n : out.cavities.notes) out.notes.push_back(n);
+  out.cavity_node_coords = coords;
+  stage.mark(opts.build_transition ? "cavities_and_transition" : "cavities");
+
+  // Rock of the near-well cells: the model cell their FV centre lies in (the cavities' cells).
+  std::vector<int32_t> dead;
+  for (const Cavity& cav : out.cavities.cavities) dead.insert(dead.end(), cav.deactivated_cells.begin(), cav.deactivated_cells.end());
+  std::sort(dead.begin(), dead.end());
+  const CornerPointLocator rock_of(model, faces, dead, coords);
+  auto set_rock = [&](CellAttributes& at) {
+    const int c = rock_of.cell_at_or_nearest(at.fv_center);
+    at.perm = reservoir_permeability(cs.reservoir, c);
+    at.porosity = reservoir_porosity(cs.reservoir, c);
+  };
+  for (WellBlock& b : out.blocks)
+    for (CellAttributes& at : b.cell_attrs) set_rock(at);
+
+  MeshBuilder builder;
+  add_nodes(builder, faces, well_nodes, out.blocks);
+  add_corner_point_cells(model, faces, cs.reservoir, out.cavities.reservoir_active, builder);
+  stage.mark("reservoir_cells");
+  std::vector<int32_t> transition_cavity;
+  std::vector<double> h_ref;
+  for (size_t k = 0; k < transitions.size(); ++k) {
+    TransitionCells& t = transitions[k];
+    const int32_t first = builder.n_nodes();
+    for (const Vec3& p : t.new_nodes) builder.add_node(p);
+    for (size_t c = 0; c < t.cells.size(); ++c) {
+      std::vector<CellFace> cell = t.cells[c];
+      for (CellFace& f : cell)
+        for (int32_t& v : f.nodes)
+          if (v >= t.base_node_id) v = v - t.base_node_id + first;
+      CellAttributes at;
+      at.region = kTransition;
+      at.fv_center = t.sites[c];
+      set_rock(at);
+      builder.add_cell(cell, at);
+      transition_cavity.push_back(static_cast<int32_t>(k));
+      h_ref.push_back(t.h_ref[c]);
+    }
+    out.transition_reports.push_back(t.report);
+  }
+  out.mesh = builder.finish(&out.build_report);
+  fill_cell_maps(out, transition_cavity, h_ref);
   out.geometry = compute_geometry(out.mesh);
-  stage("assembly_geometry");
+  stage.mark("assembly_geometry");
+  std::vector<int> all_wells(nw);
+  for (int w = 0; w < nw; ++w) all_wells[w] = w;
+  if (opts.build_transition && !out.build_report.ok)
+    throw MeshingError("assembly", all_wells,
+                       "assembly: the hybrid mesh in the corner-point model is not conforming: " +
+                           (out.build_report.problems.empty() ? std::string("?") : out.build_report.problems[0]));
+  close_unperforated_wellbore(out.mesh, out.geometry, cs);
+  if (!opts.build_transition) return out;
+  auto quality_of = [&](const TransitionCells& t) {
+    const PolyMesh sub = transition_submesh(t, coords);
+    return transition_quality(sub, compute_geometry(sub), t.h_ref);
+  };
+  for (const TransitionCells& t : transitions) {
+    out.optimized = out.optimized || t.unoptimized != nullptr;
+    add_quality(out.transition_before, quality_of(t.unoptimized ? *t.unoptimized : t));
+    if (t.unoptimized) add_quality(out.transition_after, quality_of(t));
+  }
+  std::vector<std::vector<int>> cavity_wells;
+  for (const Cavity& c : out.cavities.cavities) cavity_wells.push_back(c.wells);
+  out.self_check = self_check(out.mesh, out.geometry, out.build_report, out.cell_cavity, cavity_wells, cs);
+  stage.mark("self_check");
+  if (!out.self_check.ok()) throw MeshingError("self-check", out.self_check.wells, out.self_check.message);
+  return out;
+}
+
+}  // namespace
+
+HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
+  const CornerPointModel& model = *cs.reservoir.corner_point;
+  if (!cs.wells.empty()) return build_corner_point_wells(cs, opts);
+  HybridMesh out;
+  Stages stage(out, opts);
+  out.grid = make_reservoir_grid(cs.reservoir);  // index arithmetic only (nx, ny, nz)
+  MeshBuilder builder;
+  const CornerPointCells cells = add_corner_point_cells(model, cs.reservoir, all_present(model), builder);
+  out.mesh = builder.finish(&out.build_report);
+  stage.mark("reservoir_cells");
+  fill_cell_maps(out, {}, {});
+  out.geometry = compute_geometry(out.mesh);
+  stage.mark("assembly_geometry");
   if (cells.zero_volume_cells > 0)
     out.notes.push_back("reservoir: " + std::to_string(cells.zero_volume_cells) +
                         " active cells of zero thickness on all their pillars are not meshed (OPM Flow drops them: pore "
                         "volume 0)");
-  out.notes.push_back("reservoir: corner-point model meshed as its " + std::to_string(nc) + " cells (" +
+  out.notes.push_back("reservoir: corner-point model meshed as its " + std::to_string(out.mesh.n_cells()) + " cells (" +
                       std::to_string(cells.fault_faces) + " fault faces, " + std::to_string(cells.crossing_nodes) +
                       " edge crossings on faults)");
   if (!out.build_report.ok)
@@ -53,7 +245,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
                            (out.build_report.problems.empty() ? std::string("?") : out.build_report.problems[0]));
   if (!opts.build_transition) return out;
   out.self_check = self_check(out.mesh, out.geometry, out.build_report, out.cell_cavity, {}, cs);
-  stage("self_check");
+  stage.mark("self_check");
   if (!out.self_check.ok()) throw MeshingError("self-check", {}, out.self_check.message);
   return out;
 }

@@ -27,13 +27,15 @@ std::vector<PolygonFrame> frames_of(const Cavity& cavity, const std::vector<Vec3
   return frames;
 }
 
-// A polygon's external site is a reflection unless it faces an active reservoir cell.
-bool mirrored(const ConstrainedFace& f) { return !(f.side == FaceSide::Reservoir && f.outside_cell >= 0); }
+// A polygon's external site is a reflection unless it faces an active reservoir box.
+bool mirrored(const Cavity& cavity, const ConstrainedFace& f) {
+  return !(cavity.cells_are_boxes && f.side == FaceSide::Reservoir && f.outside_cell >= 0);
+}
 
 std::vector<int> non_admissible(const Cavity& cavity, const std::vector<PolygonFrame>& frames) {
   std::vector<int> bad;
   for (size_t q = 0; q < frames.size(); ++q)
-    if (!(frames[q].t_in > 0) || (mirrored(cavity.faces[q]) && !(frames[q].t_out < 0)))
+    if (!(frames[q].t_in > 0) || (mirrored(cavity, cavity.faces[q]) && !(frames[q].t_out < 0)))
       bad.push_back(static_cast<int>(q));
   return bad;
 }

@@ -419,8 +419,9 @@ SiteSet make_sites(const Cavity& cavity, const std::vector<Vec3>& coords, const 
   set.external_of.assign(nq, -1);
   // Group reservoir polygons by deactivated (inside) and active (outside) cell; std::map
   // keeps the site order deterministic.
+  // In a corner-point cavity (cells not boxes) no polygon has a box site.
   std::map<int32_t, std::vector<int>> by_inside, by_outside;
-  for (int q = 0; q < nq; ++q) {
+  for (int q = 0; q < nq && cavity.cells_are_boxes; ++q) {
     const ConstrainedFace& cf = cavity.faces[q];
     if (cf.side != FaceSide::Reservoir) continue;
     if (cf.inside_cell >= 0) by_inside[cf.inside_cell].push_back(q);

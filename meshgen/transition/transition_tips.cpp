@@ -214,7 +214,7 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
 
   int added = 0;
   auto try_place = [&](Vec3 f, double delta) {
-    const int cell = cell_at(grid, f);
+    const int cell = cavity.locate_cell ? cavity.locate_cell(f) : cell_at(grid, f);
     if (cell < 0 || !std::binary_search(cavity.deactivated_cells.begin(), cavity.deactivated_cells.end(), cell))
       return;
     bool in_block = false;

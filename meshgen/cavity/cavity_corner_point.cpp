@@ -1,0 +1,254 @@
+#include "cavity_corner_point.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <string>
+
+#include "meshgen/grids/gabriel.hpp"
+
+namespace hm {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Axis-aligned box of a model cell's 8 corners (the cell lies inside the corners' convex hull).
+void cell_box(const CornerPointModel& m, int c, Vec3& lo, Vec3& hi) {
+  lo = hi = model_cell_corner(m, c, 0);
+  for (int q = 1; q < 8; ++q) {
+    const Vec3 p = model_cell_corner(m, c, q);
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  }
+}
+
+std::string cell_name(const CornerPointModel& m, int c) {
+  return "(" + std::to_string(c % m.nx + 1) + ", " + std::to_string((c / m.nx) % m.ny + 1) + ", " +
+         std::to_string(c / (m.nx * m.ny) + 1) + ")";
+}
+
+// Solid angle of triangle abc seen from x (Van Oosterom and Strackee), signed by orientation.
+double solid_angle(Vec3 x, const std::array<Vec3, 3>& t) {
+  const Vec3 a = t[0] - x, b = t[1] - x, c = t[2] - x;
+  const double la = norm(a), lb = norm(b), lc = norm(c);
+  const double num = dot(a, cross(b, c));
+  const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  return 2.0 * std::atan2(num, den);
+}
+
+// One reservoir polygon of the current cavity boundary: a constrained triangle of the face of
+// active cell `outside` toward deactivated cell `inside`.
+struct ResTriangle {
+  std::vector<int32_t> nodes;
+  int32_t outside, inside;
+};
+
+std::vector<ResTriangle> reservoir_triangles(const CornerPointCellFaces& cells, const std::vector<char>& active,
+                                             const std::vector<Vec3>& coords) {
+  std::vector<ResTriangle> out;
+  for (size_t c = 0; c < cells.faces.size(); ++c) {
+    if (!cells.meshed[c] || !active[c]) continue;
+    for (CavityTriangle& t : cavity_triangles(cells, static_cast<int>(c), active, coords))
+      out.push_back({std::move(t.nodes), static_cast<int32_t>(c), t.inside});
+  }
+  return out;
+}
+
+}  // namespace
+
+CornerPointLocator::CornerPointLocator(const CornerPointModel& model, const CornerPointCellFaces& cells,
+                                       const std::vector<int32_t>& among, const std::vector<Vec3>& coords) {
+  for (int32_t c : among) {
+    if (!cells.meshed[c]) continue;
+    Cell cell;
+    cell.id = c;
+    cell_box(model, c, cell.lo, cell.hi);
+    cell.centre = Vec3{0, 0, 0};
+    for (int q = 0; q < 8; ++q) cell.centre += model_cell_corner(model, c, q) / 8.0;
+    for (const CellFace& f : cells.faces[c])
+      for (const auto& t : face_triangles(f.nodes, coords)) cell.triangles.push_back({coords[t[0]], coords[t[1]], coords[t[2]]});
+    cells_.push_back(std::move(cell));
+  }
+}
+
+int CornerPointLocator::cell_at(Vec3 x) const {
+  for (const Cell& c : cells_) {
+    bool out = false;
+    for (int a = 0; a < 3; ++a) out = out || x[a] < c.lo[a] || x[a] > c.hi[a];
+    if (out) continue;
+    double w = 0;
+    for (const auto& t : c.triangles) w += solid_angle(x, t);
+    if (std::abs(w) > 2.0 * kPi) return c.id;  // winding number 1 (4 pi), not 0
+  }
+  return -1;
+}
+
+int CornerPointLocator::cell_at_or_nearest(Vec3 x) const {
+  const int c = cell_at(x);
+  if (c >= 0) return c;
+  int best = -1;
+  double d2 = INFINITY;
+  for (const Cell& cell : cells_)
+    if (norm2(cell.centre - x) < d2) d2 = norm2(cell.centre - x), best = cell.id;
+  return best;
+}
+
+CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel& model,
+                                      const CornerPointCellFaces& cells, const std::vector<WellBlock>& blocks,
+                                      const std::vector<std::vector<int32_t>>& well_node_ids,
+                                      const std::vector<Vec3>& coords,
+                                      const std::vector<int32_t>& extra_deactivated) {
+  CavitySet out;
+  const int nc = model.nx * model.ny * model.nz;
+  out.reservoir_active.assign(nc, 1);
+  std::vector<char>& active = out.reservoir_active;
+  if (blocks.empty()) return out;
+  std::vector<Vec3> lo(nc), hi(nc);
+  for (int c = 0; c < nc; ++c)
+    if (cells.meshed[c]) cell_box(model, c, lo[c], hi[c]);
+
+  // 1. The meshed cells whose corner box comes within dilation x drainage radius of a well's
+  //    meshed path (conservative: the box holds the cell).
+  const double dil = cs.transition.dilation;
+  for (const WellBlock& b : blocks) {
+    const double reach = dil * b.radii.back();
+    for (int c = 0; c < nc; ++c)
+      if (cells.meshed[c] && box_polyline_distance(lo[c], hi[c], b.trajectory) <= reach) active[c] = 0;
+  }
+  for (int32_t c : extra_deactivated)
+    if (c >= 0 && c < nc) active[c] = 0;
+  const ReservoirGrid index_grid = make_reservoir_grid(cs.reservoir);  // index arithmetic (nx, ny, nz)
+  int regularized = regularize_deactivated(index_grid, active);
+
+  // 2. Gabriel across the two sides (paper 5.1), as in build_cavities: where a reservoir triangle
+  //    or edge holds a well vertex in its diametral sphere, or a well polygon or edge a reservoir
+  //    vertex, the active cells behind the reservoir triangles involved are deactivated.
+  const WellSurfaces well_side = well_surfaces(blocks, well_node_ids);
+  const std::vector<int32_t>& well_vertices = well_side.vertices;
+  const std::vector<std::array<int32_t, 2>>& well_edges = well_side.edges;
+  const std::vector<std::vector<int32_t>>& well_polygons = well_side.polygons;
+  int repaired = 0, rounds = 0, remaining = 0;
+  for (rounds = 0; rounds < 60; ++rounds) {
+    const std::vector<ResTriangle> tris = reservoir_triangles(cells, active, coords);
+    std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> edge_cells;
+    std::map<int32_t, std::vector<int32_t>> vertex_cells;
+    std::vector<std::vector<int32_t>> polys;
+    for (const ResTriangle& t : tris) {
+      for (size_t i = 0; i < 3; ++i) {
+        const int32_t a = t.nodes[i], b = t.nodes[(i + 1) % 3];
+        edge_cells[{std::min(a, b), std::max(a, b)}].push_back(t.outside);
+        vertex_cells[a].push_back(t.outside);
+      }
+      polys.push_back(t.nodes);
+    }
+    std::vector<std::array<int32_t, 2>> res_edges;
+    for (const auto& [e, c] : edge_cells) res_edges.push_back({e.first, e.second});
+    std::vector<int32_t> res_vertices;
+    for (const auto& [v, c] : vertex_cells) res_vertices.push_back(v);
+    const auto bad_res = gabriel_violations(coords, res_edges, well_vertices);
+    const auto bad_well = gabriel_violations(coords, well_edges, res_vertices);
+    const auto bad_res_faces = face_gabriel_violations(coords, polys, well_vertices);
+    const auto bad_well_faces = face_gabriel_violations(coords, well_polygons, res_vertices);
+    remaining = static_cast<int>(bad_res.size() + bad_well.size() + bad_res_faces.size() + bad_well_faces.size());
+    if (remaining == 0) break;
+    std::set<int32_t> grow;
+    for (const GabrielViolation& v : bad_res) {
+      const auto& c = edge_cells.at({v.a, v.b});
+      grow.insert(c.begin(), c.end());
+    }
+    for (const GabrielViolation& v : bad_well) grow.insert(vertex_cells.at(v.p).begin(), vertex_cells.at(v.p).end());
+    for (const FaceGabrielViolation& v : bad_res_faces) grow.insert(tris[v.polygon].outside);
+    for (const FaceGabrielViolation& v : bad_well_faces)
+      grow.insert(vertex_cells.at(v.p).begin(), vertex_cells.at(v.p).end());
+    if (grow.empty()) break;
+    for (int32_t c : grow) active[c] = 0;
+    repaired += static_cast<int>(grow.size());
+    regularized += regularize_deactivated(index_grid, active);
+  }
+  out.gabriel_violations_remaining = remaining;
+  if (remaining > 0)
+    throw InputError("wells: the cavity in the corner-point model cannot be made Gabriel (" + std::to_string(remaining) +
+                     " violations left after " + std::to_string(rounds) +
+                     " rounds); move the wells apart or reduce their drainage_radius");
+  if (repaired > 0)
+    out.notes.push_back("cavity: Gabriel repair deactivated " + std::to_string(repaired) + " more model cells in " +
+                        std::to_string(rounds) + " rounds (local dilation)");
+  if (regularized > 0)
+    out.notes.push_back("cavity: " + std::to_string(regularized) +
+                        " model cells deactivated to keep the cavity boundary a 2-manifold");
+
+  // 3. A deactivated cell must have a meshed cell across each of its faces: the model's outer
+  //    surface (and gaps: inactive or zero-thickness cells) has no mirror plane.
+  std::vector<int32_t> dead;
+  for (int c = 0; c < nc; ++c) {
+    if (!cells.meshed[c] || active[c]) continue;
+    dead.push_back(c);
+    for (int32_t nb : cells.neighbour[c])
+      if (nb < 0)
+        throw InputError("wells: the cavity around the wells reaches the outer surface of the corner-point model " +
+                         cs.reservoir.grdecl + " at cell " + cell_name(model, c) +
+                         " (its top, bottom or sides, or an inactive or zero-thickness cell): in a corner-point model a "
+                         "well's meshed path must stay inside, at least one layer and dilation x drainage_radius from "
+                         "that surface (docs/corner-point.md)");
+  }
+
+  // 4. Cavities: connected components of the deactivated cells across their faces.
+  std::vector<int> comp(nc, -1);
+  int n_comp = 0;
+  for (int32_t s : dead) {
+    if (comp[s] >= 0) continue;
+    std::vector<int32_t> stack{s};
+    comp[s] = n_comp;
+    while (!stack.empty()) {
+      const int32_t c = stack.back();
+      stack.pop_back();
+      for (int32_t nb : cells.neighbour[c])
+        if (nb >= 0 && cells.meshed[nb] && !active[nb] && comp[nb] < 0) comp[nb] = n_comp, stack.push_back(nb);
+    }
+    ++n_comp;
+  }
+  out.cavities.resize(n_comp);
+  for (int32_t c : dead) out.cavities[comp[c]].deactivated_cells.push_back(c);
+  // Each well to the cavity of the deactivated cell nearest the middle of its block's first segment.
+  for (size_t w = 0; w < blocks.size(); ++w) {
+    const Vec3 p = 0.5 * (blocks[w].layer_center[0] + blocks[w].layer_center[1]);
+    int best = -1;
+    double d = INFINITY;
+    for (int32_t c : dead) {
+      const double dc = box_polyline_distance(lo[c], hi[c], {p, p});
+      if (dc < d) d = dc, best = c;
+    }
+    if (best < 0) throw InputError("wells[" + std::to_string(blocks[w].well) + "].trajectory: not inside a cavity");
+    out.cavities[comp[best]].wells.push_back(static_cast<int>(w));
+  }
+
+  // 5. Boundaries: the reservoir triangles (in the active cells' order), then the blocks' polygons.
+  const std::vector<ResTriangle> tris = reservoir_triangles(cells, active, coords);
+  for (const ResTriangle& t : tris) {
+    ConstrainedFace f;
+    f.nodes = t.nodes;  // the active cell's outward orientation: into the cavity
+    f.side = FaceSide::Reservoir;
+    f.outside_cell = t.outside;
+    f.inside_cell = t.inside;
+    out.cavities[comp[t.inside]].faces.push_back(std::move(f));
+  }
+  for (size_t k = 0; k < out.cavities.size(); ++k) {
+    Cavity& cav = out.cavities[k];
+    if (cav.wells.empty()) throw InputError("wells: internal error, a cavity without a well");
+    add_well_polygons(cav, blocks, well_node_ids);
+    double dmax = 0;
+    for (int32_t c : cav.deactivated_cells) {
+      double best = INFINITY;
+      for (int w : cav.wells) best = std::min(best, box_polyline_distance(lo[c], hi[c], blocks[w].trajectory) / blocks[w].radii.back());
+      dmax = std::max(dmax, best);
+    }
+    cav.dilation_used = std::max(dil, dmax);
+    cav.cells_are_boxes = false;
+    auto locator = std::make_shared<const CornerPointLocator>(model, cells, cav.deactivated_cells, coords);
+    cav.locate_cell = [locator](Vec3 x) { return locator->cell_at(x); };
+  }
+  return out;
+}
+
+}  // namespace hm
