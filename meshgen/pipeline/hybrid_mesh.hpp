@@ -85,7 +85,8 @@ class MeshingError : public std::runtime_error {
 /// maps the mesh back (permeability_frame.hpp, docs/anisotropy.md).
 HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts = {});
 /// The job for a true corner-point reservoir (`ReservoirSpec::corner_point`): the model's active cells
-/// as the mesh (no wells yet: a case with wells is an InputError). build_hybrid_mesh calls it.
+/// as the mesh, and with wells a cavity of model cells per well group (docs/corner-point.md; a cavity
+/// reaching the model's outer surface is an InputError). build_hybrid_mesh calls it.
 HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& opts = {});
 /// The job in the case's own coordinates, orthogonal in the Euclidean sense.
 HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& cs, const PipelineOptions& opts = {});
