@@ -18,13 +18,11 @@ namespace {
 constexpr size_t kWorstIds = 10;
 
 // Ids of the (up to) k entries with the worst values, worst first; NaN counts as worst.
-// Only entries accepted by `keep` are considered.
+// Only entries accepted by `keep` are considered. Ties go to the smaller id, so the order is
+// total: each chunk's k worst are found in parallel, and the k worst of their union are the
+// k worst of all.
 template <class Keep>
 std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_worse, Keep keep) {
-  std::vector<int32_t> idx;
-  idx.reserve(v.size());
-  for (size_t i = 0; i < v.size(); ++i)
-    if (keep(i)) idx.push_back(static_cast<int32_t>(i));
   auto key = [&](int32_t i) {
     const double x = v[i];
     if (std::isnan(x)) return higher_is_worse ? std::numeric_limits<double>::infinity()
@@ -36,10 +34,23 @@ std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_w
     if (ka != kb) return higher_is_worse ? ka > kb : ka < kb;
     return a < b;
   };
-  const size_t k = std::min(kWorstIds, idx.size());
-  std::partial_sort(idx.begin(), idx.begin() + k, idx.end(), worse);
-  idx.resize(k);
-  return idx;
+  auto k_worst = [&](std::vector<int32_t>& idx) {
+    const size_t k = std::min(kWorstIds, idx.size());
+    std::partial_sort(idx.begin(), idx.begin() + k, idx.end(), worse);
+    idx.resize(k);
+  };
+  std::vector<int32_t> candidates;
+  std::mutex candidates_mutex;
+  parallel_ranges(static_cast<int64_t>(v.size()), [&](int64_t b, int64_t e) {
+    std::vector<int32_t> idx;
+    for (int64_t i = b; i < e; ++i)
+      if (keep(static_cast<size_t>(i))) idx.push_back(static_cast<int32_t>(i));
+    k_worst(idx);
+    std::lock_guard<std::mutex> lock(candidates_mutex);
+    candidates.insert(candidates.end(), idx.begin(), idx.end());
+  }, 1 << 16);
+  k_worst(candidates);
+  return candidates;
 }
 std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_worse) {
   return worst_ids_of(v, higher_is_worse, [](size_t) { return true; });

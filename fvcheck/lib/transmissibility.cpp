@@ -303,7 +303,7 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
         t.face[f] = t.half_owner[f];
       }
     }
-  });
+  }, 256);  // small chunks: the end-cap faces (a quadrature each) lie together
   for (int f = 0; f < nf; ++f) {
     if (!bad[f]) continue;
     t.negative += bad[f];
