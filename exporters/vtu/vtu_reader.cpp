@@ -388,6 +388,7 @@ void read_piece(const Source& src, vtkXMLDataElement* piece, Parsed& out) {
     if (!arr) fail("piece without <Points><DataArray>");
     const Array p = read_array(src, arr, 3 * np);
     if (p.components != 3) fail("Points must have 3 components");
+    out.points.reserve(static_cast<size_t>(base + np));
     for (int64_t k = 0; k < np; ++k) out.points.push_back({p.as_double(3 * k), p.as_double(3 * k + 1), p.as_double(3 * k + 2)});
   }
   if (nc > 0) {
@@ -407,6 +408,22 @@ void read_piece(const Source& src, vtkXMLDataElement* piece, Parsed& out) {
       if (!faceoffsets.is_int) fail("faceoffsets must be an integer array");
       faces = read_array(src, e_faces, end_from_offsets(faceoffsets, true, "faceoffsets"));
       if (!faces.is_int) fail("faces must be an integer array");
+    }
+    {  // room for every face and face node (a polyhedron's stream bounds its own)
+      int64_t faces_needed = 0, nodes_needed = 0;
+      for (int64_t c = 0; c < nc; ++c) {
+        int npts = 0;
+        const std::vector<std::vector<int>>* tmpl =
+            standard_faces(static_cast<int>(std::clamp<int64_t>(types.i[c], -1, 1000)), &npts);
+        if (!tmpl) continue;
+        faces_needed += static_cast<int64_t>(tmpl->size());
+        for (const auto& lf : *tmpl) nodes_needed += static_cast<int64_t>(lf.size());
+      }
+      nodes_needed += static_cast<int64_t>(faces.i.size());
+      faces_needed += static_cast<int64_t>(faces.i.size()) / 4;
+      out.cells.nodes.reserve(out.cells.nodes.size() + static_cast<size_t>(nodes_needed));
+      out.cells.face_ptr.reserve(out.cells.face_ptr.size() + static_cast<size_t>(faces_needed));
+      out.cells.cell_ptr.reserve(out.cells.cell_ptr.size() + static_cast<size_t>(nc));
     }
     int64_t conn_begin = 0, face_begin = 0;
     for (int64_t c = 0; c < nc; ++c) {
@@ -537,9 +554,8 @@ Parsed parse_document(Source& src) {
 }
 
 // Canonical form of every face of a file (start at the smallest id, direction towards the
-// smaller neighbour, as canonical_cycle_into) and a hash of it.
+// smaller neighbour, as canonical_cycle_into).
 struct FaceKeys {
-  std::vector<uint64_t> hash;
   std::vector<int32_t> start;
   std::vector<uint8_t> rev;
 };
@@ -549,10 +565,8 @@ bool face_keys(const RawCells& cells, FaceKeys* keys) {
   const int64_t nq = cells.faces();
   const int32_t* nodes = cells.nodes.data();
   const int64_t* fp = cells.face_ptr.data();
-  std::vector<uint64_t>& hash = keys->hash;
   std::vector<int32_t>& start = keys->start;
   std::vector<uint8_t>& rev = keys->rev;
-  hash.resize(static_cast<size_t>(nq));
   start.resize(static_cast<size_t>(nq));
   rev.resize(static_cast<size_t>(nq));
   std::vector<uint8_t> irregular(static_cast<size_t>(nq), 0);
@@ -575,33 +589,26 @@ bool face_keys(const RawCells& cells, FaceKeys* keys) {
         continue;
       }
       const int64_t k = std::min_element(c, c + n) - c;
-      const bool r = c[(k + n - 1) % n] < c[(k + 1) % n];
-      uint64_t h = 1469598103934665603ull;
-      for (int64_t i = 0, j = k; i < n; ++i) {  // j: the i-th canonical position, without a division
-        h ^= static_cast<uint32_t>(c[j]);
-        h *= 1099511628211ull;
-        j = r ? (j == 0 ? n - 1 : j - 1) : (j == n - 1 ? 0 : j + 1);
-      }
-      hash[q] = h ^ (h >> 29);
       start[q] = static_cast<int32_t>(k);
-      rev[q] = r;
+      rev[q] = c[(k + n - 1) % n] < c[(k + 1) % n];
     }
   });
   return std::none_of(irregular.begin(), irregular.end(), [](uint8_t x) { return x != 0; });
 }
 
 // The partner of each file face (the other file face with the same cycle, -1 if none). Faces are
-// bucketed by the top bits of their hash (counted and scattered in file order), each bucket
-// sorted by (hash, file face) and matched on its own, so the result does not depend on the
-// threads. False if a face is named a third time, twice by one cell or twice in one orientation.
-bool match_faces(const RawCells& cells, const FaceKeys& keys, const std::vector<int32_t>& cell_of,
+// grouped by their smallest point (counted and scattered in file order: a face and its partner
+// share it), and each group is matched on its own in file order, so the result does not depend
+// on the threads. False if a face is named a third time, twice by one cell or twice in one
+// orientation.
+bool match_faces(const RawCells& cells, int64_t n_points, const FaceKeys& keys, const std::vector<int32_t>& cell_of,
                  std::vector<int32_t>* partner_out) {
   const int64_t nq = cells.faces();
   const int32_t* nodes = cells.nodes.data();
   const int64_t* fp = cells.face_ptr.data();
-  const std::vector<uint64_t>& hash = keys.hash;
   const std::vector<int32_t>& start = keys.start;
   const std::vector<uint8_t>& rev = keys.rev;
+  auto smallest = [&](int64_t q) { return nodes[fp[q] + start[q]]; };
   auto same = [&](int64_t a, int64_t b) {
     const int64_t n = fp[a + 1] - fp[a];
     if (n != fp[b + 1] - fp[b]) return false;
@@ -613,40 +620,61 @@ bool match_faces(const RawCells& cells, const FaceKeys& keys, const std::vector<
     }
     return true;
   };
-  const int bits = 16;
-  const size_t nb = size_t(1) << bits;
-  std::vector<int64_t> bucket_ptr(nb + 1, 0);
-  for (int64_t q = 0; q < nq; ++q) ++bucket_ptr[(hash[q] >> (64 - bits)) + 1];
-  for (size_t i = 0; i < nb; ++i) bucket_ptr[i + 1] += bucket_ptr[i];
-  std::vector<int32_t> order(static_cast<size_t>(nq));  // file faces, by bucket
+  std::vector<int32_t> group_ptr(static_cast<size_t>(n_points) + 1, 0);
+  for (int64_t q = 0; q < nq; ++q) ++group_ptr[smallest(q) + 1];
+  for (int64_t v = 0; v < n_points; ++v) group_ptr[v + 1] += group_ptr[v];
+  std::vector<int32_t> order(static_cast<size_t>(nq));  // file faces, by smallest point, in file order
   {
-    std::vector<int64_t> fill(bucket_ptr.begin(), bucket_ptr.end() - 1);
-    for (int64_t q = 0; q < nq; ++q) order[fill[hash[q] >> (64 - bits)]++] = static_cast<int32_t>(q);
+    std::vector<int32_t> fill(group_ptr.begin(), group_ptr.end() - 1);
+    for (int64_t q = 0; q < nq; ++q) order[fill[smallest(q)]++] = static_cast<int32_t>(q);
   }
+  // Canonical cycles compared in order (sizes first), then file order: equal faces end up
+  // adjacent and in file order.
+  auto canonical_less = [&](int32_t a, int32_t b) {
+    const int64_t na = fp[a + 1] - fp[a], nb = fp[b + 1] - fp[b];
+    if (na != nb) return na < nb;
+    const int32_t *ca = nodes + fp[a], *cb = nodes + fp[b];
+    for (int64_t i = 0, ja = start[a], jb = start[b]; i < na; ++i) {
+      if (ca[ja] != cb[jb]) return ca[ja] < cb[jb];
+      ja = rev[a] ? (ja == 0 ? na - 1 : ja - 1) : (ja == na - 1 ? 0 : ja + 1);
+      jb = rev[b] ? (jb == 0 ? nb - 1 : jb - 1) : (jb == nb - 1 ? 0 : jb + 1);
+    }
+    return a < b;
+  };
   std::vector<int32_t>& partner = *partner_out;
   partner.assign(static_cast<size_t>(nq), -1);
-  std::vector<uint8_t> bad(nb, 0);
-  parallel_ranges(static_cast<int64_t>(nb), [&](int64_t b, int64_t e) {
-    for (int64_t k = b; k < e; ++k) {
-      int32_t* lo = order.data() + bucket_ptr[k];
-      int32_t* hi = order.data() + bucket_ptr[k + 1];
-      std::sort(lo, hi, [&](int32_t x, int32_t y) { return hash[x] != hash[y] ? hash[x] < hash[y] : x < y; });
-      for (int32_t* run = lo; run < hi;) {
-        int32_t* end = run;
-        while (end < hi && hash[*end] == hash[*run]) ++end;
-        for (int32_t* i = run + 1; i < end; ++i)
-          for (int32_t* j = run; j < i; ++j) {
-            if (!same(*j, *i)) continue;
-            // *i is a later use of the face first named by *j (or by *j's partner)
-            if (partner[*j] >= 0 || partner[*i] >= 0 || cell_of[*j] == cell_of[*i] || rev[*j] == rev[*i]) bad[k] = 1;
-            partner[*j] = *i;
-            partner[*i] = *j;
-            break;
-          }
-        run = end;
+  std::vector<uint8_t> bad(static_cast<size_t>(n_points), 0);
+  constexpr int64_t kPairwiseGroup = 32;  // larger groups are sorted (no quadratic cost)
+  parallel_ranges(n_points, [&](int64_t b, int64_t e) {
+    std::vector<int32_t> sorted;
+    for (int64_t v = b; v < e; ++v) {
+      int32_t* lo = order.data() + group_ptr[v];
+      int32_t* hi = order.data() + group_ptr[v + 1];
+      // *i is a later use of the face first named by *j (or by *j's partner)
+      auto pair_up = [&](int32_t j, int32_t i) {
+        if (partner[j] >= 0 || partner[i] >= 0 || cell_of[j] == cell_of[i] || rev[j] == rev[i]) bad[v] = 1;
+        partner[j] = i;
+        partner[i] = j;
+      };
+      if (hi - lo <= kPairwiseGroup) {
+        for (const int32_t* i = lo + 1; i < hi; ++i)
+          for (const int32_t* j = lo; j < i; ++j)
+            if (same(*j, *i)) {
+              pair_up(*j, *i);
+              break;
+            }
+        continue;
+      }
+      // The same pairs as the pairwise scan: each later face of a run of equal faces with its first.
+      sorted.assign(lo, hi);
+      std::sort(sorted.begin(), sorted.end(), canonical_less);
+      for (size_t r = 0; r < sorted.size();) {
+        size_t end = r + 1;
+        while (end < sorted.size() && same(sorted[r], sorted[end])) pair_up(sorted[r], sorted[end]), ++end;
+        r = end;
       }
     }
-  }, 64);
+  });
   return std::none_of(bad.begin(), bad.end(), [](uint8_t x) { return x != 0; });
 }
 
@@ -670,7 +698,7 @@ bool build_regular_mesh(const RawCells& cells, const std::vector<Vec3>& points, 
       for (int64_t q = cells.cell_ptr[c]; q < cells.cell_ptr[c + 1]; ++q) cell_of[q] = static_cast<int32_t>(c);
   });
   std::vector<int32_t> partner;
-  if (!match_faces(cells, keys, cell_of, &partner)) return false;
+  if (!match_faces(cells, static_cast<int64_t>(points.size()), keys, cell_of, &partner)) return false;
   keys = FaceKeys{};
   // Faces numbered by first use (file order), as MeshBuilder numbers them.
   std::vector<int32_t> face_id(static_cast<size_t>(nq));
@@ -785,10 +813,16 @@ ReadResult convert(Parsed&& in, VtuAssembly assembly) {
     build_with_mesh_builder(in, res);
   }
   PolyMesh& m = res.mesh;
-  for (const Array& a : in.cell_data) {
-    std::vector<double> v(a.size());
-    for (size_t q = 0; q < a.size(); ++q) v[q] = a.as_double(q);
-    res.cell_arrays.push_back(VtuCellArray::real(a.name, a.components, std::move(v)));
+  for (Array& a : in.cell_data) {  // as doubles; a Float64 array is moved, not copied
+    std::vector<double> v;
+    if (a.is_int) {
+      v.resize(a.size());
+      for (size_t q = 0; q < a.size(); ++q) v[q] = a.as_double(q);
+    } else {
+      v = std::move(a.d);
+    }
+    res.cell_arrays.push_back(VtuCellArray::real(std::move(a.name), a.components, std::move(v)));
+    a = Array{};
   }
   const RestoredArrays restored = restore_mesh_cell_arrays(res.cell_arrays, m);
   if (!restored.error.empty()) fail(restored.error);

@@ -18,13 +18,11 @@ namespace {
 constexpr size_t kWorstIds = 10;
 
 // Ids of the (up to) k entries with the worst values, worst first; NaN counts as worst.
-// Only entries accepted by `keep` are considered.
+// Only entries accepted by `keep` are considered. Ties go to the smaller id, so the order is
+// total: each chunk's k worst are found in parallel, and the k worst of their union are the
+// k worst of all.
 template <class Keep>
 std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_worse, Keep keep) {
-  std::vector<int32_t> idx;
-  idx.reserve(v.size());
-  for (size_t i = 0; i < v.size(); ++i)
-    if (keep(i)) idx.push_back(static_cast<int32_t>(i));
   auto key = [&](int32_t i) {
     const double x = v[i];
     if (std::isnan(x)) return higher_is_worse ? std::numeric_limits<double>::infinity()
@@ -36,10 +34,23 @@ std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_w
     if (ka != kb) return higher_is_worse ? ka > kb : ka < kb;
     return a < b;
   };
-  const size_t k = std::min(kWorstIds, idx.size());
-  std::partial_sort(idx.begin(), idx.begin() + k, idx.end(), worse);
-  idx.resize(k);
-  return idx;
+  auto k_worst = [&](std::vector<int32_t>& idx) {
+    const size_t k = std::min(kWorstIds, idx.size());
+    std::partial_sort(idx.begin(), idx.begin() + k, idx.end(), worse);
+    idx.resize(k);
+  };
+  std::vector<int32_t> candidates;
+  std::mutex candidates_mutex;
+  parallel_ranges(static_cast<int64_t>(v.size()), [&](int64_t b, int64_t e) {
+    std::vector<int32_t> idx;
+    for (int64_t i = b; i < e; ++i)
+      if (keep(static_cast<size_t>(i))) idx.push_back(static_cast<int32_t>(i));
+    k_worst(idx);
+    std::lock_guard<std::mutex> lock(candidates_mutex);
+    candidates.insert(candidates.end(), idx.begin(), idx.end());
+  }, 1 << 16);
+  k_worst(candidates);
+  return candidates;
 }
 std::vector<int32_t> worst_ids_of(const std::vector<double>& v, bool higher_is_worse) {
   return worst_ids_of(v, higher_is_worse, [](size_t) { return true; });
@@ -60,21 +71,32 @@ void push_example(std::vector<int32_t>& ids, int32_t id) {
 
 double coord_floor(double max_abs_coord) { return 64.0 * DBL_EPSILON * max_abs_coord; }
 
-// Bounding-box diagonal and absolute tolerance of a node set.
-void scale_of(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* e, double rel_tol, double* length,
-              double* tol) {
+// Bounding box and largest |coordinate| of the points added (repeats change nothing).
+struct ScaleBox {
   Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
   double amax = 0;
-  for (const int32_t* v = b; v != e; ++v) {
-    const Vec3 p = nodes[*v];
+  bool empty = true;
+  void add(Vec3 p) {
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], p[k]);
       hi[k] = std::max(hi[k], p[k]);
       amax = std::max(amax, std::fabs(p[k]));
     }
+    empty = false;
   }
-  *length = b == e ? 0.0 : norm(hi - lo);
-  *tol = std::max(rel_tol * *length, coord_floor(amax));
+  // Bounding-box diagonal and absolute tolerance.
+  void finish(double rel_tol, double* length, double* tol) const {
+    *length = empty ? 0.0 : norm(hi - lo);
+    *tol = std::max(rel_tol * *length, coord_floor(amax));
+  }
+};
+
+// Bounding-box diagonal and absolute tolerance of a node set.
+void scale_of(const std::vector<Vec3>& nodes, const int32_t* b, const int32_t* e, double rel_tol, double* length,
+              double* tol) {
+  ScaleBox box;
+  for (const int32_t* v = b; v != e; ++v) box.add(nodes[*v]);
+  box.finish(rel_tol, length, tol);
 }
 
 // Closest distance from p to triangle (a, b, c) (Ericson, Real-Time Collision Detection 5.1.5).
@@ -111,8 +133,10 @@ double point_triangle_distance(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
 
 // Uniform grid of a subset of nodes, for box queries (hanging-node search): buckets of side
 // `cell` (the median face extent, so that a face's box meets a few buckets), nodes sorted by
-// (bucket, id), a bucket's range found through an open-addressing hash of its index. A k-d
-// tree split at medians visits both sides of every tie, and a reservoir lattice is all ties.
+// (bucket, id). A bucket's range is found in a dense table of bucket starts when the grid has
+// at most a few buckets per node (a reservoir's lattice), else through an open-addressing hash
+// of its index. A k-d tree split at medians visits both sides of every tie, and a reservoir
+// lattice is all ties.
 class NodeGrid {
  public:
   NodeGrid(const std::vector<Vec3>& pts, const std::vector<int32_t>& ids, double cell) : pts_(pts) {
@@ -126,6 +150,20 @@ class NodeGrid {
     if (extent / cell_ > kMaxDim - 1) cell_ = extent / (kMaxDim - 1);
     if (!(cell_ > 0)) cell_ = 1.0;
     for (int a = 0; a < 3; ++a) dim_[a] = std::min<int64_t>(kMaxDim, static_cast<int64_t>((hi[a] - lo_[a]) / cell_) + 1);
+    const double buckets = static_cast<double>(dim_[0]) * static_cast<double>(dim_[1]) * static_cast<double>(dim_[2]);
+    if (buckets <= 4.0 * static_cast<double>(ids.size()) + 4096) {
+      // Counting sort by bucket; ids ascending within a bucket (ids is ascending).
+      dense_start_.assign(static_cast<size_t>(buckets) + 1, 0);
+      for (int32_t v : ids) ++dense_start_[key_of(pts[v]) + 1];
+      for (size_t b = 0; b + 1 < dense_start_.size(); ++b) {
+        occupied_ += dense_start_[b + 1] > 0;
+        dense_start_[b + 1] += dense_start_[b];
+      }
+      ids_.resize(ids.size());
+      std::vector<uint32_t> fill(dense_start_.begin(), dense_start_.end() - 1);
+      for (int32_t v : ids) ids_[fill[key_of(pts[v])]++] = v;
+      return;
+    }
     std::vector<std::pair<uint64_t, int32_t>> keyed;
     keyed.reserve(ids.size());
     for (int32_t v : ids) keyed.emplace_back(key_of(pts[v]), v);
@@ -135,6 +173,7 @@ class NodeGrid {
     for (size_t i = 0; i < keyed.size(); ++i)
       if (i == 0 || keyed[i].first != keyed[i - 1].first) keys_.push_back(keyed[i].first), begin_.push_back(i);
     begin_.push_back(keyed.size());
+    occupied_ = keys_.size();
     size_t size = 16;
     while (size < 2 * keys_.size()) size *= 2;
     table_.assign(size, -1);
@@ -150,24 +189,29 @@ class NodeGrid {
     if (ids_.empty()) return;
     int64_t i0[3], i1[3];
     for (int a = 0; a < 3; ++a) i0[a] = index(lo[a], a), i1[a] = index(hi[a], a);
-    auto inside = [&](Vec3 p) {
-      return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+    auto visit_inside = [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        const Vec3 p = pts_[ids_[i]];
+        if (p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z) visit(ids_[i]);
+      }
     };
     const double buckets = static_cast<double>(i1[0] - i0[0] + 1) * (i1[1] - i0[1] + 1) * (i1[2] - i0[2] + 1);
-    if (buckets > static_cast<double>(keys_.size())) {  // a box larger than the occupied grid: scan it all
-      for (size_t b = 0; b < keys_.size(); ++b)
-        for (size_t i = begin_[b]; i < begin_[b + 1]; ++i)
-          if (inside(pts_[ids_[i]])) visit(ids_[i]);
+    if (buckets > static_cast<double>(occupied_)) {  // a box larger than the occupied grid: scan it all
+      visit_inside(0, ids_.size());
       return;
     }
     for (int64_t z = i0[2]; z <= i1[2]; ++z)
-      for (int64_t y = i0[1]; y <= i1[1]; ++y)
-        for (int64_t x = i0[0]; x <= i1[0]; ++x) {
-          const int64_t b = find(static_cast<uint64_t>((z * dim_[1] + y) * dim_[0] + x));
-          if (b < 0) continue;
-          for (size_t i = begin_[b]; i < begin_[b + 1]; ++i)
-            if (inside(pts_[ids_[i]])) visit(ids_[i]);
+      for (int64_t y = i0[1]; y <= i1[1]; ++y) {
+        const int64_t row = (z * dim_[1] + y) * dim_[0];
+        if (!dense_start_.empty()) {  // the row's buckets x0..x1 are contiguous
+          visit_inside(dense_start_[row + i0[0]], dense_start_[row + i1[0] + 1]);
+          continue;
         }
+        for (int64_t x = i0[0]; x <= i1[0]; ++x) {
+          const int64_t b = find(static_cast<uint64_t>(row + x));
+          if (b >= 0) visit_inside(begin_[b], begin_[b + 1]);
+        }
+      }
   }
 
  private:
@@ -191,10 +235,12 @@ class NodeGrid {
   Vec3 lo_;
   double cell_ = 1.0;
   int64_t dim_[3] = {1, 1, 1};
-  std::vector<int32_t> ids_;      // sorted by (bucket, id)
-  std::vector<uint64_t> keys_;    // occupied buckets, ascending
-  std::vector<size_t> begin_;     // bucket b: ids_[begin_[b] .. begin_[b + 1])
-  std::vector<int64_t> table_;    // hash slot -> bucket, -1 empty
+  size_t occupied_ = 0;                // buckets holding a node
+  std::vector<int32_t> ids_;           // sorted by (bucket, id)
+  std::vector<uint32_t> dense_start_;  // dense grid: bucket b is ids_[dense_start_[b] .. dense_start_[b + 1])
+  std::vector<uint64_t> keys_;         // hashed grid: occupied buckets, ascending
+  std::vector<size_t> begin_;          // hashed grid: bucket k is ids_[begin_[k] .. begin_[k + 1])
+  std::vector<int64_t> table_;         // hashed grid: hash slot -> bucket, -1 empty
 };
 
 double cross2(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
@@ -224,10 +270,12 @@ CellScales compute_cell_scales(const PolyMesh& m, double rel_tol) {
   s.length.assign(m.n_cells(), 0.0);
   s.tol.assign(m.n_cells(), 0.0);
   parallel_ranges(m.n_cells(), [&](int64_t b, int64_t e) {
-    std::vector<int32_t> ids;
     for (int c = static_cast<int>(b); c < e; ++c) {
-      cell_node_ids_into(m, c, &ids);
-      scale_of(m.nodes, ids.data(), ids.data() + ids.size(), rel_tol, &s.length[c], &s.tol[c]);
+      // Over every face's nodes: a node shared by faces counts once in a box anyway.
+      ScaleBox box;
+      for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f)
+        for (const int32_t* v = m.face_begin(*f); v != m.face_end(*f); ++v) box.add(m.nodes[*v]);
+      box.finish(rel_tol, &s.length[c], &s.tol[c]);
     }
   });
   return s;
@@ -246,13 +294,27 @@ std::vector<int32_t> cell_node_ids(const PolyMesh& m, int c) {
   return ids;
 }
 
-int face_polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, const int32_t* end, double rel_tol) {
+namespace {
+
+// Whether |cross| <= tol * hypot(cx, cy), deciding on the bounds max(|cx|, |cy|) <= hypot <=
+// |cx| + |cy| (with a margin far above rounding) when they settle it: hypot is slow.
+bool on_chord_line(double abs_cross, double tol, double cx, double cy) {
+  const double ax = std::fabs(cx), ay = std::fabs(cy);
+  const double scale = tol * (ax + ay);
+  if (std::isfinite(scale) && scale > 1e-290 && std::isfinite(abs_cross)) {  // else (rare) as hypot has it
+    if (abs_cross > tol * (ax + ay) * (1 + 1e-6)) return false;
+    if (abs_cross < tol * std::max(ax, ay) * (1 - 1e-6)) return true;
+  }
+  return abs_cross <= tol * std::hypot(cx, cy);
+}
+
+// face_polygon_defect of a face whose area vector and centroid (polygon_area_centroid) are known.
+int polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, const int32_t* end, double rel_tol,
+                   Vec3 area, Vec3 centroid) {
   const int k = static_cast<int>(end - begin);
   if (k < 3) return 3;
   double diam = 0, tol = 0;
   scale_of(nodes, begin, end, rel_tol, &diam, &tol);
-  Vec3 area, centroid;
-  polygon_area_centroid(nodes, begin, end, &area, &centroid);
   const double an = norm(area);
   if (!(diam > 0) || !(an > tol * tol)) return 3;  // no usable normal
   const Vec3 n = area / an;
@@ -261,17 +323,30 @@ int face_polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, co
                         ? Vec3{1, 0, 0}
                         : (std::fabs(n.y) <= std::fabs(n.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1});
   const Vec3 u = normalized(cross(n, axis)), w = cross(n, u);
-  std::vector<double> q(2 * k);
+  // Projected corners: on the stack for the usual faces (no allocation per face).
+  std::array<double, 64> small;
+  std::vector<double> large;
+  if (2 * k > static_cast<int>(small.size())) large.resize(2 * k);
+  double* q = 2 * k > static_cast<int>(small.size()) ? large.data() : small.data();
   for (int i = 0; i < k; ++i) {
     const Vec3 d = nodes[begin[i]] - centroid;
     q[2 * i] = dot(d, u);
     q[2 * i + 1] = dot(d, w);
   }
   auto P = [&](int i) { return &q[2 * (((i % k) + k) % k)]; };
-  // Non-adjacent edges must keep apart.
+  // Non-adjacent edges must keep apart. Two edges whose boxes are 2 tol apart on an axis are
+  // farther than tol (far beyond rounding: tol >= 1e-9 of the face's extent).
+  auto apart = [&](const double* a0, const double* a1, const double* b0, const double* b1) {
+    for (int x = 0; x < 2; ++x)
+      if (std::min(b0[x], b1[x]) - std::max(a0[x], a1[x]) > 2 * tol ||
+          std::min(a0[x], a1[x]) - std::max(b0[x], b1[x]) > 2 * tol)
+        return true;
+    return false;
+  };
   for (int i = 0; i < k; ++i)
     for (int j = i + 2; j < k; ++j) {
       if (i == 0 && j == k - 1) continue;
+      if (apart(P(i), P(i + 1), P(j), P(j + 1))) continue;
       if (segment_distance_2d(P(i), P(i + 1), P(j), P(j + 1)) <= tol) return 2;
     }
   // Turns: (u, w, n) is right-handed and the cycle is counter-clockwise seen from n, so a
@@ -284,8 +359,7 @@ int face_polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, co
     const double* c = P(i + 1);
     const double e1x = b[0] - a[0], e1y = b[1] - a[1], e2x = c[0] - b[0], e2y = c[1] - b[1];
     const double cr = cross2(e1x, e1y, e2x, e2y);
-    const double chord = std::hypot(c[0] - a[0], c[1] - a[1]);
-    if (std::fabs(cr) <= tol * chord) {
+    if (on_chord_line(std::fabs(cr), tol, c[0] - a[0], c[1] - a[1])) {
       if (e1x * e2x + e1y * e2y < 0) return 2;  // folds back on itself
       continue;                                 // straight: a node on an edge line is allowed
     }
@@ -294,15 +368,24 @@ int face_polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, co
   return defect;
 }
 
+}  // namespace
+
+int face_polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, const int32_t* end, double rel_tol) {
+  if (end - begin < 3) return 3;
+  Vec3 area, centroid;
+  polygon_area_centroid(nodes, begin, end, &area, &centroid);
+  return polygon_defect(nodes, begin, end, rel_tol, area, centroid);
+}
+
 CheckResult check_convexity(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
   CheckResult r;
   r.name = "convexity";
   r.values.assign(m.n_cells(), 0.0);
-  const CellScales sc = compute_cell_scales(m, opt.rel_tol);
   std::vector<int> defect(m.n_faces());
   parallel_ranges(m.n_faces(), [&](int64_t b, int64_t e) {
     for (int f = static_cast<int>(b); f < e; ++f)
-      defect[f] = face_polygon_defect(m.nodes, m.face_begin(f), m.face_end(f), opt.rel_tol);
+      defect[f] = polygon_defect(m.nodes, m.face_begin(f), m.face_end(f), opt.rel_tol, geo.face_area[f],
+                                 geo.face_centroid[f]);
   });
   int64_t reflex = 0, non_simple = 0, degenerate = 0;
   std::vector<int32_t> ex_reflex, ex_non_simple, ex_degenerate, ex_outside;
@@ -317,9 +400,11 @@ CheckResult check_convexity(const PolyMesh& m, const MeshGeometry& geo, const Ch
     std::vector<int32_t> ids;
     for (int c = static_cast<int>(cb); c < ce; ++c) {
       cell_node_ids_into(m, c, &ids);
-      const double L = sc.length[c];
+      double L = 0, tol = 0;
+      scale_of(m.nodes, ids.data(), ids.data() + ids.size(), opt.rel_tol, &L, &tol);
       double worst = -std::numeric_limits<double>::infinity();
       bool bad_face = false;
+      const bool few = ids.size() <= 64;  // the face's nodes as bits of their place in ids
       for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
         const int f = *fp;
         if (defect[f] != 0) bad_face = true;
@@ -327,12 +412,17 @@ CheckResult check_convexity(const PolyMesh& m, const MeshGeometry& geo, const Ch
         const double an = norm(a);
         if (!(an > 0)) continue;  // degenerate face: already flagged
         const Vec3 n = a / an;
-        for (int32_t v : ids) {
-          if (std::find(m.face_begin(f), m.face_end(f), v) != m.face_end(f)) continue;
+        uint64_t on_face = 0;
+        if (few)
+          for (const int32_t* v = m.face_begin(f); v != m.face_end(f); ++v)
+            on_face |= uint64_t(1) << (std::lower_bound(ids.begin(), ids.end(), *v) - ids.begin());
+        for (size_t i = 0; i < ids.size(); ++i) {
+          const int32_t v = ids[i];
+          if (few ? (on_face >> i) & 1 : std::find(m.face_begin(f), m.face_end(f), v) != m.face_end(f)) continue;
           worst = std::max(worst, dot(m.nodes[v] - geo.face_centroid[f], n));
         }
       }
-      const bool outside = worst > sc.tol[c];
+      const bool outside = worst > tol;
       double value = L > 0 && std::isfinite(worst) ? worst / L : (std::isfinite(worst) ? 0.0 : -1.0);
       if (std::isnan(worst)) value = 1.0;
       if (bad_face) value = std::max(value, 1.0);
@@ -375,42 +465,78 @@ CheckResult check_conformity(const PolyMesh& m, const MeshGeometry& geo, const C
   for (int f = 0; f < nf; ++f)
     if (m.face_patch[f] == kUnmatchedFace) ++unmatched, push_example(ex_unmatched, f), mark_face(f);
 
-  // (b) Two face records over the same node set: a face used by more than two cells.
-  std::vector<int32_t> sorted_ptr(nf + 1, 0), sorted_nodes(m.face_nodes.size());
+  // (b) Two face records over the same node set: a face used by more than two cells. Faces
+  // are grouped by their smallest node (a counting sort, by face id within a node), and a face
+  // is compared with the earlier faces of its group only.
+  std::vector<int32_t> sorted_nodes(m.face_nodes.size());
   parallel_ranges(nf, [&](int64_t b, int64_t e) {
     for (int f = static_cast<int>(b); f < e; ++f) {
-      sorted_ptr[f + 1] = m.face_node_ptr[f + 1];
       std::copy(m.face_begin(f), m.face_end(f), sorted_nodes.begin() + m.face_node_ptr[f]);
       std::sort(sorted_nodes.begin() + m.face_node_ptr[f], sorted_nodes.begin() + m.face_node_ptr[f + 1]);
     }
   });
+  auto key_begin = [&](int32_t f) { return sorted_nodes.begin() + m.face_node_ptr[f]; };
+  auto key_end = [&](int32_t f) { return sorted_nodes.begin() + m.face_node_ptr[f + 1]; };
   auto key_less = [&](int32_t a, int32_t b) {
-    return std::lexicographical_compare(sorted_nodes.begin() + sorted_ptr[a], sorted_nodes.begin() + sorted_ptr[a + 1],
-                                        sorted_nodes.begin() + sorted_ptr[b], sorted_nodes.begin() + sorted_ptr[b + 1]);
+    return std::lexicographical_compare(key_begin(a), key_end(a), key_begin(b), key_end(b));
   };
-  std::vector<int32_t> order(nf);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), key_less);
+  std::vector<int32_t> group_ptr(m.n_nodes() + 1, 0), group(nf);
+  for (int f = 0; f < nf; ++f) ++group_ptr[*key_begin(f) + 1];
+  for (int v = 0; v < m.n_nodes(); ++v) group_ptr[v + 1] += group_ptr[v];
+  {
+    std::vector<int32_t> fill(group_ptr.begin(), group_ptr.end() - 1);
+    for (int f = 0; f < nf; ++f) group[fill[*key_begin(f)]++] = f;
+  }
+  std::vector<int32_t> first_same(nf, -1);  // the smallest face id over the same node set, if earlier
+  parallel_ranges(nf, [&](int64_t b, int64_t e) {
+    for (int f = static_cast<int>(b); f < e; ++f) {
+      const int32_t v = *key_begin(f);
+      for (int32_t i = group_ptr[v]; i < group_ptr[v + 1] && group[i] < f; ++i)
+        if (std::equal(key_begin(f), key_end(f), key_begin(group[i]), key_end(group[i]))) {
+          first_same[f] = group[i];
+          break;
+        }
+    }
+  });
+  group_ptr = {};
+  group = {};
+  // Each set of equal faces (ids ascending), the sets in the order of their sorted node lists;
+  // a set of n faces counts n - 1 duplicates.
+  std::vector<std::vector<int32_t>> same_sets;
+  {
+    std::vector<int32_t> set_of(nf, -1);
+    for (int f = 0; f < nf; ++f) {
+      const int32_t root = first_same[f];
+      if (root < 0) continue;
+      if (set_of[root] < 0) set_of[root] = static_cast<int32_t>(same_sets.size()), same_sets.push_back({root});
+      same_sets[set_of[root]].push_back(f);
+    }
+  }
+  first_same = {};
+  std::sort(same_sets.begin(), same_sets.end(),
+            [&](const std::vector<int32_t>& a, const std::vector<int32_t>& b) { return key_less(a[0], b[0]); });
   int64_t duplicates = 0;
   std::vector<int32_t> ex_dup;
-  for (int i = 1; i < nf; ++i)
-    if (!key_less(order[i - 1], order[i]) && !key_less(order[i], order[i - 1])) {
+  for (const std::vector<int32_t>& set : same_sets)
+    for (size_t i = 1; i < set.size(); ++i) {
       ++duplicates;
-      push_example(ex_dup, order[i]);
-      mark_face(order[i]);
-      mark_face(order[i - 1]);
+      push_example(ex_dup, set[i]);
+      mark_face(set[i]);
+      mark_face(set[i - 1]);
     }
+  sorted_nodes = {};
 
   // (c) Each cell's surface: every edge used by exactly two of its faces, once per direction.
   int64_t open_cells = 0, misoriented_cells = 0;
   std::vector<int32_t> ex_open, ex_misoriented;
-  struct DirEdge {
-    int32_t lo, hi;
-    bool forward;  // traversed lo -> hi
+  // A directed edge packed as (lo << 33) | (hi << 1) | (traversed lo -> hi): sorting the keys
+  // sorts by (lo, hi, direction). Node ids are below 2^31.
+  auto edge_key = [](int32_t a, int32_t b) {
+    return a < b ? (uint64_t(a) << 33) | (uint64_t(b) << 1) | 1u : (uint64_t(b) << 33) | (uint64_t(a) << 1);
   };
   std::vector<char> surface(nc, 0);  // 1: open, 2: misoriented
   parallel_ranges(nc, [&](int64_t cb, int64_t ce) {
-    std::vector<DirEdge> edges;
+    std::vector<uint64_t> edges;
     for (int c = static_cast<int>(cb); c < ce; ++c) {
       edges.clear();
       for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
@@ -418,20 +544,17 @@ CheckResult check_conformity(const PolyMesh& m, const MeshGeometry& geo, const C
         const int32_t* v = m.face_begin(f);
         const bool own = m.face_sign(f, c) > 0;
         for (int i = 0; i < k; ++i) {
-          int32_t a = v[i], b = v[(i + 1) % k];
-          if (!own) std::swap(a, b);
-          edges.push_back(a < b ? DirEdge{a, b, true} : DirEdge{b, a, false});
+          const int32_t a = v[i], b = v[i + 1 == k ? 0 : i + 1];
+          edges.push_back(own ? edge_key(a, b) : edge_key(b, a));
         }
       }
-      std::sort(edges.begin(), edges.end(), [](const DirEdge& x, const DirEdge& y) {
-        return x.lo != y.lo ? x.lo < y.lo : (x.hi != y.hi ? x.hi < y.hi : x.forward < y.forward);
-      });
+      std::sort(edges.begin(), edges.end());
       bool open = false, misoriented = false;
       for (size_t i = 0; i < edges.size();) {
         size_t j = i;
-        while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+        while (j < edges.size() && (edges[j] >> 1) == (edges[i] >> 1)) ++j;
         if (j - i != 2) open = true;
-        else if (edges[i].forward == edges[i + 1].forward) misoriented = true;
+        else if ((edges[i] & 1) == (edges[i + 1] & 1)) misoriented = true;
         i = j;
       }
       surface[c] = static_cast<char>((open ? 1 : 0) | (misoriented ? 2 : 0));
@@ -482,18 +605,18 @@ CheckResult check_conformity(const PolyMesh& m, const MeshGeometry& geo, const C
     for (int f = static_cast<int>(fb); f < fe; ++f) {
       const int k = m.face_size(f);
       const int32_t* v = m.face_begin(f);
-      double diam = 0, tol = 0;
-      scale_of(m.nodes, v, v + k, opt.rel_tol, &diam, &tol);
-      Vec3 lo{DBL_MAX, DBL_MAX, DBL_MAX}, hi{-DBL_MAX, -DBL_MAX, -DBL_MAX};
+      ScaleBox box;
       Vec3 g;
       for (int i = 0; i < k; ++i) {
         const Vec3 p = m.nodes[v[i]];
         g += p;
-        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+        box.add(p);
       }
       g = g / k;
+      double diam = 0, tol = 0;
+      box.finish(opt.rel_tol, &diam, &tol);
       const Vec3 pad{tol, tol, tol};
-      tree.query(lo - pad, hi + pad, [&](int32_t p) {
+      tree.query(box.lo - pad, box.hi + pad, [&](int32_t p) {
         if (std::find(v, v + k, p) != v + k) return;
         double d = DBL_MAX;
         for (int i = 0; i < k && d > tol; ++i)
@@ -560,10 +683,13 @@ CheckResult check_closure(const PolyMesh& m, const MeshGeometry& geo, const Chec
 }
 
 CheckResult check_volume(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  return check_volume(m, geo, opt, compute_cell_scales(m, opt.rel_tol));
+}
+
+CheckResult check_volume(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt, const CellScales& sc) {
   CheckResult r;
   r.name = "volume";
   r.values.assign(m.n_cells(), 0.0);
-  const CellScales sc = compute_cell_scales(m, opt.rel_tol);
   double min_vol = std::numeric_limits<double>::infinity(), total = 0;
   for (int c = 0; c < m.n_cells(); ++c) {
     const double L = sc.length[c], v = geo.cell_volume[c];
@@ -605,13 +731,13 @@ CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, cons
   // For information (docs/fvcheck.md, "Boundary faces"): boundary faces measured from the FV
   // centre to the face centroid, the paper's literal eq. 8, which is not the pair the flux uses.
   if (!k_metric) {
-    const std::vector<double> at_centroid = face_orthogonality(m, geo, BoundaryPoint::Centroid);
     double worst = 90.0;
     int64_t below = 0;
     for (int f = 0; f < m.n_faces(); ++f) {
       if (m.face_neighbour[f] >= 0) continue;
-      worst = std::min(worst, at_centroid[f]);
-      below += !(at_centroid[f] >= opt.min_orthogonality_deg);
+      const double at_centroid = face_orthogonality_of(m, geo, f, geo.face_centroid[f]);
+      worst = std::min(worst, at_centroid);
+      below += !(at_centroid >= opt.min_orthogonality_deg);
     }
     r.measures.push_back({"boundary_centroid_min_deg", worst});
     r.counts.push_back({"boundary_faces_below_threshold_at_centroid", below});
@@ -620,10 +746,14 @@ CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, cons
 }
 
 CheckResult check_auto_centering(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt) {
+  return check_auto_centering(m, geo, opt, compute_cell_scales(m, opt.rel_tol));
+}
+
+CheckResult check_auto_centering(const PolyMesh& m, const MeshGeometry& geo, const CheckOptions& opt,
+                                 const CellScales& sc) {
   CheckResult r;
   r.name = "auto_centering";
   r.values.assign(m.n_cells(), 0.0);
-  const CellScales sc = compute_cell_scales(m, opt.rel_tol);
   std::vector<char> violates(m.n_cells(), 0);
   parallel_ranges(m.n_cells(), [&](int64_t b, int64_t e) {
     for (int c = static_cast<int>(b); c < e; ++c) {

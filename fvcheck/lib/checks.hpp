@@ -83,6 +83,9 @@ CheckResult check_closure(const PolyMesh& mesh, const MeshGeometry& geo, const C
 /// Positive volume: values[c] = volume / L_c^3; violation when <= volume_rel_tol.
 /// worst = smallest value; measure "min_volume" = smallest volume (m^3).
 CheckResult check_volume(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt = {});
+/// The same with the cell scales given (== compute_cell_scales(mesh, opt.rel_tol)).
+CheckResult check_volume(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt,
+                         const CellScales& scales);
 
 /// Dual orthogonality per face (paper eq. 8, FV centres; boundary faces use the FV centre
 /// and the face centroid). values[f] = Q_O(F) in degrees; violation when < min_orthogonality_deg.
@@ -94,6 +97,9 @@ CheckResult check_orthogonality(const PolyMesh& mesh, const MeshGeometry& geo, c
 /// values[c] = max over faces of the signed distance of the centre to the face plane / L_c
 /// (< 0 inside); violation when > -tol_c / L_c. worst = max of values.
 CheckResult check_auto_centering(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt = {});
+/// The same with the cell scales given (== compute_cell_scales(mesh, opt.rel_tol)).
+CheckResult check_auto_centering(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt,
+                                 const CellScales& scales);
 
 /// Planarity per face (paper eq. 10). values[f] = Q_P(F) in degrees; violation when
 /// > max_planarity_deg. worst = max Q_P.

@@ -54,9 +54,10 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   r.checks.push_back(check_convexity(mesh, geo, opt)), progress.advance();
   r.checks.push_back(check_conformity(mesh, geo, opt, build)), progress.advance();
   r.checks.push_back(check_closure(mesh, geo, opt)), progress.advance();
-  r.checks.push_back(check_volume(mesh, geo, opt)), progress.advance();
+  const CellScales scales = compute_cell_scales(mesh, opt.rel_tol);  // volume and auto-centering
+  r.checks.push_back(check_volume(mesh, geo, opt, scales)), progress.advance();
   r.checks.push_back(check_orthogonality(mesh, geo, opt)), progress.advance();
-  r.checks.push_back(check_auto_centering(mesh, geo, opt)), progress.advance();
+  r.checks.push_back(check_auto_centering(mesh, geo, opt, scales)), progress.advance();
   r.checks.push_back(check_planarity(mesh, geo, opt)), progress.advance();
   r.q_s = cell_shape_quality(mesh, h_ref);
   r.q_o_cell = cell_min_of_faces(mesh, r.k_metric ? face_orthogonality(mesh, geo) : r.find("orthogonality")->values);

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "meshgen/core/fv_quality.hpp"
+#include "meshgen/core/parallel.hpp"
 
 namespace hm {
 
@@ -288,19 +289,25 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
   t.half_owner.assign(nf, 0.0);
   t.half_neighbour.assign(nf, 0.0);
   t.face.assign(nf, 0.0);
-  for (int f = 0; f < nf; ++f) {
-    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
-    t.half_owner[f] = half(o, f);
-    int bad = is_bad(t.half_owner[f]);
-    if (n >= 0) {
-      t.half_neighbour[f] = half(n, f);
-      bad += is_bad(t.half_neighbour[f]);
-      t.face[f] = harmonic(t.half_owner[f], t.half_neighbour[f]);
-    } else if (is_wellbore_patch(m.face_patch[f])) {
-      t.face[f] = t.half_owner[f];
+  std::vector<uint8_t> bad(nf, 0);  // per face, counted in face order below
+  parallel_ranges(nf, [&](int64_t fb, int64_t fe) {
+    for (int f = static_cast<int>(fb); f < fe; ++f) {
+      const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+      t.half_owner[f] = half(o, f);
+      bad[f] = is_bad(t.half_owner[f]);
+      if (n >= 0) {
+        t.half_neighbour[f] = half(n, f);
+        bad[f] += is_bad(t.half_neighbour[f]);
+        t.face[f] = harmonic(t.half_owner[f], t.half_neighbour[f]);
+      } else if (is_wellbore_patch(m.face_patch[f])) {
+        t.face[f] = t.half_owner[f];
+      }
     }
-    t.negative += bad;
-    if (bad && static_cast<int>(t.negative_faces.size()) < kMaxListedNegative) t.negative_faces.push_back(f);
+  }, 256);  // small chunks: the end-cap faces (a quadrature each) lie together
+  for (int f = 0; f < nf; ++f) {
+    if (!bad[f]) continue;
+    t.negative += bad[f];
+    if (static_cast<int>(t.negative_faces.size()) < kMaxListedNegative) t.negative_faces.push_back(f);
   }
   return t;
 }

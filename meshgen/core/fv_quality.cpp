@@ -112,20 +112,23 @@ Vec3 closest_point_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
   return a + (vb / den) * ab + (vc / den) * ac;
 }
 
-// Distinct undirected edges (a < b) of cell c.
-void cell_edges(const PolyMesh& m, int c, std::vector<std::pair<int32_t, int32_t>>& edges) {
+// Distinct undirected edges (a < b) of cell c, ascending, packed as (a << 32) | b (sorting the
+// packed keys sorts the pairs).
+void cell_edges(const PolyMesh& m, int c, std::vector<uint64_t>& edges) {
   edges.clear();
   for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
     const int f = *fp, n = m.face_size(f);
     const int32_t* v = m.face_begin(f);
     for (int i = 0; i < n; ++i) {
-      int32_t a = v[i], b = v[(i + 1) % n];
-      if (a > b) std::swap(a, b);
-      edges.emplace_back(a, b);
+      const uint32_t a = static_cast<uint32_t>(v[i]), b = static_cast<uint32_t>(v[i + 1 == n ? 0 : i + 1]);
+      edges.push_back(a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a);
     }
   }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+}
+Vec3 edge_vector(const PolyMesh& m, uint64_t e) {
+  return m.nodes[static_cast<uint32_t>(e)] - m.nodes[static_cast<uint32_t>(e >> 32)];
 }
 }  // namespace
 
@@ -155,19 +158,23 @@ std::vector<Vec3> boundary_flux_points(const PolyMesh& m, const MeshGeometry& ge
   return out;
 }
 
+double face_orthogonality_of(const PolyMesh& m, const MeshGeometry& geo, int f, Vec3 boundary_end) {
+  const double a = norm(geo.face_area[f]);
+  const Vec3 p1 = m.cell_fv_center[m.face_owner[f]];
+  const Vec3 p2 = m.face_neighbour[f] >= 0 ? m.cell_fv_center[m.face_neighbour[f]] : boundary_end;
+  const Vec3 d = p2 - p1;
+  const double l = norm(d);
+  if (!(a > 0) || !(l > 0)) return 0.0;  // degenerate
+  return std::asin(clamp_unit(std::fabs(dot(d, geo.face_area[f])) / (l * a))) * kDeg;
+}
+
 std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& geo, BoundaryPoint boundary) {
   std::vector<double> q(m.n_faces(), 0.0);
-  const std::vector<Vec3> end = boundary == BoundaryPoint::Flux ? boundary_flux_points(m, geo) : geo.face_centroid;
+  std::vector<Vec3> flux;  // no copy of the centroids when they are the end points
+  if (boundary == BoundaryPoint::Flux) flux = boundary_flux_points(m, geo);
+  const std::vector<Vec3>& end = boundary == BoundaryPoint::Flux ? flux : geo.face_centroid;
   parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
-    for (int f = static_cast<int>(fb); f < fe; ++f) {
-      const double a = norm(geo.face_area[f]);
-      const Vec3 p1 = m.cell_fv_center[m.face_owner[f]];
-      const Vec3 p2 = m.face_neighbour[f] >= 0 ? m.cell_fv_center[m.face_neighbour[f]] : end[f];
-      const Vec3 d = p2 - p1;
-      const double l = norm(d);
-      if (!(a > 0) || !(l > 0)) continue;  // degenerate: Q_O = 0
-      q[f] = std::asin(clamp_unit(std::fabs(dot(d, geo.face_area[f])) / (l * a))) * kDeg;
-    }
+    for (int f = static_cast<int>(fb); f < fe; ++f) q[f] = face_orthogonality_of(m, geo, f, end[f]);
   });
   return q;
 }
@@ -183,18 +190,20 @@ std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometr
     return std::atan2(norm(cross(ds, ns)), std::fabs(dot(ds, ns))) * kDeg;
   };
   const std::vector<Vec3> end = boundary_flux_points(m, geo);
-  for (int f = 0; f < m.n_faces(); ++f) {
-    const Vec3 a = geo.face_area[f];
-    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
-    const Vec3 p1 = m.cell_fv_center[o];
-    const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : end[f]) - p1;
-    if (!(norm(a) > 0) || !(norm(d) > 0)) {
-      q[f] = 90.0;  // degenerate
-      continue;
+  parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
+    for (int f = static_cast<int>(fb); f < fe; ++f) {
+      const Vec3 a = geo.face_area[f];
+      const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+      const Vec3 p1 = m.cell_fv_center[o];
+      const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : end[f]) - p1;
+      if (!(norm(a) > 0) || !(norm(d) > 0)) {
+        q[f] = 90.0;  // degenerate
+        continue;
+      }
+      q[f] = angle(o, a, d);
+      if (n >= 0) q[f] = std::max(q[f], angle(n, a, d));
     }
-    q[f] = angle(o, a, d);
-    if (n >= 0) q[f] = std::max(q[f], angle(n, a, d));
-  }
+  });
   return q;
 }
 
@@ -228,32 +237,36 @@ std::vector<double> face_planarity(const PolyMesh& m, const MeshGeometry& geo) {
 
 std::vector<double> cell_min_of_faces(const PolyMesh& m, const std::vector<double>& fv) {
   std::vector<double> out(m.n_cells(), 0.0);
-  for (int c = 0; c < m.n_cells(); ++c) {
-    double v = std::numeric_limits<double>::infinity();
-    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) v = std::min(v, fv[*f]);
-    out[c] = std::isfinite(v) ? v : 0.0;
-  }
+  parallel_ranges(m.n_cells(), [&](int64_t cb, int64_t ce) {
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      double v = std::numeric_limits<double>::infinity();
+      for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) v = std::min(v, fv[*f]);
+      out[c] = std::isfinite(v) ? v : 0.0;
+    }
+  });
   return out;
 }
 
 std::vector<double> cell_max_of_faces(const PolyMesh& m, const std::vector<double>& fv) {
   std::vector<double> out(m.n_cells(), 0.0);
-  for (int c = 0; c < m.n_cells(); ++c) {
-    double v = 0;
-    for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) v = std::max(v, fv[*f]);
-    out[c] = v;
-  }
+  parallel_ranges(m.n_cells(), [&](int64_t cb, int64_t ce) {
+    for (int c = static_cast<int>(cb); c < ce; ++c) {
+      double v = 0;
+      for (const int32_t* f = m.cell_begin(c); f != m.cell_end(c); ++f) v = std::max(v, fv[*f]);
+      out[c] = v;
+    }
+  });
   return out;
 }
 
 std::vector<double> cell_mean_edge_length(const PolyMesh& m) {
   std::vector<double> out(m.n_cells(), 0.0);
   parallel_ranges(m.n_cells(), [&](int64_t cb, int64_t ce) {
-    std::vector<std::pair<int32_t, int32_t>> edges;
+    std::vector<uint64_t> edges;
     for (int c = static_cast<int>(cb); c < ce; ++c) {
       cell_edges(m, c, edges);
       double s = 0;
-      for (auto [a, b] : edges) s += norm(m.nodes[b] - m.nodes[a]);
+      for (uint64_t e : edges) s += norm(edge_vector(m, e));
       out[c] = edges.empty() ? 0.0 : s / static_cast<double>(edges.size());
     }
   });
@@ -264,20 +277,20 @@ std::vector<double> cell_shape_quality(const PolyMesh& m, const std::vector<doub
   std::vector<double> out(m.n_cells(), 0.0);
   const bool use_ref = h_ref.size() == static_cast<size_t>(m.n_cells());
   parallel_ranges(m.n_cells(), [&](int64_t cb, int64_t ce) {
-    std::vector<std::pair<int32_t, int32_t>> edges;
+    std::vector<uint64_t> edges;
     for (int c = static_cast<int>(cb); c < ce; ++c) {
       cell_edges(m, c, edges);
       if (edges.empty()) continue;
       double h = use_ref ? h_ref[c] : 0.0;
       if (!(h > 0) || !std::isfinite(h)) {
         h = 0;
-        for (auto [a, b] : edges) h += norm(m.nodes[b] - m.nodes[a]);
+        for (uint64_t e : edges) h += norm(edge_vector(m, e));
         h /= static_cast<double>(edges.size());
       }
       if (!(h > 0)) continue;  // every edge has zero length
       double q = 1.0;
-      for (auto [a, b] : edges) {
-        const double l = norm(m.nodes[b] - m.nodes[a]);
+      for (uint64_t e : edges) {
+        const double l = norm(edge_vector(m, e));
         q = std::min(q, l > 0 ? std::min(l / h, h / l) : 0.0);
       }
       out[c] = q;

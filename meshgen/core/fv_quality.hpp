@@ -33,6 +33,8 @@ enum class BoundaryPoint {
 /// 0 for a degenerate face or coincident points.
 std::vector<double> face_orthogonality(const PolyMesh& mesh, const MeshGeometry& geo,
                                        BoundaryPoint boundary = BoundaryPoint::Flux);
+/// Q_O(F) of face f alone, its boundary segment (if a boundary face) ending at boundary_end.
+double face_orthogonality_of(const PolyMesh& mesh, const MeshGeometry& geo, int f, Vec3 boundary_end);
 
 /// K-non-orthogonality in degrees for every face (docs/anisotropy.md): the angle between K n and
 /// the line d between the FV centres of owner and neighbour (boundary face: owner's FV centre ->

@@ -4,7 +4,12 @@
 // irregular face goes to MeshBuilder, which reports it (the pair's fail half).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
+#include <map>
+#include <vector>
 #include <cstdlib>
 #include <string>
 #include <filesystem>
@@ -115,6 +120,82 @@ TEST(VtuAssemblyIrregular, RegularAndMisorientedFilesGiveMeshBuildersResult) {
   EXPECT_EQ(g.mesh.n_cells(), 2);
   EXPECT_TRUE(g.assembled_in_parallel);
   expect_same_mesh(g, hm::read_vtu_buffer(good, hm::VtuAssembly::Serial));
+  const hm::ReadResult b = hm::read_vtu_buffer(bad);
+  EXPECT_FALSE(b.build.ok);
+  EXPECT_EQ(b.build.misoriented_faces, 1);
+  EXPECT_FALSE(b.assembled_in_parallel);
+  expect_same_mesh(b, hm::read_vtu_buffer(bad, hm::VtuAssembly::Serial));
+}
+
+// A fan of 32 tetrahedra around point 0 (a ring of 16 points, one above, one below) as an ASCII
+// VTU with face_patch: point 0 is the smallest point of 96 file faces, so the assembly matches
+// that group by sorting it (groups of more than 32 faces) rather than pairwise. `flip` reverses
+// the cycle of tetrahedron 0's face towards tetrahedron 1 (both then name it in one orientation).
+std::string tet_fan(bool flip) {
+  const int n = 16;
+  std::ostringstream pts;
+  pts << "0 0 0 ";
+  for (int i = 0; i < n; ++i) pts << std::cos(2 * M_PI * i / n) << ' ' << std::sin(2 * M_PI * i / n) << " 0 ";
+  pts << "0 0 1 0 0 -1";
+  const int top = n + 1, bottom = n + 2;
+  std::vector<std::array<int, 4>> tets;  // positively oriented (a, b, c, d)
+  for (int i = 0; i < n; ++i) tets.push_back({0, 1 + i, 1 + (i + 1) % n, top});
+  for (int i = 0; i < n; ++i) tets.push_back({0, 1 + (i + 1) % n, 1 + i, bottom});
+  std::vector<std::vector<int>> faces;  // outward cycles, 4 per tetrahedron
+  for (const auto& t : tets) {
+    const int a = t[0], b = t[1], c = t[2], d = t[3];
+    for (const std::vector<int>& f : {std::vector<int>{a, c, b}, {a, b, d}, {b, c, d}, {a, d, c}}) faces.push_back(f);
+  }
+  if (flip) std::reverse(faces[3].begin(), faces[3].end());  // tet 0's face (0, top, 2), shared with tet 1
+  std::map<std::vector<int>, int> uses;
+  for (std::vector<int> f : faces) std::sort(f.begin(), f.end()), ++uses[f];
+  std::ostringstream stream, patch, conn, offsets, types, faceoffsets;
+  size_t stream_size = 0;
+  for (size_t t = 0; t < tets.size(); ++t) {
+    stream << "4 ";
+    ++stream_size;
+    for (int k = 0; k < 4; ++k) {
+      std::vector<int> f = faces[4 * t + k];
+      stream << "3 " << f[0] << ' ' << f[1] << ' ' << f[2] << ' ';
+      stream_size += 4;
+      std::sort(f.begin(), f.end());
+      patch << (uses[f] == 2 ? -1 : 0) << ' ';
+      conn << tets[t][k] << ' ';
+    }
+    offsets << 4 * (t + 1) << ' ';
+    types << "42 ";
+    faceoffsets << stream_size << ' ';
+  }
+  return "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+         "header_type=\"UInt64\">\n<UnstructuredGrid>\n<FieldData><DataArray type=\"Int32\" Name=\"face_patch\" "
+         "NumberOfTuples=\"" + std::to_string(faces.size()) + "\" format=\"ascii\">" + patch.str() +
+         "</DataArray></FieldData>\n<Piece NumberOfPoints=\"" + std::to_string(n + 3) + "\" NumberOfCells=\"" +
+         std::to_string(tets.size()) + "\">\n<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">" + pts.str() + "</DataArray></Points>\n<Cells>\n"
+         "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">" + conn.str() + "</DataArray>\n"
+         "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">" + offsets.str() + "</DataArray>\n"
+         "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">" + types.str() + "</DataArray>\n"
+         "<DataArray type=\"Int64\" Name=\"faces\" format=\"ascii\">" + stream.str() + "</DataArray>\n"
+         "<DataArray type=\"Int64\" Name=\"faceoffsets\" format=\"ascii\">" + faceoffsets.str() + "</DataArray>\n"
+         "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+}
+
+// Pass/fail pair for a large group: the regular fan is assembled in parallel into MeshBuilder's
+// mesh for any thread count; the flipped face sends the file to MeshBuilder, which reports it.
+TEST(VtuAssemblyIrregular, FaceGroupsLargerThanPairwiseScanGiveMeshBuildersResult) {
+  const std::string good = tet_fan(false), bad = tet_fan(true);
+  const hm::ReadResult serial = hm::read_vtu_buffer(good, hm::VtuAssembly::Serial);
+  ASSERT_TRUE(serial.ok) << serial.error;
+  EXPECT_TRUE(serial.build.ok);
+  EXPECT_EQ(serial.mesh.n_cells(), 32);
+  EXPECT_EQ(serial.mesh.n_faces(), 32 * 4 - 48);  // 16 + 16 + 16 shared faces around the axis
+  for (int threads : {1, 2, 0}) {
+    SCOPED_TRACE(threads);
+    const hm::ThreadLimit limit(threads);
+    const hm::ReadResult g = hm::read_vtu_buffer(good);
+    EXPECT_TRUE(g.assembled_in_parallel);
+    expect_same_mesh(g, serial);
+  }
   const hm::ReadResult b = hm::read_vtu_buffer(bad);
   EXPECT_FALSE(b.build.ok);
   EXPECT_EQ(b.build.misoriented_faces, 1);

@@ -38,6 +38,26 @@ int face_between(const PolyMesh& m, int a, int b) {
   return -1;
 }
 
+// Appends a cell whose faces are new boundary face records over the given node cycles.
+void append_boundary_cell(PolyMesh& d, const std::vector<std::vector<int32_t>>& cycles) {
+  const int cell = d.n_cells();
+  for (const std::vector<int32_t>& cyc : cycles) {
+    d.cell_faces.push_back(d.n_faces());
+    d.face_nodes.insert(d.face_nodes.end(), cyc.begin(), cyc.end());
+    d.face_node_ptr.push_back(static_cast<int32_t>(d.face_nodes.size()));
+    d.face_owner.push_back(cell);
+    d.face_neighbour.push_back(-1);
+    d.face_patch.push_back(kOuterBoundary);
+  }
+  d.cell_face_ptr.push_back(static_cast<int32_t>(d.cell_faces.size()));
+  d.cell_region.push_back(0);
+  d.cell_fv_center.push_back({0.5, 0.5, 0.5});
+  d.cell_ijk.push_back({-1, -1, -1});
+  d.cell_perm.push_back({});
+  d.cell_porosity.push_back(0);
+  d.cell_radial.push_back({});
+}
+
 const std::vector<std::pair<double, double>> kSquare{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
 const std::vector<std::pair<double, double>> kLShape{{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
 
@@ -165,22 +185,9 @@ TEST(Conformity, UnmatchedAndDuplicateFacesAndBuilderProblems) {
 
   // A second cell over the same six node cycles, as separate face records.
   PolyMesh d = box_grid(1, 1, 1);
-  const int nf = d.n_faces();
-  for (int q = 0; q < nf; ++q) {
-    d.face_nodes.insert(d.face_nodes.end(), d.face_begin(q), d.face_end(q));
-    d.face_node_ptr.push_back(static_cast<int32_t>(d.face_nodes.size()));
-    d.face_owner.push_back(1);
-    d.face_neighbour.push_back(-1);
-    d.face_patch.push_back(kOuterBoundary);
-    d.cell_faces.push_back(nf + q);
-  }
-  d.cell_face_ptr.push_back(static_cast<int32_t>(d.cell_faces.size()));
-  d.cell_region.push_back(0);
-  d.cell_fv_center.push_back({0.5, 0.5, 0.5});
-  d.cell_ijk.push_back({-1, -1, -1});
-  d.cell_perm.push_back({});
-  d.cell_porosity.push_back(0);
-  d.cell_radial.push_back({});
+  std::vector<std::vector<int32_t>> cycles;
+  for (int q = 0; q < d.n_faces(); ++q) cycles.emplace_back(d.face_begin(q), d.face_end(q));
+  append_boundary_cell(d, cycles);
   ASSERT_TRUE(check_csr_invariants(d).ok);
   const CheckResult rd = check_conformity(d, compute_geometry(d));
   EXPECT_EQ(count_of(rd, "duplicate_faces"), 6);
@@ -195,6 +202,34 @@ TEST(Conformity, UnmatchedAndDuplicateFacesAndBuilderProblems) {
   const CheckResult rb = check_conformity(g, compute_geometry(g), {}, &br);
   EXPECT_EQ(rb.violations, 4);
   EXPECT_EQ(count_of(rb, "builder_misoriented_faces"), 1);
+}
+
+// Three records over each face of a cube (the second rotated, the third reversed): a set of n
+// equal records counts n - 1 duplicates whatever their cycles; the cube's faces that share a
+// smallest node are not duplicates of each other. Examples: the later records of each set.
+TEST(Conformity, RecordsOverTheSameNodeSetAreDuplicatesInAnyCycle) {
+  PolyMesh d = box_grid(1, 1, 1);
+  const int nf = d.n_faces();
+  for (int copy = 1; copy <= 2; ++copy) {
+    std::vector<std::vector<int32_t>> cycles;
+    for (int q = 0; q < nf; ++q) {
+      std::vector<int32_t> cyc(d.face_begin(q), d.face_end(q));
+      std::rotate(cyc.begin(), cyc.begin() + copy, cyc.end());
+      if (copy == 2) std::reverse(cyc.begin(), cyc.end());
+      cycles.push_back(cyc);
+    }
+    append_boundary_cell(d, cycles);
+  }
+  ASSERT_TRUE(check_csr_invariants(d).ok);
+  const CheckResult r = check_conformity(d, compute_geometry(d));
+  EXPECT_EQ(count_of(r, "duplicate_faces"), 2 * nf);
+  // Each set {f, f + nf, f + 2 nf} marks f once, its middle record twice and the last once.
+  EXPECT_EQ(r.values, (std::vector<double>{double(nf), 2.0 * nf, double(nf)}));
+  std::vector<int32_t> examples;
+  for (const auto& [name, ids] : r.id_lists)
+    if (name == "duplicate_faces") examples = ids;
+  ASSERT_EQ(examples.size(), 10u);
+  for (int32_t f : examples) EXPECT_GE(f, nf) << "the first record of a set is not an example";
 }
 
 // ---------------------------------------------------------------- closure
