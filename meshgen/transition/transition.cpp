@@ -189,6 +189,7 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   }
   const Clock::time_point t3 = Clock::now();
   SiteOptimizeReport optimization;
+  int sliver_removals = 0;
   // The site optimiser rebuilds the diagram without the boundary planes' mirror sites: a cavity
   // that touches the outer boundary is left as built (docs/optimization.md).
   const bool optimize = options.optimize && images.empty();
@@ -196,10 +197,13 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
     auto raw = std::make_shared<const TransitionCells>(out);
     optimization = optimize_sites(set, cavity, node_coords, frames, options, out);
     out.unoptimized = std::move(raw);
+  } else if (images.empty()) {
+    sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, out);
   }
   // Merge the stage reports.
   TransitionReport& r = out.report;
   r.optimization = optimization;
+  r.sliver_removals = sliver_removals;
   r.seconds_optimize = optimize ? seconds(t3, Clock::now()) : 0.0;
   r.seconds_delaunay = seconds(t0, t1);
   r.seconds_sites = seconds(t1, t2);

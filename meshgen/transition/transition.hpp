@@ -62,6 +62,7 @@ struct TransitionReport {
   double seconds_delaunay = 0, seconds_sites = 0, seconds_power = 0;  ///< wall time of the stages
   double seconds_optimize = 0;  ///< wall time of the site optimiser (0 when not run)
   SiteOptimizeReport optimization;
+  int sliver_removals = 0;      ///< without optimisation: site moves that removed a sliver edge (docs/transition.md)
 };
 
 /// Transition cells of one cavity, ready for the builder.

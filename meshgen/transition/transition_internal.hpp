@@ -224,5 +224,10 @@ class PowerDiagram {
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& options,
                                   TransitionCells& out);
+/// Without optimisation: only the removal of sliver edges (kSliverEdge, transition_optimize.cpp),
+/// each kept unless a cell newly fails a shape check of the self-check. Returns the moves kept.
+int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                       const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+                                       TransitionCells& out);
 
 }  // namespace hm::transition_detail

@@ -28,6 +28,12 @@ namespace hm::transition_detail {
 
 namespace {
 
+// A power edge shorter than this fraction of its cells' reference length joins vertices that
+// are distinct only because nearly co-spherical sites (a grid uniform to rounding) are not
+// exactly so: the faces beside it are slivers whose plane the written coordinates cannot
+// carry (docs/transition.md, "Sliver edges").
+constexpr double kSliverEdge = 1e-5;
+
 struct SiteState {
   Vec3 p;
   double w2 = 0, t = 0;
@@ -139,8 +145,9 @@ class SiteOptimizer {
  public:
   SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                 const std::vector<PolygonFrame>& frames, const std::vector<double>& h_ref,
-                const TransitionOptions& opt)
-      : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt) {}
+                const TransitionOptions& opt, bool slivers_only = false)
+      : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt),
+        slivers_only_(slivers_only) {}
 
   // One round on `out` (a valid diagram of set_): true if some move was kept.
   // skew_only: only steps against skewed faces. Sets skewed_left() to the count on entry.
@@ -215,6 +222,9 @@ class SiteOptimizer {
   std::set<std::array<int, 9>> refused_;
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   int skewed_left_ = 0;
+  // Only removals of sliver edges (below kSliverEdge h), kept unless a cell newly fails a
+  // shape check: the pass run on a diagram that is not optimised (remove_sliver_edges).
+  bool slivers_only_ = false;
   std::optional<Measured> next_;  // the measurement of the diagram the last round left in `out`
 };
 
@@ -365,7 +375,10 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     const int32_t a = edge_cell[i][0], b = edge_cell[i][1];
     const bool free_end = global[a] >= out.base_node_id || global[b] >= out.base_node_id;
     const double len = norm(sub.nodes[a] - sub.nodes[b]);
-    if (free_end && h > 0 && len < opt_.g_expand * h) cand.push_back({len / h, len, h, a, b, i, j});
+    const bool wanted = slivers_only_ ? global[a] >= out.base_node_id && global[b] >= out.base_node_id &&
+                                            len < kSliverEdge * h
+                                      : free_end && len < opt_.g_expand * h;
+    if (wanted && h > 0) cand.push_back({len / h, len, h, a, b, i, j});
     i = j;
   }
   std::sort(cand.begin(), cand.end(), [&](const Candidate& x, const Candidate& y) {
@@ -387,6 +400,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   // Skewed faces first, worst first: one of their two sites moves a step (toward or away from
   // its polygon, or from the other site), kept if the cells around have fewer skewed faces.
   for (int f : skewed_faces) {
+    if (slivers_only_) break;
     const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
     if (moved[s1] || moved[s2] || locked[s1] || locked[s2]) continue;
     Move best;
@@ -412,7 +426,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     for (int end = 0; end < 2; ++end) {
       const int32_t v = end ? e.a : e.b, u = end ? e.b : e.a;
       if (global[v] < out.base_node_id) continue;
-      const bool removal = e.rel < opt_.g_remove && global[u] >= out.base_node_id;
+      const bool removal = (slivers_only_ || e.rel < opt_.g_remove) && global[u] >= out.base_node_id;
       const Vec3 pv = sub.nodes[v], pu = sub.nodes[u];
       const Vec3 x = removal ? pu : pv + ((opt_.g_expand * e.h - e.len) / e.len) * (pv - pu);
       // Sites of v not around the edge: those of its cells and of its power sphere.
@@ -481,8 +495,9 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     }
     // A step against skewness must lower the count of skewed faces around, or their worst
     // skewness; a short-edge move must raise Q_S without adding a skewed face.
-    const bool better = !fails && (m.skew ? skew_after < skew_before || (skew_after == skew_before && worst_after < worst_before)
-                                          : skew_after <= skew_before && after > before + 1e-12);
+    const bool better =
+        !fails && (slivers_only_ || (m.skew ? skew_after < skew_before || (skew_after == skew_before && worst_after < worst_before)
+                                            : skew_after <= skew_before && after > before + 1e-12));
     if (better) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
@@ -513,6 +528,35 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
 }  // namespace
 
 constexpr int kSkewRounds = 8;
+constexpr int kSliverRounds = 4;
+
+namespace {
+// An edge between two free vertices shorter than kSliverEdge x the h_ref of a cell it bounds.
+bool has_sliver_edge(const TransitionCells& t) {
+  auto at = [&](int32_t v) { return t.new_nodes[v - t.base_node_id]; };
+  for (size_t c = 0; c < t.cells.size(); ++c)
+    for (const CellFace& f : t.cells[c])
+      for (size_t k = 0; k < f.nodes.size(); ++k) {
+        const int32_t a = f.nodes[k], b = f.nodes[(k + 1) % f.nodes.size()];
+        if (a >= t.base_node_id && b >= t.base_node_id && norm(at(a) - at(b)) < kSliverEdge * t.h_ref[c]) return true;
+      }
+  return false;
+}
+}  // namespace
+
+int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                        const std::vector<PolygonFrame>& frames, const TransitionOptions& opt, TransitionCells& out) {
+  if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
+  SiteOptimizeReport rep;
+  const std::vector<double> h_ref = out.h_ref;
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, true);
+  while (rep.rounds < kSliverRounds) {
+    ++rep.rounds;
+    if (!optimizer.round(out, rep, false)) break;
+  }
+  out.h_ref = h_ref;
+  return rep.kept;
+}
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
