@@ -120,6 +120,113 @@ double distance_to_segment(Vec3 x, Vec3 a, Vec3 b) {
   return norm(x - (a + s * d));
 }
 
+// Power of x w.r.t. site s.
+double power_of(const Site& s, Vec3 x) { return norm2(x - s.p) - s.w2; }
+
+// Plane sites (docs/transition.md, "Plane sites"). A transition cell whose site lies at depth D
+// under an outer-boundary plane and whose face in the plane does not hold the site's foot is
+// measured towards the nearest point of that face (its boundary flux point): beyond D from the
+// foot the pair is below 45 degrees. The slabs of the cells of an inclined column of sites (the
+// lateral well polygons of a deviated block, one per segment) meet a plane above the block
+// displaced down-dip from their feet by about D tan(inclination). Where a plane point y is owned
+// by such a site (its foot not in its own cell, y farther than kPlaneReach D from the foot), a
+// free site is placed at depth delta under y: a weight-0 site F outside every sphere has at
+// its foot power delta^2, and a site P deeper than F has there |y - P|^2 - w^2 >= |F - P|^2 +
+// delta^2 - w^2 > delta^2, so F's face in the plane holds F's foot. Lattice spacing: the deep
+// owners lose the plane points between free sites when 0.75 h^2 < D^2 - w^2 (the farthest
+// point of a square of side h from its corner sites at depth h / 2).
+constexpr double kPlaneReach = 0.8;        // owner's foot distance / depth that calls for plane sites
+constexpr double kPlaneSpacingSafety = 0.8;
+
+template <class TryPlace>
+int place_plane_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                      const std::vector<WellBlock>& blocks, TryPlace&& try_place) {
+  double r_out = 0;
+  for (const WellBlock& b : blocks)
+    if (std::find(cavity.wells.begin(), cavity.wells.end(), b.well) != cavity.wells.end() && !b.radii.empty())
+      r_out = std::max(r_out, b.radii.back());
+  if (!(r_out > 0)) return 0;
+  std::vector<int> owners;
+  for (size_t s = 0; s < set.sites.size(); ++s)
+    if (set.sites[s].alive && set.sites[s].internal()) owners.push_back(static_cast<int>(s));
+  auto owner_at = [&](Vec3 y) {
+    int best = -1;
+    double pb = kInf;
+    for (int s : owners) {
+      const double p = power_of(set.sites[s], y);
+      if (p < pb) pb = p, best = s;
+    }
+    return best;
+  };
+  int added = 0;
+  for (const MirrorPlane& m : cavity.mirrors) {
+    const int a = m.axis, u = (a + 1) % 3, v = (a + 2) % 3;
+    Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+    double inward = 0;
+    for (const ConstrainedFace& f : cavity.faces)
+      for (int32_t id : f.nodes) {
+        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], coords[id][k]), hi[k] = std::max(hi[k], coords[id][k]);
+        if (coords[id][a] != m.value) inward = coords[id][a] > m.value ? 1 : -1;
+      }
+    if (inward == 0) continue;
+    auto on_plane = [&](double cu, double cv) {
+      Vec3 y;
+      y[a] = m.value, y[u] = cu, y[v] = cv;
+      return y;
+    };
+    auto depth = [&](const Site& s) { return inward * (s.p[a] - m.value); };
+    // Owners of the plane points on a lattice of spacing r_out that see them too obliquely.
+    const int nu = std::max(1, static_cast<int>(std::ceil((hi[u] - lo[u]) / r_out)));
+    const int nv = std::max(1, static_cast<int>(std::ceil((hi[v] - lo[v]) / r_out)));
+    // The owner of plane point y when it sees y too obliquely (its foot not in its cell, y beyond
+    // kPlaneReach times its depth from the foot), else -1.
+    std::map<int, bool> owns_foot;
+    auto oblique_owner = [&](Vec3 y) {
+      const int o = owner_at(y);
+      if (o < 0) return -1;
+      const Site& so = set.sites[o];
+      const double d = depth(so);
+      Vec3 foot = so.p;
+      foot[a] = m.value;
+      if (!(d > 0) || norm(y - foot) <= kPlaneReach * d) return -1;
+      auto it = owns_foot.find(o);
+      if (it == owns_foot.end()) it = owns_foot.emplace(o, owner_at(foot) == o).first;
+      return it->second ? -1 : o;
+    };
+    double need = kInf;  // smallest D^2 - w^2 of an oblique owner
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nv; ++j) {
+        const int o = oblique_owner(
+            on_plane(lo[u] + (i + 0.5) * (hi[u] - lo[u]) / nu, lo[v] + (j + 0.5) * (hi[v] - lo[v]) / nv));
+        if (o < 0) continue;
+        const double d = depth(set.sites[o]);
+        // A site whose sphere reaches the plane keeps free sites off its foot: it sets no spacing.
+        if (d * d > set.sites[o].w2) need = std::min(need, d * d - set.sites[o].w2);
+      }
+    if (!(need < kInf)) continue;
+    const double h = std::min(r_out, kPlaneSpacingSafety * std::sqrt(need / 0.75));
+    if (!(h > 1e-3 * r_out)) continue;
+    const int mu = std::max(1, static_cast<int>(std::ceil((hi[u] - lo[u]) / h)));
+    const int mv = std::max(1, static_cast<int>(std::ceil((hi[v] - lo[v]) / h)));
+    for (int i = 0; i < mu; ++i)
+      for (int j = 0; j < mv; ++j) {
+        // Off the symmetric lattice (co-circular quadruples of sites, with their images
+        // co-spherical octuples, make power vertices that are only rounded).
+        const double ju = std::fmod(0.618034 * (j + 1) + 0.414214 * i, 1.0) - 0.5;
+        const double jv = std::fmod(0.414214 * (i + 1) + 0.618034 * j, 1.0) - 0.5;
+        const Vec3 y = on_plane(lo[u] + (i + 0.5 + 0.2 * ju) * (hi[u] - lo[u]) / mu,
+                                lo[v] + (j + 0.5 + 0.2 * jv) * (hi[v] - lo[v]) / mv);
+        if (oblique_owner(y) < 0) continue;
+        Vec3 f = y;
+        f[a] += inward * 0.5 * h * (1.0 + 0.1 * ju);
+        const size_t before = set.sites.size();
+        try_place(f, kClearance * h);
+        added += static_cast<int>(set.sites.size() - before);
+      }
+  }
+  return added;
+}
+
 }  // namespace
 
 int cap_sites_off_bend_axes(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -179,7 +286,7 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
     if (s.kind == SiteKind::Free) s.alive = false;
   const std::vector<WellEnd> ends = well_ends(cavity, blocks);
   const std::vector<FocalSegment> segments = focal_segments(cavity, blocks);
-  if (ends.empty() && segments.empty()) return 0;
+  if (ends.empty() && segments.empty() && cavity.mirrors.empty()) return 0;
 
   // Obstacles sorted by x - radius: every live site's sphere and every cavity vertex.
   // Through an outer-boundary plane a free site must also clear the images of the spheres (its
@@ -267,6 +374,7 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
       }
     }
   }
+  place_plane_sites(set, cavity, coords, blocks, try_place);  // counted by try_place
   return added;
 }
 

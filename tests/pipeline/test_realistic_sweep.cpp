@@ -9,6 +9,7 @@
 #include <map>
 
 #include "sweep_support.hpp"
+#include "uniform_nodes.hpp"
 
 using namespace hm;
 using namespace hm::testing;
@@ -265,4 +266,32 @@ TEST(RealisticSweep, FieldCoordinateSliversAreRemovedWithoutOptimisation) {
   EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
   std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
               r.seconds);
+}
+
+// The 10k row of bench_scaling in small (bench/bench_scaling.cpp, docs/robustness.md, "Session 8, bench
+// 10k row"): one deviated well (45 degrees, R 6 m) from 20 m below the top to 20 m above the bottom of
+// a 100 m reservoir in 101.8 m cells, whose dilated cavity reaches both planes. The cells of the
+// block's lateral polygons (one per segment, the sectors facing a plane) met the plane down-dip of
+// their sites, 19 boundary faces below 45 degrees towards their flux points (self-check refusal,
+// no optimisation); the plane sites (transition_tips.cpp, place_plane_sites) take those plane
+// points. Must mesh and pass every check (under 1 s in Release).
+TEST(RealisticSweep, DeviatedWellInCoarseCellsReachingTopAndBottomMeshes) {
+  RealisticCase rc;
+  CaseSpec& cs = rc.spec;
+  cs.name = "plane_sites";
+  const double dx = 2240.0 / 22;  // the bench's cells at lateral = 22
+  cs.reservoir.x = hm::test::uniform_nodes(0, 6 * dx, dx);
+  cs.reservoir.y = hm::test::uniform_nodes(0, 6 * dx, dx);
+  cs.reservoir.z = hm::test::uniform_nodes(2000, 2100, 5);
+  WellSpec w;
+  w.name = "W1";
+  w.trajectory = {{320, 320, 2020}, {280, 275, 2080}};
+  w.radius = 0.1;
+  w.drainage_radius = 6;
+  w.rings = 6;
+  w.sectors = 12;
+  cs.wells.push_back(w);
+  cs.transition.optimize = false;
+  const CaseResult r = mesh_and_check(rc);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << r.reason;
 }
