@@ -12,6 +12,7 @@
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "perforations.hpp"
+#include "transition_assembly.hpp"
 
 namespace hm {
 
@@ -34,22 +35,6 @@ class Stages {
 };
 
 std::vector<char> all_present(const CornerPointModel& m) { return std::vector<char>(m.actnum.size(), 1); }
-
-void fill_cell_maps(HybridMesh& out, const std::vector<int32_t>& transition_cavity, const std::vector<double>& h_ref) {
-  const int nc = out.mesh.n_cells();
-  out.cell_cavity.assign(nc, -1);
-  out.cell_h_ref.assign(nc, 0.0);
-  out.reservoir_cell_of.assign(nc, -1);
-  for (int c = 0, t = 0; c < nc; ++c) {
-    const auto& ijk = out.mesh.cell_ijk[c];
-    if (out.mesh.cell_region[c] == kReservoir) out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
-    if (out.mesh.cell_region[c] == kTransition) {
-      out.cell_cavity[c] = transition_cavity[t];
-      out.cell_h_ref[c] = h_ref[t];
-      ++t;
-    }
-  }
-}
 
 std::string well_names(const CaseSpec& cs, const std::vector<int>& wells) {
   std::string s;
@@ -167,29 +152,9 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   add_nodes(builder, faces, well_nodes, out.blocks);
   add_corner_point_cells(model, faces, cs.reservoir, out.cavities.reservoir_active, builder);
   stage.mark("reservoir_cells");
-  std::vector<int32_t> transition_cavity;
-  std::vector<double> h_ref;
-  for (size_t k = 0; k < transitions.size(); ++k) {
-    TransitionCells& t = transitions[k];
-    const int32_t first = builder.n_nodes();
-    for (const Vec3& p : t.new_nodes) builder.add_node(p);
-    for (size_t c = 0; c < t.cells.size(); ++c) {
-      std::vector<CellFace> cell = t.cells[c];
-      for (CellFace& f : cell)
-        for (int32_t& v : f.nodes)
-          if (v >= t.base_node_id) v = v - t.base_node_id + first;
-      CellAttributes at;
-      at.region = kTransition;
-      at.fv_center = t.sites[c];
-      set_rock(at);
-      builder.add_cell(cell, at);
-      transition_cavity.push_back(static_cast<int32_t>(k));
-      h_ref.push_back(t.h_ref[c]);
-    }
-    out.transition_reports.push_back(t.report);
-  }
+  const TransitionCellMaps maps = add_transition_cells(transitions, set_rock, builder, out.transition_reports);
   out.mesh = builder.finish(&out.build_report);
-  fill_cell_maps(out, transition_cavity, h_ref);
+  fill_cell_maps(out, maps);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   std::vector<int> all_wells(nw);
@@ -229,7 +194,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
   const CornerPointCells cells = add_corner_point_cells(model, cs.reservoir, all_present(model), builder);
   out.mesh = builder.finish(&out.build_report);
   stage.mark("reservoir_cells");
-  fill_cell_maps(out, {}, {});
+  fill_cell_maps(out, TransitionCellMaps{});
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   if (cells.zero_volume_cells > 0)

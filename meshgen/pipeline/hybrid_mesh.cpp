@@ -11,6 +11,7 @@
 
 #include "meshgen/core/progress.hpp"
 #include "perforations.hpp"
+#include "transition_assembly.hpp"
 
 namespace hm {
 
@@ -355,45 +356,17 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
   timer.mark("reservoir_cells");
 
   std::optional<Progress> assembly_progress(std::in_place, "assembly + geometry");
-  // Assemble the transition cells; free nodes are renumbered cavity by cavity.
-  std::vector<int32_t> cell_cavity_list;
-  std::vector<double> h_ref_list;
-  for (size_t k = 0; k < transitions.size(); ++k) {
-    TransitionCells& t = transitions[k];
-    const int32_t first = builder.n_nodes();
-    for (const Vec3& p : t.new_nodes) builder.add_node(p);
-    for (size_t c = 0; c < t.cells.size(); ++c) {
-      std::vector<CellFace> faces = t.cells[c];
-      for (CellFace& f : faces)
-        for (int32_t& v : f.nodes)
-          if (v >= t.base_node_id) v = v - t.base_node_id + first;
-      CellAttributes at;
-      at.region = kTransition;
-      at.fv_center = t.sites[c];
-      const int rock_cell = reservoir_cell_at(cs.reservoir, at.fv_center);  // the model cell around its site
-      at.perm = reservoir_permeability(cs.reservoir, rock_cell);
-      at.porosity = reservoir_porosity(cs.reservoir, rock_cell);
-      builder.add_cell(faces, at);
-      cell_cavity_list.push_back(static_cast<int32_t>(k));
-      h_ref_list.push_back(t.h_ref[c]);
-    }
-    out.transition_reports.push_back(t.report);
-  }
-
+  // Assemble the transition cells; rock: the reservoir cell around each site.
+  const TransitionCellMaps maps = add_transition_cells(
+      transitions,
+      [&](CellAttributes& at) {
+        const int rock_cell = reservoir_cell_at(cs.reservoir, at.fv_center);
+        at.perm = reservoir_permeability(cs.reservoir, rock_cell);
+        at.porosity = reservoir_porosity(cs.reservoir, rock_cell);
+      },
+      builder, out.transition_reports);
   out.mesh = builder.finish(&out.build_report);
-  const int nc = out.mesh.n_cells();
-  out.cell_cavity.assign(nc, -1);
-  out.cell_h_ref.assign(nc, 0.0);
-  out.reservoir_cell_of.assign(nc, -1);
-  for (int c = 0, t = 0; c < nc; ++c) {
-    if (out.mesh.cell_region[c] == kTransition) {
-      out.cell_cavity[c] = cell_cavity_list[t];
-      out.cell_h_ref[c] = h_ref_list[t];
-      ++t;
-    }
-    const auto& ijk = out.mesh.cell_ijk[c];
-    if (out.mesh.cell_region[c] == kReservoir) out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
-  }
+  fill_cell_maps(out, maps);
   out.geometry = compute_geometry(out.mesh);
   assembly_progress.reset();
   timer.mark("assembly_geometry");

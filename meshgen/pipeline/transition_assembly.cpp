@@ -1,0 +1,47 @@
+#include "transition_assembly.hpp"
+
+namespace hm {
+
+TransitionCellMaps add_transition_cells(const std::vector<TransitionCells>& transitions,
+                                        const std::function<void(CellAttributes&)>& set_rock, MeshBuilder& builder,
+                                        std::vector<TransitionReport>& reports) {
+  TransitionCellMaps maps;
+  for (size_t k = 0; k < transitions.size(); ++k) {
+    const TransitionCells& t = transitions[k];
+    const int32_t first = builder.n_nodes();
+    for (const Vec3& p : t.new_nodes) builder.add_node(p);
+    for (size_t c = 0; c < t.cells.size(); ++c) {
+      std::vector<CellFace> faces = t.cells[c];
+      for (CellFace& f : faces)
+        for (int32_t& v : f.nodes)
+          if (v >= t.base_node_id) v = v - t.base_node_id + first;
+      CellAttributes at;
+      at.region = kTransition;
+      at.fv_center = t.sites[c];
+      set_rock(at);
+      builder.add_cell(faces, at);
+      maps.cavity.push_back(static_cast<int32_t>(k));
+      maps.h_ref.push_back(t.h_ref[c]);
+    }
+    reports.push_back(t.report);
+  }
+  return maps;
+}
+
+void fill_cell_maps(HybridMesh& out, const TransitionCellMaps& maps) {
+  const int nc = out.mesh.n_cells();
+  out.cell_cavity.assign(nc, -1);
+  out.cell_h_ref.assign(nc, 0.0);
+  out.reservoir_cell_of.assign(nc, -1);
+  for (int c = 0, t = 0; c < nc; ++c) {
+    const auto& ijk = out.mesh.cell_ijk[c];
+    if (out.mesh.cell_region[c] == kReservoir) out.reservoir_cell_of[c] = out.grid.cell_index(ijk[0], ijk[1], ijk[2]);
+    if (out.mesh.cell_region[c] == kTransition) {
+      out.cell_cavity[c] = maps.cavity[t];
+      out.cell_h_ref[c] = maps.h_ref[t];
+      ++t;
+    }
+  }
+}
+
+}  // namespace hm
