@@ -137,6 +137,11 @@ double power_of(const Site& s, Vec3 x) { return norm2(x - s.p) - s.w2; }
 // point of a square of side h from its corner sites at depth h / 2).
 constexpr double kPlaneReach = 0.8;        // owner's foot distance / depth that calls for plane sites
 constexpr double kPlaneSpacingSafety = 0.8;
+constexpr double kPlaneMinSpacing = 1e-3;  // of the block radius: below it no lattice is laid
+// The lattice is shifted per point by a low-discrepancy (Weyl) sequence, off its symmetric
+// positions: kPlaneJitter of a lattice step in plan, kPlaneDepthJitter of the depth.
+constexpr double kWeylA = 0.618034, kWeylB = 0.414214;  // golden ratio - 1, sqrt(2) - 1
+constexpr double kPlaneJitter = 0.2, kPlaneDepthJitter = 0.1;
 
 template <class TryPlace>
 int place_plane_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -205,20 +210,20 @@ int place_plane_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3
       }
     if (!(need < kInf)) continue;
     const double h = std::min(r_out, kPlaneSpacingSafety * std::sqrt(need / 0.75));
-    if (!(h > 1e-3 * r_out)) continue;
+    if (!(h > kPlaneMinSpacing * r_out)) continue;
     const int mu = std::max(1, static_cast<int>(std::ceil((hi[u] - lo[u]) / h)));
     const int mv = std::max(1, static_cast<int>(std::ceil((hi[v] - lo[v]) / h)));
     for (int i = 0; i < mu; ++i)
       for (int j = 0; j < mv; ++j) {
         // Off the symmetric lattice (co-circular quadruples of sites, with their images
         // co-spherical octuples, make power vertices that are only rounded).
-        const double ju = std::fmod(0.618034 * (j + 1) + 0.414214 * i, 1.0) - 0.5;
-        const double jv = std::fmod(0.414214 * (i + 1) + 0.618034 * j, 1.0) - 0.5;
-        const Vec3 y = on_plane(lo[u] + (i + 0.5 + 0.2 * ju) * (hi[u] - lo[u]) / mu,
-                                lo[v] + (j + 0.5 + 0.2 * jv) * (hi[v] - lo[v]) / mv);
+        const double ju = std::fmod(kWeylA * (j + 1) + kWeylB * i, 1.0) - 0.5;
+        const double jv = std::fmod(kWeylB * (i + 1) + kWeylA * j, 1.0) - 0.5;
+        const Vec3 y = on_plane(lo[u] + (i + 0.5 + kPlaneJitter * ju) * (hi[u] - lo[u]) / mu,
+                                lo[v] + (j + 0.5 + kPlaneJitter * jv) * (hi[v] - lo[v]) / mv);
         if (oblique_owner(y) < 0) continue;
         Vec3 f = y;
-        f[a] += inward * 0.5 * h * (1.0 + 0.1 * ju);
+        f[a] += inward * 0.5 * h * (1.0 + kPlaneDepthJitter * ju);
         const size_t before = set.sites.size();
         try_place(f, kClearance * h);
         added += static_cast<int>(set.sites.size() - before);
