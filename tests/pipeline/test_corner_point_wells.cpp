@@ -187,11 +187,7 @@ TEST(CornerPointWells, VerticalWellInTiltedLayersMeshes) {
   const CaseSpec cs = case_of(tmp, g, vertical_well(90, 90, 1034, 1046));
   ASSERT_TRUE(cs.reservoir.corner_point);
   HybridMesh out;
-  try {
-    out = build_hybrid_mesh(cs);
-  } catch (const std::exception& e) {
-    FAIL() << e.what();
-  }
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));  // gtest prints the exception's what()
   expect_sound_mesh(cs, out);
   for (const Cavity& cav : out.cavities.cavities) EXPECT_FALSE(cav.cells_are_boxes);
   // Deterministic: the same case meshes to the same mesh.
@@ -210,11 +206,7 @@ TEST(CornerPointWells, DeviatedWellWithInclinedPillarsMeshes) {
                            "drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
   const CaseSpec cs = case_of(tmp, g, well);
   HybridMesh out;
-  try {
-    out = build_hybrid_mesh(cs);
-  } catch (const std::exception& e) {
-    FAIL() << e.what();
-  }
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));  // gtest prints the exception's what()
   expect_sound_mesh(cs, out);
 }
 

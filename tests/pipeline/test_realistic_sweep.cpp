@@ -44,6 +44,14 @@ std::string mode_label(const RealisticOptions& o) {
          (o.optimize ? " opt" : "") + (o.field_origin ? " utm" : "") + (o.cross_top_bottom ? " cross" : "");
 }
 
+// The seed's case must mesh and pass every check; one line per case on stdout.
+void expect_meshes(const RealisticCase& rc, const RealisticOptions& o) {
+  const CaseResult r = mesh_and_check(rc);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+  std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
+              r.seconds);
+}
+
 }  // namespace
 
 TEST(RealisticCases, GeneratorIsDeterministicAndValid) {
@@ -228,10 +236,7 @@ TEST(RealisticSweep, FlatEndsWithLargeRingRatioMeshAndPassFvcheck) {
     const RealisticOptions o = sweep_options(seed);
     const RealisticCase rc = make_realistic_case(seed, o);
     ASSERT_GE(rc.drainage_radius, 60.0) << rc.label;  // the generator still draws the large-R case
-    const CaseResult r = mesh_and_check(rc);
-    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
-    std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
-                r.seconds);
+    expect_meshes(rc, o);
   }
 }
 
@@ -245,10 +250,7 @@ TEST(RealisticSweep, OptimiserKeepsTheSelfCheckShapeChecks) {
   const RealisticOptions o = sweep_options(seed);
   ASSERT_TRUE(o.optimize);
   const RealisticCase rc = make_realistic_case(seed, o);
-  const CaseResult r = mesh_and_check(rc);
-  EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
-  std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
-              r.seconds);
+  expect_meshes(rc, o);
 }
 
 // Field coordinates written with 10 significant digits make the grid uniform only to 5e-5-8e-4 m:
@@ -262,10 +264,7 @@ TEST(RealisticSweep, FieldCoordinateSliversAreRemovedWithoutOptimisation) {
   const RealisticOptions o = sweep_options(seed);
   ASSERT_TRUE(o.field_origin && !o.optimize);  // the generator still draws the rounded field case
   const RealisticCase rc = make_realistic_case(seed, o);
-  const CaseResult r = mesh_and_check(rc);
-  EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
-  std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
-              r.seconds);
+  expect_meshes(rc, o);
 }
 
 // The 10k row of bench_scaling in small (bench/bench_scaling.cpp, docs/robustness.md, "Session 8, bench
