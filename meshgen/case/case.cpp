@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/corner_point_refine.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/case/meshed_trajectory.hpp"
 #include "meshgen/case/segment_distance.hpp"
@@ -306,12 +307,54 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
   return r;
 }
 
+// reservoir.near_well_cell_size: auto (0), off (-1) or a size in metres.
+double read_near_well_cell_size(const YAML::Node& n, const std::string& path) {
+  if (n.IsScalar() && n.Scalar() == "auto") return 0;
+  if (n.IsScalar() && n.Scalar() == "off") return -1;
+  if (!n.IsScalar() || !decimal_text(n.Scalar())) fail(path, "expected auto, off or a size in m, got " + describe(n));
+  const double v = read_number(n, path);
+  require(v > 0, path, "must be > 0");
+  return v;
+}
+
+// A corner-point model with wells: its columns near the wells split to the wells' scale
+// (meshgen/case/corner_point_refine.hpp); the case's reservoir becomes the refined model.
+void refine_near_wells(CaseSpec& cs) {
+  ReservoirSpec& r = cs.reservoir;
+  if (!r.corner_point || cs.wells.empty() || r.near_well_cell_size < 0) return;
+  std::vector<RefinementRequest> requests;
+  for (const WellSpec& w : cs.wells) {
+    const double size = r.near_well_cell_size > 0 ? r.near_well_cell_size : w.drainage_radius;
+    requests.push_back({w.trajectory, size, cs.transition.dilation * w.drainage_radius + 2 * size,
+                        r.near_well_cell_size == 0});
+  }
+  const ColumnSplits splits = near_well_splits(*r.corner_point, requests);
+  if (!splits.refines()) return;
+  auto refined = std::make_shared<const CornerPointModel>(refined_model(*r.corner_point, splits));
+  const double cells = double(refined->nx) * refined->ny * refined->nz;
+  if (cells > kMaxCells)
+    fail("reservoir.near_well_cell_size", "refining the model near the wells gives " + fmt_count(cells) + " cells > " +
+                                              fmt_count(kMaxCells) + ": give a larger size, or off");
+  const ReservoirSpec grid = corner_point_reservoir(refined, "reservoir.grdecl");
+  r.x = grid.x;
+  r.y = grid.y;
+  r.z = grid.z;
+  r.cell_permx = grid.cell_permx;
+  r.cell_permy = grid.cell_permy;
+  r.cell_permz = grid.cell_permz;
+  r.cell_poro = grid.cell_poro;
+  r.corner_point = grid.corner_point;
+}
+
 ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir) {
-  const Fields f(n, "reservoir", {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure"});
+  const Fields f(n, "reservoir",
+                 {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size"});
   ReservoirSpec r;
   if (f.get("grdecl")) {
     r = read_grdecl_reservoir(f, base_dir);
+    if (auto s = f.get("near_well_cell_size")) r.near_well_cell_size = read_near_well_cell_size(*s, f.path("near_well_cell_size"));
   } else {
+    if (f.get("near_well_cell_size")) fail(f.path("near_well_cell_size"), "only with reservoir.grdecl (a corner-point model)");
     r.x = read_axis(f.required("x"), f.path("x"));
     r.y = read_axis(f.required("y"), f.path("y"));
     r.z = read_axis(f.required("z"), f.path("z"));
@@ -571,6 +614,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   for (WellSpec& w : cs.wells)
     for (Vec3& p : w.trajectory) p = map_to_grid(cs.reservoir, p);
   check_wells(cs);
+  refine_near_wells(cs);
   return cs;
 }
 

@@ -38,6 +38,10 @@ struct ReservoirSpec {
   /// brought into the grid frame with it (OPM's convention: COORD is in the grid frame).
   bool has_map_axes = false;
   Vec3 map_origin{0, 0, 0}, map_unit_x{1, 0, 0}, map_unit_y{0, 1, 0};
+  /// `reservoir.near_well_cell_size` (corner-point models with wells): the size the model's columns
+  /// near a well are split to (meshgen/case/corner_point_refine.hpp); 0 = auto (each well's
+  /// drainage radius), < 0 = off. After load_case, `corner_point` is the refined model.
+  double near_well_cell_size = 0;
 };
 
 /// The grid-frame point of map point p (MAPAXES inverse; the identity without MAPAXES); z unchanged.

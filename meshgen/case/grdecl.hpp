@@ -3,6 +3,7 @@
 // (INCLUDE, MULTIPLY, BOX, EQUALS, MINPV, PINCH, ...) means what it means in OPM Flow.
 #pragma once
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,10 +28,14 @@ struct CornerPointModel {
   /// (top x y z, bottom x y z; pillar (i, j) at i + (nx+1) j) and 8 depths per cell (Eclipse order,
   /// `zcorn_index`). The mesh's model cells and the exported deck's COORD/ZCORN come from these.
   std::vector<double> coord, zcorn;
-  std::vector<double> opm_volume;              ///< EclipseGrid::getCellVolume per cell (m3), for comparisons
+  std::vector<double> opm_volume;              ///< EclipseGrid::getCellVolume per cell (m3), for comparisons; empty for a refined model
   /// OPM's transmissibility multipliers per cell and face direction (TransMult::getMultiplier: MULTX,
   /// MULTX-, ..., MULTZ with FAULTS/MULTFLT folded in), in the order +x, -x, +y, -y, +z, -z.
   std::array<std::vector<double>, 6> trans_mult;
+  /// A model refined near wells (corner_point_refine.hpp): the cell of the model as read that each
+  /// cell lies in (natural order of that model). Empty for a model as read.
+  std::vector<int32_t> parent_cell;
+  int parent_nx = 0, parent_ny = 0;  ///< refined model: nx, ny of the model as read
   bool has_mapaxes = false;
   /// MAPAXES as OPM applies it: the map (world) position of grid point (0, 0) and of the
   /// unit grid x and y directions (origin, unit_x, unit_y), for has_mapaxes.

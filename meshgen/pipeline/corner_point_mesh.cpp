@@ -129,6 +129,11 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
     }
     if (!refused) break;
   }
+  if (!model.parent_cell.empty())
+    out.notes.push_back("reservoir: the model's columns near the wells are refined (reservoir.near_well_cell_size): " +
+                        std::to_string(model.parent_nx) + " x " + std::to_string(model.parent_ny) + " -> " +
+                        std::to_string(model.nx) + " x " + std::to_string(model.ny) + " columns, " +
+                        std::to_string(model.nz) + " layers (docs/corner-point.md)");
   for (const WellBlock& b : out.blocks)
     for (const std::string& n : b.notes) out.notes.push_back(n);
   for (const std::string& n : out.cavities.notes) out.notes.push_back(n);

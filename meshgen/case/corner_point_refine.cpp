@@ -1,0 +1,217 @@
+#include "corner_point_refine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hm {
+
+namespace {
+
+// Pillar (i, j) of the model as two points (top, bottom) of COORD.
+const double* pillar(const CornerPointModel& m, int i, int j) { return &m.coord[6 * (size_t(i) + size_t(m.nx + 1) * j)]; }
+
+// Bilinear weights of the 4 corners (00, 10, 01, 11) at (s, t). At s, t in {0, 1} the weights
+// are exactly 0 and 1, so interpolated values there are the corner values bit for bit.
+std::array<double, 4> bilinear_weights(double s, double t) {
+  return {(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t};
+}
+
+// The point of the pillar quad of column (i, j) at parameters (s, t) and depth z, in plan.
+Vec3 column_point(const CornerPointModel& m, int i, int j, double s, double t, double z) {
+  const int nx1 = m.nx + 1;
+  const auto w = bilinear_weights(s, t);
+  const int p[4] = {i + nx1 * j, i + 1 + nx1 * j, i + nx1 * (j + 1), i + 1 + nx1 * (j + 1)};
+  Vec3 out{0, 0, z};
+  for (int a = 0; a < 4; ++a) {
+    const Vec3 q = pillar_point(m, p[a], z);
+    out.x += w[a] * q.x;
+    out.y += w[a] * q.y;
+  }
+  return out;
+}
+
+// (s, t) in [0, 1]^2 of plan point x in column (i, j) at depth x.z, by Newton on the bilinear
+// map; false when x is not in the column's quad.
+bool locate_in_column(const CornerPointModel& m, int i, int j, Vec3 x, double& s, double& t) {
+  const Vec3 a = column_point(m, i, j, 0, 0, x.z), b = column_point(m, i, j, 1, 0, x.z);
+  const Vec3 c = column_point(m, i, j, 0, 1, x.z), d = column_point(m, i, j, 1, 1, x.z);
+  const double lo_x = std::min({a.x, b.x, c.x, d.x}), hi_x = std::max({a.x, b.x, c.x, d.x});
+  const double lo_y = std::min({a.y, b.y, c.y, d.y}), hi_y = std::max({a.y, b.y, c.y, d.y});
+  if (x.x < lo_x || x.x > hi_x || x.y < lo_y || x.y > hi_y) return false;
+  s = t = 0.5;
+  for (int it = 0; it < 30; ++it) {
+    const auto w = bilinear_weights(s, t);
+    const double px = w[0] * a.x + w[1] * b.x + w[2] * c.x + w[3] * d.x - x.x;
+    const double py = w[0] * a.y + w[1] * b.y + w[2] * c.y + w[3] * d.y - x.y;
+    const double xs = (1 - t) * (b.x - a.x) + t * (d.x - c.x), ys = (1 - t) * (b.y - a.y) + t * (d.y - c.y);
+    const double xt = (1 - s) * (c.x - a.x) + s * (d.x - b.x), yt = (1 - s) * (c.y - a.y) + s * (d.y - b.y);
+    const double det = xs * yt - xt * ys;
+    if (!(std::abs(det) > 0)) return false;
+    s -= (px * yt - py * xt) / det;
+    t -= (xs * py - ys * px) / det;
+  }
+  // A column is chosen to size slices, not to place nodes: a point on a shared edge may go to
+  // either column.
+  constexpr double kEdge = 1e-9;
+  return s >= -kEdge && s <= 1 + kEdge && t >= -kEdge && t <= 1 + kEdge;
+}
+
+double plan_distance(Vec3 a, Vec3 b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+// Points along the path at most `step` apart (the vertices included).
+std::vector<Vec3> sample_path(const std::vector<Vec3>& path, double step) {
+  std::vector<Vec3> out;
+  for (size_t k = 0; k + 1 < path.size(); ++k) {
+    const int n = std::max(1, static_cast<int>(std::ceil(norm(path[k + 1] - path[k]) / step)));
+    for (int a = 0; a < n; ++a) out.push_back(path[k] + (path[k + 1] - path[k]) * (double(a) / n));
+  }
+  if (!path.empty()) out.push_back(path.back());
+  return out;
+}
+
+// Thickness (in depth) at (s, t) of the layer of column (i, j) that holds depth z; 0 if none does.
+double layer_thickness(const CornerPointModel& m, int i, int j, double s, double t, double z) {
+  const auto w = bilinear_weights(s, t);
+  for (int k = 0; k < m.nz; ++k) {
+    double top = 0, bottom = 0;
+    for (int a = 0; a < 4; ++a) {
+      top += w[a] * m.zcorn[zcorn_index(m, i, j, k, a)];
+      bottom += w[a] * m.zcorn[zcorn_index(m, i, j, k, 4 | a)];
+    }
+    if (top <= z && z <= bottom) return bottom - top;
+  }
+  return 0;
+}
+
+// Children of a slice `width` wide at distance `d` from the path, for near-well cells of `size`.
+int children(double width, double d, double size, const RefinementRequest& r) {
+  if (!(width > kRefineWiderThan * size)) return 1;
+  const double target = size + kRefinementGrowth * std::max(0.0, d - r.reach);
+  return std::max(1, static_cast<int>(std::lround(width / target)));
+}
+
+}  // namespace
+
+bool ColumnSplits::refines() const {
+  return std::any_of(i.begin(), i.end(), [](int n) { return n > 1; }) ||
+         std::any_of(j.begin(), j.end(), [](int n) { return n > 1; });
+}
+
+ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<RefinementRequest>& wells) {
+  ColumnSplits out{std::vector<int>(m.nx, 1), std::vector<int>(m.ny, 1)};
+  for (const RefinementRequest& r : wells) {
+    if (!(r.cell_size > 0)) continue;
+    for (const Vec3& x : sample_path(r.path, 0.5 * r.cell_size)) {
+      int ip = -1, jp = -1;
+      double s = 0, t = 0;
+      for (int j = 0; j < m.ny && ip < 0; ++j)
+        for (int i = 0; i < m.nx && ip < 0; ++i)
+          if (locate_in_column(m, i, j, x, s, t)) ip = i, jp = j;
+      if (ip < 0) continue;
+      double size = r.cell_size;
+      if (const double h = layer_thickness(m, ip, jp, s, t, x.z); r.limit_by_layer && h > 0)
+        size = std::min(size, kCellsPerLayerThickness * h);
+      // Slices along i in the row of x (at its t), then along j in its column (at its s).
+      for (int i = 0; i < m.nx; ++i) {
+        const Vec3 lo = column_point(m, i, jp, 0, t, x.z), hi = column_point(m, i, jp, 1, t, x.z);
+        const double d = i == ip ? 0.0 : plan_distance(x, i > ip ? lo : hi);
+        out.i[i] = std::max(out.i[i], children(plan_distance(lo, hi), d, size, r));
+      }
+      for (int j = 0; j < m.ny; ++j) {
+        const Vec3 lo = column_point(m, ip, j, s, 0, x.z), hi = column_point(m, ip, j, s, 1, x.z);
+        const double d = j == jp ? 0.0 : plan_distance(x, j > jp ? lo : hi);
+        out.j[j] = std::max(out.j[j], children(plan_distance(lo, hi), d, size, r));
+      }
+    }
+  }
+  return out;
+}
+
+CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& splits) {
+  // Per refined pillar line / slice: the model slice it lies in and its parametric position.
+  struct Slot {
+    int parent;
+    int child, of;
+  };
+  auto slots = [](const std::vector<int>& n) {
+    std::vector<Slot> v;
+    for (int p = 0; p < static_cast<int>(n.size()); ++p)
+      for (int a = 0; a < n[p]; ++a) v.push_back({p, a, n[p]});
+    return v;
+  };
+  const std::vector<Slot> si = slots(splits.i), sj = slots(splits.j);
+  CornerPointModel r;
+  r.nx = static_cast<int>(si.size());
+  r.ny = static_cast<int>(sj.size());
+  r.nz = m.nz;
+  r.parent_nx = m.parent_cell.empty() ? m.nx : m.parent_nx;
+  r.parent_ny = m.parent_cell.empty() ? m.ny : m.parent_ny;
+  r.has_mapaxes = m.has_mapaxes;
+  r.map_origin = m.map_origin;
+  r.map_unit_x = m.map_unit_x;
+  r.map_unit_y = m.map_unit_y;
+
+  // Pillars: pillar line I lies in model slice si[I].parent at s = child / of (the last line at s = 1).
+  auto line = [](const std::vector<Slot>& sl, int I, int& parent, double& s) {
+    if (I < static_cast<int>(sl.size())) {
+      parent = sl[I].parent, s = double(sl[I].child) / sl[I].of;
+    } else {
+      parent = sl.back().parent, s = 1.0;
+    }
+  };
+  r.coord.resize(6 * size_t(r.nx + 1) * (r.ny + 1));
+  for (int J = 0; J <= r.ny; ++J)
+    for (int I = 0; I <= r.nx; ++I) {
+      int i, j;
+      double s, t;
+      line(si, I, i, s);
+      line(sj, J, j, t);
+      const auto w = bilinear_weights(s, t);
+      const double* p[4] = {pillar(m, i, j), pillar(m, i + 1, j), pillar(m, i, j + 1), pillar(m, i + 1, j + 1)};
+      double* out = &r.coord[6 * (size_t(I) + size_t(r.nx + 1) * J)];
+      for (int a = 0; a < 6; ++a) out[a] = w[0] * p[0][a] + w[1] * p[1][a] + w[2] * p[2][a] + w[3] * p[3][a];
+    }
+
+  const size_t n = size_t(r.nx) * r.ny * r.nz;
+  r.corners.resize(n);
+  r.zcorn.assign(8 * n, 0.0);
+  r.actnum.resize(n);
+  r.parent_cell.resize(n);
+  for (auto* a : {&r.permx, &r.permy, &r.permz, &r.poro, &r.ntg}) a->resize(n);
+  for (int d = 0; d < 6; ++d)
+    if (!m.trans_mult[d].empty()) r.trans_mult[d].resize(n);
+  for (int k = 0; k < r.nz; ++k)
+    for (int J = 0; J < r.ny; ++J)
+      for (int I = 0; I < r.nx; ++I) {
+        const size_t c = I + size_t(r.nx) * (J + size_t(r.ny) * k);
+        const int i = si[I].parent, j = sj[J].parent;
+        const int pc = i + m.nx * (j + m.ny * k);
+        r.parent_cell[c] = m.parent_cell.empty() ? pc : m.parent_cell[pc];
+        for (int q = 0; q < 8; ++q) {
+          const double s = double(si[I].child + (q & 1)) / si[I].of;
+          const double t = double(sj[J].child + ((q >> 1) & 1)) / sj[J].of;
+          const int side = q & 4;
+          const auto w = bilinear_weights(s, t);
+          double z = 0;
+          for (int a = 0; a < 4; ++a) z += w[a] * m.zcorn[zcorn_index(m, i, j, k, side | a)];
+          r.zcorn[zcorn_index(r, I, J, k, q)] = z;
+          const bool on_model_pillar = (s == 0 || s == 1) && (t == 0 || t == 1);
+          r.corners[c][q] = on_model_pillar ? m.corners[pc][side | (s == 1 ? 1 : 0) | (t == 1 ? 2 : 0)]
+                                            : pillar_point(r, I + (q & 1) + (r.nx + 1) * (J + ((q >> 1) & 1)), z);
+        }
+        r.actnum[c] = m.actnum[pc];
+        r.permx[c] = m.permx[pc];
+        r.permy[c] = m.permy[pc];
+        r.permz[c] = m.permz[pc];
+        r.poro[c] = m.poro[pc];
+        r.ntg[c] = m.ntg[pc];
+        // +x, -x, +y, -y act on the parent's faces; z on every child.
+        const bool at[6] = {si[I].child == si[I].of - 1, si[I].child == 0, sj[J].child == sj[J].of - 1,
+                            sj[J].child == 0, true, true};
+        for (int d = 0; d < 6; ++d)
+          if (!m.trans_mult[d].empty()) r.trans_mult[d][c] = at[d] ? m.trans_mult[d][pc] : 1.0;
+      }
+  return r;
+}
+
+}  // namespace hm

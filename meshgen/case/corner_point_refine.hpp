@@ -1,0 +1,61 @@
+// Near-well refinement of a corner-point model's columns (docs/corner-point.md, "Near-well
+// refinement"). A model whose columns are many times wider than a well's drainage radius (Reek:
+// 100-160 m cells around blocks of 10-30 m) gives cavity walls whose constrained triangles have
+// diametral spheres far larger than the block, and the Gabriel repair grows the cavity through
+// the whole model. Splitting the model's i-columns and j-rows near the wells brings the cells
+// there to the block's scale, like an Eclipse CARFIN extended along whole rows so that the
+// refined model is again a corner-point grid: new pillars interpolate the model's pillars,
+// children's ZCORN interpolate their parent's, so faults stay on the model's pillars and every
+// child keeps its parent's rock and multipliers.
+#pragma once
+#include <vector>
+
+#include "grdecl.hpp"
+#include "meshgen/core/vec3.hpp"
+
+namespace hm {
+
+/// Children per model column along i (size nx) and along j (size ny), each >= 1.
+struct ColumnSplits {
+  std::vector<int> i, j;
+  bool refines() const;
+};
+
+/// What a well asks of the columns around it: its path in the grid frame, the size its nearby
+/// cells should have, and the distance from the path within which cells get that size.
+struct RefinementRequest {
+  std::vector<Vec3> path;
+  double cell_size = 0;
+  double reach = 0;
+  /// Also no wider than kCellsPerLayerThickness x the thickness of the layer the path is in (auto).
+  bool limit_by_layer = false;
+};
+
+/// A column or row wider than this many target cell sizes is split (Gabriel repair handles the
+/// narrower ones with a round or two: docs/corner-point.md, measured).
+constexpr double kRefineWiderThan = 4.0;
+/// With limit_by_layer, near-well cells are at most this many layer thicknesses wide: where the
+/// pillars are inclined the cells are sheared, and the constrained triangles of a sheared cavity
+/// wall stay Delaunay admissible only if the cells are not much wider than thick (measured on
+/// 3 m layers: docs/corner-point.md, "Near-well refinement").
+constexpr double kCellsPerLayerThickness = 1.5;
+/// Beyond `reach` the target size grows by this much per metre of distance from the path, so
+/// that neighbouring slices differ by a bounded ratio and refinement dies out within a few
+/// model columns.
+constexpr double kRefinementGrowth = 1.0;
+
+/// How many children each model column and row gets: a slice (all columns of one i, or of one j)
+/// whose width near a well's path exceeds kRefineWiderThan x cell_size is split into children of
+/// about the target size at its distance from the path (cell_size within reach, growing beyond).
+/// Path points outside the model's columns in plan ask nothing.
+ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<RefinementRequest>& wells);
+
+/// The model with column i split into splits.i[i] and row j into splits.j[j] children of equal
+/// parametric width. New pillars interpolate the model's pillars bilinearly (top and bottom
+/// points); a child's ZCORN interpolate its parent's 4 depths on the same side bilinearly, so a
+/// child's corners on the model's pillars are its parent's (bit for bit). Rock, ACTNUM and the
+/// z multipliers are the parent's; an x (y) multiplier stays on the children along the parent's
+/// face it acts on, 1 inside the parent. `parent_cell` maps each cell to the model's cell.
+CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& splits);
+
+}  // namespace hm

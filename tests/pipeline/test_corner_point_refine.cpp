@@ -1,0 +1,227 @@
+// Near-well refinement of a corner-point model's columns (meshgen/case/corner_point_refine.hpp,
+// docs/corner-point.md "Near-well refinement"). What can fail: the children tile their parents
+// (volumes per parent and in total, corners on the model's pillars bit for bit, faults kept), rock
+// and multipliers are inherited as the keywords mean, the splits follow the well and do not depend
+// on where the model sits, and thin layers in coarse cells, refused without refinement, mesh soundly.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include "../exporters/exporter_test_support.hpp"
+#include "corner_point_test_models.hpp"
+#include "meshgen/case/corner_point_refine.hpp"
+#include "meshgen/case/grdecl.hpp"
+#include "meshgen/grids/well_block.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+
+using namespace hm;
+using hmtest::TempDir;
+
+namespace {
+
+CornerPointModel read_model(const TempDir& tmp, const hmtest::LayeredModel& g) {
+  std::ofstream(tmp.path / "M.GRDECL") << g.text();
+  return read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
+}
+
+// The model's cells meshed alone (no wells): mesh volume per model cell (natural order).
+std::vector<double> cell_volumes(const CornerPointModel& m) {
+  CaseSpec cs;
+  cs.name = "m";
+  cs.reservoir = corner_point_reservoir(std::make_shared<const CornerPointModel>(m), "reservoir.grdecl");
+  const HybridMesh out = build_hybrid_mesh(cs);
+  EXPECT_TRUE(out.build_report.ok);
+  std::vector<double> v(m.corners.size(), 0.0);
+  for (int c = 0; c < out.mesh.n_cells(); ++c) {
+    const auto& ijk = out.mesh.cell_ijk[c];
+    v[ijk[0] + m.nx * (ijk[1] + m.ny * ijk[2])] = out.geometry.cell_volume[c];
+  }
+  return v;
+}
+
+std::string well_case(const std::string& grdecl, const std::string& reservoir_extra, double radius) {
+  return "name: m\nreservoir: {grdecl: " + grdecl + reservoir_extra +
+         "}\nwells:\n  - {name: P1, trajectory: [[350, 350, 1080], [350, 350, 1092]], radius: 0.1, drainage_radius: " +
+         hmtest::grdecl_number(radius) + ", end_caps: flat, bhp: 150}\n";
+}
+
+}  // namespace
+
+// Children of planar-faced cells (planar layers, parallel inclined pillars, a fault of 2.5 layers)
+// fill their parents exactly; corners on the model's pillars are the parent's; rock and multipliers
+// are inherited (an x multiplier only on the children along the parent's face it acts on).
+TEST(NearWellRefinement, ChildrenTileTheirParents) {
+  TempDir tmp("cprefine");
+  hmtest::LayeredModel g;
+  g.nx = 6, g.ny = 5, g.nz = 4, g.dx = 40, g.dy = 30, g.dz = 4, g.pillar_deg = 20, g.fault_i = 3, g.throw_m = 10;
+  CornerPointModel m = read_model(tmp, g);
+  const int marked = 2 + m.nx * (1 + m.ny * 2);  // cell (2, 1, 2): +x, -y and +z multipliers
+  m.trans_mult[0][marked] = 0.5;
+  m.trans_mult[3][marked] = 0.25;
+  m.trans_mult[4][marked] = 0.125;
+  const ColumnSplits splits{{1, 3, 2, 4, 1, 1}, {2, 1, 3, 1, 1}};
+  const CornerPointModel r = refined_model(m, splits);
+  ASSERT_EQ(r.nx, 12);
+  ASSERT_EQ(r.ny, 8);
+  ASSERT_EQ(r.nz, m.nz);
+  ASSERT_EQ(r.parent_cell.size(), r.corners.size());
+
+  const std::vector<double> parent_volume = cell_volumes(m), child_volume = cell_volumes(r);
+  std::vector<double> sum(parent_volume.size(), 0.0);
+  double total_parent = 0, total_child = 0;
+  for (size_t c = 0; c < r.corners.size(); ++c) sum[r.parent_cell[c]] += child_volume[c], total_child += child_volume[c];
+  for (size_t p = 0; p < parent_volume.size(); ++p) {
+    total_parent += parent_volume[p];
+    EXPECT_NEAR(sum[p] / parent_volume[p], 1.0, 1e-12) << "model cell " << p;
+  }
+  EXPECT_NEAR(total_child / total_parent, 1.0, 1e-12);
+
+  int on_model_pillars = 0;
+  for (size_t c = 0; c < r.corners.size(); ++c) {
+    const int p = r.parent_cell[c];
+    EXPECT_EQ(r.permx[c], m.permx[p]);
+    EXPECT_EQ(r.poro[c], m.poro[p]);
+    EXPECT_EQ(r.actnum[c], m.actnum[p]);
+    for (int q = 0; q < 8; ++q)
+      for (int pq = 0; pq < 8; ++pq)
+        if ((q & 4) == (pq & 4) && norm(r.corners[c][q] - m.corners[p][pq]) < 1e-9) {
+          EXPECT_EQ(r.corners[c][q], m.corners[p][pq]);  // bit for bit, not only close
+          ++on_model_pillars;
+        }
+    if (p != marked) {
+      for (int d = 0; d < 6; ++d) EXPECT_EQ(r.trans_mult[d][c], 1.0);
+      continue;
+    }
+    const int I = c % r.nx, J = (c / r.nx) % r.ny;
+    const bool last_i = I + 1 == r.nx || r.parent_cell[c + 1] != p, first_j = J == 0 || r.parent_cell[c - r.nx] != p;
+    EXPECT_EQ(r.trans_mult[0][c], last_i ? 0.5 : 1.0);
+    EXPECT_EQ(r.trans_mult[3][c], first_j ? 0.25 : 1.0);
+    EXPECT_EQ(r.trans_mult[4][c], 0.125);
+  }
+  EXPECT_EQ(on_model_pillars, 8 * m.nx * m.ny * m.nz);  // each parent's 8 corners, once each
+}
+
+// The splits: fine near the well, coarser away, none far off or in narrow columns; the same when
+// the model sits at UTM coordinates.
+TEST(NearWellRefinement, SplitsFollowTheWellWhereverTheModelSits) {
+  TempDir tmp("cprefine");
+  hmtest::LayeredModel g;
+  g.nx = 15, g.ny = 9, g.nz = 10, g.dx = 100, g.dy = 60, g.pillar_deg = 30;
+  const CornerPointModel m = read_model(tmp, g);
+  const RefinementRequest well{{{750, 270, 1030}, {760, 275, 1040}}, 10, 35, false};
+  const ColumnSplits s = near_well_splits(m, {well});
+  ASSERT_EQ(s.i.size(), 15u);
+  ASSERT_EQ(s.j.size(), 9u);
+  // The path is in column (7, 4) (pillars leaning 30 degrees: 17-23 m at its depths): children of
+  // the requested size there and in the columns within reach, fewer further, none 300 m away.
+  EXPECT_EQ(s.i[7], 10);
+  EXPECT_EQ(s.j[4], 6);
+  for (int i = 0; i < 15; ++i) {
+    EXPECT_LE(s.i[i], s.i[7]) << i;
+    if (std::abs(i - 7) >= 3) {
+      EXPECT_EQ(s.i[i], 1) << i;
+    }
+  }
+  EXPECT_LT(s.i[8], s.i[7]);
+  // Narrow columns (not wider than kRefineWiderThan sizes) keep their cells.
+  const ColumnSplits none = near_well_splits(m, {{well.path, 30, 35, false}});
+  EXPECT_FALSE(none.refines());
+  // A model at UTM coordinates with the well moved alike: the same splits.
+  const Vec3 shift{456510.25, 5926880.75, 0};
+  const CornerPointModel far = translated_model(m, shift);
+  const ColumnSplits moved = near_well_splits(far, {{{well.path[0] + shift, well.path[1] + shift}, 10, 35, false}});
+  EXPECT_EQ(moved.i, s.i);
+  EXPECT_EQ(moved.j, s.j);
+}
+
+// Thin layers (3 m) in coarse cells (100 m), a vertical 12 m well of drainage radius 10 m: without
+// refinement the Gabriel repair takes the cavity to the model's top (refused, with the reason);
+// with it the mesh is sound, for vertical and for pillars leaning 56 degrees (sheared cells).
+TEST(NearWellRefinement, ThinLayersInCoarseCellsMesh) {
+  for (double lean : {0.0, 56.0}) {
+    TempDir tmp("cprefine");
+    hmtest::LayeredModel g;
+    g.pillar_deg = lean;
+    std::ofstream(tmp.path / "M.GRDECL") << g.text();
+    std::ofstream(tmp.path / "off.yaml") << well_case("M.GRDECL", ", near_well_cell_size: off", 10);
+    std::ofstream(tmp.path / "auto.yaml") << well_case("M.GRDECL", "", 10);
+    const CaseSpec off = load_case((tmp.path / "off.yaml").string());
+    EXPECT_EQ(off.reservoir.corner_point->nx, 7);
+    try {
+      build_hybrid_mesh(off);
+      ADD_FAILURE() << "lean " << lean << ": meshed without refinement";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("outer surface"), std::string::npos) << e.what();
+    }
+
+    const CaseSpec cs = load_case((tmp.path / "auto.yaml").string());
+    const CornerPointModel& r = *cs.reservoir.corner_point;
+    ASSERT_GT(r.nx, 7);
+    HybridMesh out;
+    ASSERT_NO_THROW(out = build_hybrid_mesh(cs)) << "lean " << lean;
+    ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
+    EXPECT_TRUE(out.build_report.ok);
+    // Volume: the refined model's (equal to the model's: planar faces) minus the wellbore hole.
+    double v = 0, v0 = 0;
+    for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
+    for (double c : cell_volumes(r)) v0 += c;
+    const double hole = exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors);
+    EXPECT_NEAR(v / (v0 - hole), 1.0, 1e-9);
+    int transition = 0;
+    for (int c = 0; c < out.mesh.n_cells(); ++c) transition += out.mesh.cell_region[c] == kTransition;
+    std::printf("[ figures  ] lean %.0f deg: model 7 x 7 x 40 refined to %d x %d x %d, %d cells (%d transition)\n", lean,
+                r.nx, r.ny, r.nz, out.mesh.n_cells(), transition);
+  }
+}
+
+TEST(NearWellRefinement, CaseKeyIsChecked) {
+  TempDir tmp("cprefine");
+  const hmtest::LayeredModel g;
+  std::ofstream(tmp.path / "M.GRDECL") << g.text();
+  auto error_of = [&](const std::string& text) {
+    std::ofstream(tmp.path / "c.yaml") << text;
+    try {
+      load_case((tmp.path / "c.yaml").string());
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of(well_case("M.GRDECL", ", near_well_cell_size: -2", 10)), "reservoir.near_well_cell_size: must be > 0");
+  EXPECT_NE(error_of(well_case("M.GRDECL", ", near_well_cell_size: fine", 10)).find("expected auto, off or a size"),
+            std::string::npos);
+  EXPECT_NE(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], near_well_cell_size: 3}\n")
+                .find("reservoir.near_well_cell_size: only with reservoir.grdecl"),
+            std::string::npos);
+  EXPECT_EQ(error_of(well_case("M.GRDECL", ", near_well_cell_size: 5", 10)), "");
+}
+
+// The table of docs/corner-point.md, "Near-well refinement": the thin-layer model of
+// ThinLayersInCoarseCellsMesh with pillars leaning 0-56 degrees and drainage radii 5-20 m, auto
+// refinement. Every case must mesh soundly (the pipeline's self-check) or the test fails.
+TEST(NearWellRefinement, LeanSweep) {
+  const char* v = std::getenv("HM_LONG_TESTS");
+  if (!(v && std::string(v) == "1")) GTEST_SKIP() << "long test: set HM_LONG_TESTS=1";
+  std::printf("| lean (deg) | R (m) | refined columns | cells | transition cells | meshing s |\n|---|---|---|---|---|---|\n");
+  for (double lean : {0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 56.0})
+    for (double radius : {5.0, 10.0, 20.0}) {
+      TempDir tmp("cprefine");
+      hmtest::LayeredModel g;
+      g.pillar_deg = lean;
+      std::ofstream(tmp.path / "M.GRDECL") << g.text();
+      std::ofstream(tmp.path / "c.yaml") << well_case("M.GRDECL", "", radius);
+      const CaseSpec cs = load_case((tmp.path / "c.yaml").string());
+      const auto t0 = std::chrono::steady_clock::now();
+      HybridMesh out;
+      EXPECT_NO_THROW(out = build_hybrid_mesh(cs)) << "lean " << lean << ", R " << radius;
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      int transition = 0;
+      for (int c = 0; c < out.mesh.n_cells(); ++c) transition += out.mesh.cell_region[c] == kTransition;
+      std::printf("| %.0f | %.0f | %d x %d | %d | %d | %.1f |\n", lean, radius, cs.reservoir.corner_point->nx,
+                  cs.reservoir.corner_point->ny, out.mesh.n_cells(), transition, s);
+    }
+}
