@@ -113,7 +113,7 @@ std::vector<int> skewed_faces_of_cells(const PolyMesh& sub, std::vector<int>* sk
 // The transition cells of a diagram's submesh that fail a shape check the self-check applies to
 // the written mesh (meshgen/pipeline/self_check.cpp, fvcheck's checks at their defaults):
 // convexity, the FV centre (the site) inside, orthogonality of the faces between two transition
-// cells. The faces on the cavity's polygons are the submesh's boundary and not measured here (the
+// cells, planarity of every face. The faces on the cavity's polygons are the submesh's boundary and not measured here (the
 // segment ends on the cell beyond, which the submesh does not hold). The checks report the cells
 // they fail through worst_ids (at most 10); `complete` is false when a check failed more.
 struct ShapeFailures {
@@ -133,11 +133,15 @@ ShapeFailures shape_failures(const PolyMesh& sub) {
     for (size_t i = 0; i < r.worst_ids.size() && static_cast<int64_t>(i) < r.violations; ++i) out.cell[r.worst_ids[i]] = 1;
   }
   const std::vector<double> qo = face_orthogonality(sub, geo);
-  for (int f = 0; f < sub.n_faces(); ++f)
-    if (sub.face_neighbour[f] >= 0 && qo[f] < opt.min_orthogonality_deg) {
-      out.cell[sub.face_owner[f]] = out.cell[sub.face_neighbour[f]] = 1;
-      ++out.count;
-    }
+  const CheckResult planarity = check_planarity(sub, geo, opt);
+  for (int f = 0; f < sub.n_faces(); ++f) {
+    const bool skewed = sub.face_neighbour[f] >= 0 && qo[f] < opt.min_orthogonality_deg;
+    const bool bent = !planarity.values.empty() && planarity.values[f] > opt.max_planarity_deg;
+    if (!skewed && !bent) continue;
+    out.cell[sub.face_owner[f]] = 1;
+    if (sub.face_neighbour[f] >= 0) out.cell[sub.face_neighbour[f]] = 1;
+    ++out.count;
+  }
   return out;
 }
 
