@@ -29,12 +29,13 @@ inline void write_zcorn(std::ostringstream& o, int nx, int ny, int nz,
 }
 
 /// Planar layers (depth 1000 + dz k + tan(dip) x + 0.01 y at pillar (x, y) = (dx I, dy J)) on
-/// parallel straight pillars inclined `pillar_deg` from the vertical toward +x, so every cell face is
+/// parallel straight pillars inclined `pillar_deg` from the vertical toward azimuth `pillar_azimuth_deg`
+/// (0: +x, 90: +y), so every cell face is
 /// planar; an optional fault on pillar line I = fault_i (columns i >= fault_i down by throw_m).
 /// PERMX varies by cell; PERMY 120, PERMZ 12 mD; PORO 0.2.
 struct LayeredModel {
   int nx = 7, ny = 7, nz = 40, fault_i = -1;
-  double dx = 100, dy = 100, dz = 3, dip_deg = 5, pillar_deg = 0, throw_m = 0;
+  double dx = 100, dy = 100, dz = 3, dip_deg = 5, pillar_deg = 0, pillar_azimuth_deg = 0, throw_m = 0;
 
   double depth(int i_col, int I, int J, int k) const {
     double z = 1000 + dz * k + std::tan(dip_deg * M_PI / 180) * dx * I + 0.01 * dy * J;
@@ -43,13 +44,14 @@ struct LayeredModel {
   }
   std::string text() const {
     std::ostringstream o;
-    const double lean = std::tan(pillar_deg * M_PI / 180);
+    const double lean = std::tan(pillar_deg * M_PI / 180), az = pillar_azimuth_deg * M_PI / 180;
+    const double lx = lean * std::cos(az), ly = lean * std::sin(az);
     o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
     for (int J = 0; J <= ny; ++J)
       for (int I = 0; I <= nx; ++I) {
         const double x = dx * I, y = dy * J;  // the pillar's point at depth 1000
-        o << grdecl_number(x - 100 * lean) << " " << grdecl_number(y) << " 900 " << grdecl_number(x + 300 * lean) << " "
-          << grdecl_number(y) << " 1300\n";
+        o << grdecl_number(x - 100 * lx) << " " << grdecl_number(y - 100 * ly) << " 900 " << grdecl_number(x + 300 * lx)
+          << " " << grdecl_number(y + 300 * ly) << " 1300\n";
       }
     o << "/\nZCORN\n";
     write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
