@@ -1,5 +1,7 @@
 #include "summary.hpp"
 
+#include "meshgen/case/grdecl.hpp"
+
 
 namespace hm {
 
@@ -24,6 +26,11 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
   j["nodes"] = h.mesh.n_nodes();
   j["faces"] = h.mesh.n_faces();
   j["cavities"] = h.cavities.cavities.size();
+  if (const auto& m = cs.reservoir.corner_point) {
+    const bool refined = !m->parent_cell.empty();
+    j["corner_point"] = {{"model", {refined ? m->parent_nx : m->nx, refined ? m->parent_ny : m->ny, m->nz}},
+                         {"meshed", {m->nx, m->ny, m->nz}}};
+  }
   nlohmann::json cav = nlohmann::json::array();
   for (size_t k = 0; k < h.cavities.cavities.size(); ++k) {
     const Cavity& c = h.cavities.cavities[k];

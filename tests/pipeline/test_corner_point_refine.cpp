@@ -18,6 +18,7 @@
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/summary.hpp"
 
 using namespace hm;
 using hmtest::TempDir;
@@ -290,6 +291,10 @@ TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
   for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
   const double hole = exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors);
   EXPECT_NEAR(v / (v0 - hole), 1.0, 1e-9);
+  const nlohmann::json summary = make_summary(cs, out);
+  EXPECT_EQ(summary["corner_point"]["model"], nlohmann::json::array({40, 64, 14}));
+  EXPECT_EQ(summary["corner_point"]["meshed"],
+            nlohmann::json::array({cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny, 14}));
   int transition = 0;
   for (int c = 0; c < out.mesh.n_cells(); ++c) transition += out.mesh.cell_region[c] == kTransition;
   std::printf("[ figures  ] Reek, well in column (8, 52), R = 5 m: model 40 x 64 refined to %d x %d, %d cells (%d "
