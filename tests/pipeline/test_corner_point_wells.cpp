@@ -41,6 +41,7 @@ struct TiltedModel {
   double dx = 20, dy = 20, dz = 4.5, dip_deg = 5, throw_m = 0;
   bool inclined_pillars = false;  // non-parallel pillars: the column faces are not planar either
   double pillar_twist = 0;        // inclined pillars whose slope also varies along the model's sides (bent sides)
+  std::vector<int> inactive;      // cells with ACTNUM 0 (natural index)
 
   double depth(int i_col, int I, int J, int k) const {
     const double x = dx * I, y = dy * J;
@@ -62,6 +63,10 @@ struct TiltedModel {
     o << "/\nZCORN\n";
     hmtest::write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
     const int n = nx * ny * nz;
+    if (!inactive.empty()) {
+      o << "/\nACTNUM\n";
+      for (int c = 0; c < n; ++c) o << (std::find(inactive.begin(), inactive.end(), c) == inactive.end() ? 1 : 0) << "\n";
+    }
     o << "/\nPERMX\n";
     for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
     o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
@@ -341,8 +346,8 @@ TiltedModel small_columns() {
 
 // Meshes model g with `wells`, checks the mesh (expect_sound_mesh), and that the cavity reaches the
 // outer surface only where expected: each of its triangles there is on a cell `where` accepts (model
-// cell index) and points into the cavity along +axis.
-void expect_meshes_reaching_the_surface(const TiltedModel& g, const std::string& wells, int axis,
+// cell index) and points into that cell (toward the mean of its corners).
+void expect_meshes_reaching_the_surface(const TiltedModel& g, const std::string& wells,
                                         const std::function<bool(const CornerPointModel&, int)>& where) {
   TempDir tmp("cpsurface");
   const CaseSpec cs = case_of(tmp, g, wells);
@@ -358,7 +363,9 @@ void expect_meshes_reaching_the_surface(const TiltedModel& g, const std::string&
       EXPECT_TRUE(where(m, t.inside_cell)) << "a surface triangle on cell " << t.inside_cell;
       const Vec3 a = out.cavity_node_coords[t.nodes[0]], b = out.cavity_node_coords[t.nodes[1]],
                  c = out.cavity_node_coords[t.nodes[2]];
-      EXPECT_GT(cross(b - a, c - a)[axis], 0) << "a surface triangle not oriented into the cavity";
+      Vec3 centre{0, 0, 0};
+      for (int q = 0; q < 8; ++q) centre += model_cell_corner(m, t.inside_cell, q) / 8.0;
+      EXPECT_GT(dot(cross(b - a, c - a), centre - (a + b + c) / 3.0), 0) << "a surface triangle not oriented into the cavity";
     }
   EXPECT_GT(on_surface, 0u) << "the cavity does not reach the surface: the case tests nothing";
 }
@@ -368,8 +375,30 @@ void expect_meshes_reaching_the_surface(const TiltedModel& g, const std::string&
 // The cavity reaches the model's top (twisted: no top face is planar): it meshes, the top's triangles
 // over the deactivated cells are outer-boundary faces of transition cells (docs/corner-point.md).
 TEST(CornerPointSurface, WellReachingTheTopMeshes) {
-  expect_meshes_reaching_the_surface(small_columns(), vertical_well(45, 45, 1013, 1025), 2,  // down, into the cavity
+  expect_meshes_reaching_the_surface(small_columns(), vertical_well(45, 45, 1013, 1025),
                                      [](const CornerPointModel& m, int c) { return c / (m.nx * m.ny) == 0; });
+}
+
+// The same beside a fault of half a layer's throw on pillar line x = 48 m, through the cavity: the top
+// steps down 1.5 m across it, and the up-thrown cells' fault faces above the down-thrown top (no cell
+// across) are surface triangles too.
+TEST(CornerPointSurface, WellReachingTheTopAcrossAFaultStepMeshes) {
+  TiltedModel g = small_columns();
+  g.fault_i = 8, g.throw_m = 1.5;
+  expect_meshes_reaching_the_surface(g, vertical_well(45, 45, 1013, 1025),
+                                     [](const CornerPointModel& m, int c) { return c / (m.nx * m.ny) == 0; });
+}
+
+// A cavity inside the model beside an inactive cell (ACTNUM 0, 8 m from the well's axis): the faces
+// toward it have no meshed cell across and are surface triangles, outer-boundary faces inside the model.
+TEST(CornerPointSurface, WellBesideAnInactiveCellMeshes) {
+  TiltedModel g = small_columns();
+  const int gap = 9 + g.nx * (7 + g.ny * 7);  // (10, 8, 8), beside the cavity's column i = 9
+  g.inactive = {gap};
+  expect_meshes_reaching_the_surface(g, vertical_well(45, 45, 1023, 1035), [gap](const CornerPointModel& m, int c) {
+    return c == gap - 1 || c == gap + 1 || c == gap - m.nx || c == gap + m.nx || c == gap - m.nx * m.ny ||
+           c == gap + m.nx * m.ny;
+  });
 }
 
 // The cavity reaches a side of a model with inclined, non-parallel pillars whose slope varies along
@@ -377,7 +406,7 @@ TEST(CornerPointSurface, WellReachingTheTopMeshes) {
 TEST(CornerPointSurface, WellReachingASideMeshes) {
   TiltedModel g = small_columns();
   g.inclined_pillars = true, g.pillar_twist = 0.03;
-  expect_meshes_reaching_the_surface(g, vertical_well(14, 45, 1018, 1030), 0,  // +x, into the cavity
+  expect_meshes_reaching_the_surface(g, vertical_well(14, 45, 1018, 1030),
                                      [](const CornerPointModel& m, int c) { return c % m.nx == 0; });
 }
 
