@@ -192,6 +192,12 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
                      "cavity cannot be made Gabriel (paper 5.1); keep the well's meshed path farther from that surface "
                      "than its faces are wide, or make the model's cells near the well smaller (docs/corner-point.md)");
   };
+  auto metres = [](double d) {
+    std::ostringstream os;
+    os.precision(3);
+    os << d << " m";
+    return os.str();
+  };
   // The deactivated cell of the first surface triangle holding all of `nodes`.
   auto surface_cell = [](const std::vector<ResTriangle>& tris, std::initializer_list<int32_t> nodes) {
     for (const ResTriangle& t : tris) {
@@ -228,12 +234,6 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
     remaining = static_cast<int>(bad_res.size() + bad_well.size() + bad_res_faces.size() + bad_well_faces.size());
     if (remaining == 0) break;
     std::set<int32_t> grow;
-    auto metres = [](double d) {
-      std::ostringstream os;
-      os.precision(3);
-      os << d << " m";
-      return os.str();
-    };
     for (const GabrielViolation& v : bad_res) {
       const auto& c = edge_cells.at({v.a, v.b});
       if (c.empty())

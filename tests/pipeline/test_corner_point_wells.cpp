@@ -379,6 +379,16 @@ TEST(CornerPointSurface, WellReachingTheTopMeshes) {
                                      [](const CornerPointModel& m, int c) { return c / (m.nx * m.ny) == 0; });
 }
 
+// A well in the corner column of the bent-sided model, its cavity reaching the top and the two sides
+// x = 0 and y = 0 where they meet (the model's corner: transition cells on three bent surfaces).
+TEST(CornerPointSurface, WellReachingACornerMeshes) {
+  TiltedModel g = small_columns();
+  g.inclined_pillars = true, g.pillar_twist = 0.03;
+  expect_meshes_reaching_the_surface(g, vertical_well(14, 14, 1010, 1022), [](const CornerPointModel& m, int c) {
+    return c / (m.nx * m.ny) == 0 || c % m.nx == 0 || (c / m.nx) % m.ny == 0;
+  });
+}
+
 // The same beside a fault of half a layer's throw on pillar line x = 48 m, through the cavity: the top
 // steps down 1.5 m across it, and the up-thrown cells' fault faces above the down-thrown top (no cell
 // across) are surface triangles too.
@@ -389,7 +399,7 @@ TEST(CornerPointSurface, WellReachingTheTopAcrossAFaultStepMeshes) {
                                      [](const CornerPointModel& m, int c) { return c / (m.nx * m.ny) == 0; });
 }
 
-// A cavity inside the model beside an inactive cell (ACTNUM 0, 8 m from the well's axis): the faces
+// A cavity inside the model beside an inactive cell (ACTNUM 0, 9 m from the well's axis): the faces
 // toward it have no meshed cell across and are surface triangles, outer-boundary faces inside the model.
 TEST(CornerPointSurface, WellBesideAnInactiveCellMeshes) {
   TiltedModel g = small_columns();
