@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "meshgen/grids/gabriel.hpp"
@@ -38,12 +39,31 @@ double solid_angle(Vec3 x, const std::array<Vec3, 3>& t) {
 }
 
 // One reservoir polygon of the current cavity boundary: a constrained triangle of the face of
-// active cell `outside` toward deactivated cell `inside`.
+// active cell `outside` toward deactivated cell `inside`; or (outside = -1) a triangle of a face
+// of deactivated cell `inside` with no meshed cell across it (the model's outer surface, a gap).
 struct ResTriangle {
   std::vector<int32_t> nodes;
   int32_t outside, inside;
 };
 
+// The faces of deactivated cell c with no meshed cell across them, as triangles over their own
+// nodes oriented into the cavity: face_triangles of each face, a fanned face's cycle once and
+// without its centre (as cavity_triangles cuts the faces toward active cells).
+void add_surface_triangles(const CornerPointCellFaces& cells, int c, const std::vector<Vec3>& coords,
+                           std::vector<ResTriangle>& out) {
+  for (size_t f = 0; f < cells.faces[c].size(); ++f) {
+    if (cells.neighbour[c][f] >= 0) continue;
+    const int32_t g = cells.group[c][f];
+    bool seen = false;
+    for (size_t e = 0; e < f && g >= 0 && !seen; ++e) seen = cells.group[c][e] == g;
+    if (seen) continue;
+    const std::vector<int32_t>& cycle = g >= 0 ? cells.groups[g] : cells.faces[c][f].nodes;  // outward for c
+    for (const auto& t : face_triangles(cycle, coords)) out.push_back({{t[2], t[1], t[0]}, -1, static_cast<int32_t>(c)});
+  }
+}
+
+// The cavity boundary's reservoir triangles: those of the active cells toward deactivated ones (in
+// the cells' order), then those of the deactivated cells on the model's outer surface.
 std::vector<ResTriangle> reservoir_triangles(const CornerPointCellFaces& cells, const std::vector<char>& active,
                                              const std::vector<Vec3>& coords) {
   std::vector<ResTriangle> out;
@@ -52,6 +72,8 @@ std::vector<ResTriangle> reservoir_triangles(const CornerPointCellFaces& cells, 
     for (CavityTriangle& t : cavity_triangles(cells, static_cast<int>(c), active, coords))
       out.push_back({std::move(t.nodes), static_cast<int32_t>(c), t.inside});
   }
+  for (size_t c = 0; c < cells.faces.size(); ++c)
+    if (cells.meshed[c] && !active[c]) add_surface_triangles(cells, static_cast<int>(c), coords, out);
   return out;
 }
 
@@ -121,24 +143,83 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
   const ReservoirGrid index_grid = make_reservoir_grid(cs.reservoir);  // index arithmetic (nx, ny, nz)
   int regularized = regularize_deactivated(index_grid, active);
 
-  // 2. Gabriel across the two sides (paper 5.1), as in build_cavities: where a reservoir triangle
-  //    or edge holds a well vertex in its diametral sphere, or a well polygon or edge a reservoir
-  //    vertex, the active cells behind the reservoir triangles involved are deactivated.
   const WellSurfaces well_side = well_surfaces(blocks, well_node_ids);
   const std::vector<int32_t>& well_vertices = well_side.vertices;
   const std::vector<std::array<int32_t, 2>>& well_edges = well_side.edges;
   const std::vector<std::vector<int32_t>>& well_polygons = well_side.polygons;
+  auto well_name = [&](int32_t v) {
+    for (size_t w = 0; w < well_node_ids.size(); ++w)
+      if (std::find(well_node_ids[w].begin(), well_node_ids[w].end(), v) != well_node_ids[w].end())
+        return "wells[" + std::to_string(blocks[w].well) + "] (" + cs.wells[blocks[w].well].name + ")";
+    return std::string("a well");
+  };
+
+  // 1b. The blocks lie inside the model's meshed cells: every outer vertex of a block inside the
+  //     closed surface of the deactivated cells (winding number of its triangles, which are the
+  //     union's boundary; dilation >= 1 deactivates every meshed cell a block meets). A cavity may
+  //     reach the model's outer surface, a block may not cross it.
+  {
+    std::vector<std::array<Vec3, 3>> surface;
+    for (const ResTriangle& t : reservoir_triangles(cells, active, coords))
+      surface.push_back({coords[t.nodes[0]], coords[t.nodes[1]], coords[t.nodes[2]]});
+    for (int32_t v : well_vertices) {
+      double w = 0;
+      for (const auto& t : surface) w += solid_angle(coords[v], t);
+      if (!(std::abs(w) > 2.0 * kPi)) {  // winding number 0 (outside), not 1 (4 pi)
+        std::ostringstream os;
+        os.precision(6);
+        os << coords[v].z;
+        throw InputError(well_name(v) + ": its well block (drainage_radius around the meshed path, and its ends) "
+                         "reaches outside the meshed cells of the corner-point model " + cs.reservoir.grdecl +
+                         " at depth " + os.str() + " m (above its top, below its bottom, beyond a side, or into an "
+                         "inactive or zero-thickness cell): the block must lie inside the model (docs/corner-point.md)");
+      }
+    }
+  }
+
+  // 2. Gabriel across the two sides (paper 5.1), as in build_cavities: where a reservoir triangle
+  //    or edge holds a well vertex in its diametral sphere, or a well polygon or edge a reservoir
+  //    vertex, the active cells behind the reservoir triangles involved are deactivated.
+  // A violation on the model's outer surface (a surface triangle or edge holding a well vertex, a
+  // surface vertex in a well polygon's or edge's sphere, with no active cell behind) cannot be
+  // repaired: those triangles stay on the cavity boundary whatever else is deactivated, and the well
+  // block does not move. The cavity is refused, naming the cell and the well.
+  auto refuse_on_surface = [&](int32_t cell, const std::string& what, int32_t well_vertex) {
+    throw InputError("wells: the cavity of " + well_name(well_vertex) + " in the corner-point model " +
+                     cs.reservoir.grdecl + " reaches the model's outer surface (its top, bottom or sides, or an "
+                     "inactive or zero-thickness cell) at cell " + cell_name(model, cell) + ", where " + what +
+                     ": the surface cannot move away from the well (no model cell behind it to deactivate), so the "
+                     "cavity cannot be made Gabriel (paper 5.1); keep the well's meshed path farther from that surface "
+                     "than its faces are wide, or make the model's cells near the well smaller (docs/corner-point.md)");
+  };
+  auto metres = [](double d) {
+    std::ostringstream os;
+    os.precision(3);
+    os << d << " m";
+    return os.str();
+  };
+  // The deactivated cell of the first surface triangle holding all of `nodes`.
+  auto surface_cell = [](const std::vector<ResTriangle>& tris, std::initializer_list<int32_t> nodes) {
+    for (const ResTriangle& t : tris) {
+      bool all = t.outside < 0;
+      for (int32_t v : nodes) all = all && std::find(t.nodes.begin(), t.nodes.end(), v) != t.nodes.end();
+      if (all) return t.inside;
+    }
+    return int32_t{-1};
+  };
   int repaired = 0, rounds = 0, remaining = 0;
   for (rounds = 0; rounds < 60; ++rounds) {
     const std::vector<ResTriangle> tris = reservoir_triangles(cells, active, coords);
+    // Per reservoir edge and vertex: the active cells behind its triangles (none on the surface).
     std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> edge_cells;
     std::map<int32_t, std::vector<int32_t>> vertex_cells;
     std::vector<std::vector<int32_t>> polys;
     for (const ResTriangle& t : tris) {
       for (size_t i = 0; i < 3; ++i) {
         const int32_t a = t.nodes[i], b = t.nodes[(i + 1) % 3];
-        edge_cells[{std::min(a, b), std::max(a, b)}].push_back(t.outside);
-        vertex_cells[a].push_back(t.outside);
+        std::vector<int32_t>& ec = edge_cells[{std::min(a, b), std::max(a, b)}];
+        std::vector<int32_t>& vc = vertex_cells[a];
+        if (t.outside >= 0) ec.push_back(t.outside), vc.push_back(t.outside);
       }
       polys.push_back(t.nodes);
     }
@@ -155,12 +236,42 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
     std::set<int32_t> grow;
     for (const GabrielViolation& v : bad_res) {
       const auto& c = edge_cells.at({v.a, v.b});
+      if (c.empty())
+        refuse_on_surface(surface_cell(tris, {v.a, v.b}),
+                          "an edge of its surface triangles (" + metres(norm(coords[v.a] - coords[v.b])) +
+                              " long) holds a vertex of the well block in its diametral sphere",
+                          v.p);
       grow.insert(c.begin(), c.end());
     }
-    for (const GabrielViolation& v : bad_well) grow.insert(vertex_cells.at(v.p).begin(), vertex_cells.at(v.p).end());
-    for (const FaceGabrielViolation& v : bad_res_faces) grow.insert(tris[v.polygon].outside);
-    for (const FaceGabrielViolation& v : bad_well_faces)
-      grow.insert(vertex_cells.at(v.p).begin(), vertex_cells.at(v.p).end());
+    for (const GabrielViolation& v : bad_well) {
+      const auto& c = vertex_cells.at(v.p);
+      if (c.empty())
+        refuse_on_surface(surface_cell(tris, {v.p}),
+                          "a node of its surface face lies in the diametral sphere of an edge of the well block (" +
+                              metres(norm(coords[v.a] - coords[v.b])) + " long)",
+                          v.a);
+      grow.insert(c.begin(), c.end());
+    }
+    for (const FaceGabrielViolation& v : bad_res_faces) {
+      const ResTriangle& t = tris[v.polygon];
+      if (t.outside < 0) {
+        double longest = 0;
+        for (size_t i = 0; i < 3; ++i) longest = std::max(longest, norm(coords[t.nodes[i]] - coords[t.nodes[(i + 1) % 3]]));
+        refuse_on_surface(t.inside,
+                          "a triangle of its surface face (edges up to " + metres(longest) +
+                              ") holds a vertex of the well block in its diametral sphere",
+                          v.p);
+      }
+      grow.insert(t.outside);
+    }
+    for (const FaceGabrielViolation& v : bad_well_faces) {
+      const auto& c = vertex_cells.at(v.p);
+      if (c.empty())
+        refuse_on_surface(surface_cell(tris, {v.p}),
+                          "a node of its surface face lies in the diametral sphere of a polygon of the well block",
+                          well_polygons[v.polygon].front());
+      grow.insert(c.begin(), c.end());
+    }
     if (grow.empty()) break;
     for (int32_t c : grow) active[c] = 0;
     repaired += static_cast<int>(grow.size());
@@ -178,20 +289,12 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
     out.notes.push_back("cavity: " + std::to_string(regularized) +
                         " model cells deactivated to keep the cavity boundary a 2-manifold");
 
-  // 3. A deactivated cell must have a meshed cell across each of its faces: the model's outer
-  //    surface (and gaps: inactive or zero-thickness cells) has no mirror plane.
+  // 3. The deactivated cells. Their faces with no meshed cell across (the model's outer surface,
+  //    gaps: inactive or zero-thickness cells) are constrained triangles too (step 5), whose
+  //    transition faces are outer-boundary faces (docs/corner-point.md, "Outer surface").
   std::vector<int32_t> dead;
-  for (int c = 0; c < nc; ++c) {
-    if (!cells.meshed[c] || active[c]) continue;
-    dead.push_back(c);
-    for (int32_t nb : cells.neighbour[c])
-      if (nb < 0)
-        throw InputError("wells: the cavity around the wells reaches the outer surface of the corner-point model " +
-                         cs.reservoir.grdecl + " at cell " + cell_name(model, c) +
-                         " (its top, bottom or sides, or an inactive or zero-thickness cell): in a corner-point model a "
-                         "well's meshed path must stay inside, at least one layer and dilation x drainage_radius from "
-                         "that surface (docs/corner-point.md)");
-  }
+  for (int c = 0; c < nc; ++c)
+    if (cells.meshed[c] && !active[c]) dead.push_back(c);
 
   // 4. Cavities: connected components of the deactivated cells across their faces.
   std::vector<int> comp(nc, -1);
@@ -223,16 +326,23 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
     out.cavities[comp[best]].wells.push_back(static_cast<int>(w));
   }
 
-  // 5. Boundaries: the reservoir triangles (in the active cells' order), then the blocks' polygons.
+  // 5. Boundaries: the reservoir triangles (toward the active cells in their order, then those on the
+  //    model's outer surface: outside_cell -1, an outer-boundary face of the transition), then the
+  //    blocks' polygons.
   const std::vector<ResTriangle> tris = reservoir_triangles(cells, active, coords);
+  int on_surface = 0;
   for (const ResTriangle& t : tris) {
     ConstrainedFace f;
-    f.nodes = t.nodes;  // the active cell's outward orientation: into the cavity
+    f.nodes = t.nodes;  // into the cavity
     f.side = FaceSide::Reservoir;
     f.outside_cell = t.outside;
     f.inside_cell = t.inside;
+    if (t.outside < 0) f.patch = kOuterBoundary, ++on_surface;
     out.cavities[comp[t.inside]].faces.push_back(std::move(f));
   }
+  if (on_surface > 0)
+    out.notes.push_back("cavity: " + std::to_string(on_surface) +
+                        " constrained triangles on the corner-point model's outer surface (outer-boundary faces)");
   for (size_t k = 0; k < out.cavities.size(); ++k) {
     Cavity& cav = out.cavities[k];
     if (cav.wells.empty()) throw InputError("wells: internal error, a cavity without a well");

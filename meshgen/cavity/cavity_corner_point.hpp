@@ -2,7 +2,8 @@
 // well block are deactivated (and grown for the Gabriel condition, as in cavity.hpp); the
 // boundary is made of the model faces between an active and a deactivated cell (fault
 // overlaps included), each as its constrained triangles (cavity_triangles), which the
-// active cell gets as its faces too: no new node, exact conformity.
+// active cell gets as its faces too: no new node, exact conformity; and the deactivated cells'
+// faces on the model's outer surface, as triangles over their own nodes (outer-boundary faces).
 #pragma once
 #include <memory>
 #include <vector>
@@ -35,9 +36,12 @@ class CornerPointLocator {
 /// The cavities of the wells in a corner-point model: `cells` (corner_point_cell_faces) with
 /// its nodes in `node_coords`, `well_node_ids[w]` the builder ids of block w's nodes. Every
 /// cavity has cells_are_boxes = false, no mirror plane, and a locate_cell over its cells.
-/// `extra_deactivated` are deactivated too (a transition's request). Throws InputError when a
-/// cavity reaches the model's outer surface (top, bottom, sides, an inactive or zero-thickness
-/// cell: no mirror plane there, docs/corner-point.md) or cannot be made Gabriel.
+/// `extra_deactivated` are deactivated too (a transition's request). A cavity may reach the
+/// model's outer surface (top, bottom, sides, an inactive or zero-thickness cell): the deactivated
+/// cells' faces there are constrained triangles too (outside_cell -1, patch kOuterBoundary: the
+/// transition's faces on them are outer-boundary faces; docs/corner-point.md). Throws InputError
+/// when a cavity cannot be made Gabriel, in particular where the surface itself is too close to a
+/// well (no cell behind it to deactivate; the message names the cell and the well).
 CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel& model,
                                       const CornerPointCellFaces& cells, const std::vector<WellBlock>& blocks,
                                       const std::vector<std::vector<int32_t>>& well_node_ids,

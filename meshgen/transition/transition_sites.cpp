@@ -234,7 +234,7 @@ std::vector<int> non_empty_sites(SiteSet& set, const Cavity& cavity, const std::
 }
 
 // Short label of a site for the correction's diagnostics: its kind and, for polygon sites, the
-// side and orientation of its polygon (reservoir faces: x/y/z normal).
+// side and orientation of its polygon (reservoir faces, "res", or on the outer surface, "surf": x/y/z normal).
 std::string site_label(const SiteSet& set, int s, const Cavity& cavity, const std::vector<PolygonFrame>& frames) {
   const Site& site = set.sites[s];
   switch (site.kind) {
@@ -245,7 +245,10 @@ std::string site_label(const SiteSet& set, int s, const Cavity& cavity, const st
     default: break;
   }
   const int q = site.polygon;
-  std::string side = cavity.faces[q].side == FaceSide::Well ? "well" : "res";
+  // "surf": a corner-point cavity's triangle on the model's outer surface (docs/corner-point.md).
+  std::string side = cavity.faces[q].side == FaceSide::Well ? "well"
+                     : cavity.faces[q].patch == kOuterBoundary ? "surf"
+                                                                : "res";
   if (cavity.faces[q].side == FaceSide::Reservoir) {
     const Vec3 n = frames[q].normal;
     side += std::abs(n.z) > 0.5 ? "-z" : std::abs(n.y) > 0.5 ? "-y" : "-x";

@@ -2,15 +2,18 @@
 // curved layers; a fault), a vertical well inside. What can fail: the job meshes and passes the
 // self-check (fvcheck's checks; it throws otherwise), the total volume is the model's meshed
 // volume minus the wellbore hole, every model face toward the cavity appears exactly once in the
-// mesh as its constrained triangles between its active cell and one transition cell, the
-// transition cells take the rock of the model cell around their centre, and a well reaching the
-// model's outer surface is refused with the reason.
+// mesh as its constrained triangles between its active cell and one transition cell, every face of a
+// deactivated cell on the model's outer surface appears exactly once as its triangles, boundary faces
+// of transition cells, the model's boundary area is kept, the transition cells take the rock of the
+// model cell around their centre; and a well too near the surface for its faces is refused with the reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -37,6 +40,8 @@ struct TiltedModel {
   int nx = 9, ny = 9, nz = 16, fault_i = -1;
   double dx = 20, dy = 20, dz = 4.5, dip_deg = 5, throw_m = 0;
   bool inclined_pillars = false;  // non-parallel pillars: the column faces are not planar either
+  double pillar_twist = 0;        // inclined pillars whose slope also varies along the model's sides (bent sides)
+  std::vector<int> inactive;      // cells with ACTNUM 0 (natural index)
 
   double depth(int i_col, int I, int J, int k) const {
     const double x = dx * I, y = dy * J;
@@ -51,12 +56,17 @@ struct TiltedModel {
       for (int I = 0; I <= nx; ++I)
       {
         const double x = dx * I, y = dy * J;
-        const double bx = inclined_pillars ? x + 6 + 0.01 * x : x, by = inclined_pillars ? y + 3 - 0.005 * y : y;
+        const double bx = inclined_pillars ? x + 6 + 0.01 * x + pillar_twist * y : x,
+                     by = inclined_pillars ? y + 3 - 0.005 * y + pillar_twist * x : y;
         o << num(x) << " " << num(y) << " 900 " << num(bx) << " " << num(by) << " 1200\n";
       }
     o << "/\nZCORN\n";
     hmtest::write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
     const int n = nx * ny * nz;
+    if (!inactive.empty()) {
+      o << "/\nACTNUM\n";
+      for (int c = 0; c < n; ++c) o << (std::find(inactive.begin(), inactive.end(), c) == inactive.end() ? 1 : 0) << "\n";
+    }
     o << "/\nPERMX\n";
     for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
     o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
@@ -106,7 +116,6 @@ void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
   std::printf("[ figures  ] corner-point with wells: %d cells (%d transition), volume %.9f vs model - wellbore %.9f "
               "(rel %.2e)\n",
               out.mesh.n_cells(), transition, v, v0 - hole, v / (v0 - hole) - 1);
-  EXPECT_NEAR(v / (v0 - hole), 1.0, 1e-9);
   // Each constrained triangle of a reservoir side: exactly one mesh face, between the model cell
   // outside and a transition cell; and no other face joins a model cell to a transition cell.
   std::map<std::array<double, 3>, int32_t> node_at;
@@ -117,23 +126,44 @@ void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
     std::sort(key.begin(), key.end());
     faces_of[key].push_back(f);
   }
+  // Every face once in the mesh, in exactly two cells' lists when interior (two distinct cells), in
+  // its owner's only when on the boundary (then in a patch).
+  std::vector<int> uses(out.mesh.n_faces(), 0);
+  for (int32_t f : out.mesh.cell_faces) ++uses[f];
+  for (const auto& [key, fs] : faces_of) ASSERT_EQ(fs.size(), 1u) << "two mesh faces over the same nodes";
+  for (int32_t f = 0; f < out.mesh.n_faces(); ++f) {
+    const bool interior = out.mesh.face_neighbour[f] >= 0;
+    ASSERT_EQ(uses[f], interior ? 2 : 1) << "face " << f;
+    ASSERT_EQ(out.mesh.face_patch[f] == kInteriorFace, interior) << "face " << f;
+    if (interior) {
+      ASSERT_NE(out.mesh.face_owner[f], out.mesh.face_neighbour[f]) << "face " << f;
+    }
+  }
   const CornerPointModel& m = *cs.reservoir.corner_point;
-  size_t triangles = 0;
+  auto mesh_face = [&](const std::vector<int32_t>& builder_ids) {
+    std::vector<int32_t> key;
+    for (int32_t v : builder_ids) {
+      const Vec3 p = out.cavity_node_coords[v];
+      key.push_back(node_at.at({p.x, p.y, p.z}));
+    }
+    std::sort(key.begin(), key.end());
+    const auto it = faces_of.find(key);
+    return it == faces_of.end() ? -1 : it->second[0];
+  };
+  size_t triangles = 0, surface = 0;
   for (const Cavity& cav : out.cavities.cavities)
     for (const ConstrainedFace& cf : cav.faces) {
       if (cf.side != FaceSide::Reservoir) continue;
-      ++triangles;
       ASSERT_EQ(cf.nodes.size(), 3u);
-      std::vector<int32_t> key;
-      for (int32_t v : cf.nodes) {
-        const Vec3 p = out.cavity_node_coords[v];
-        key.push_back(node_at.at({p.x, p.y, p.z}));
+      const int32_t f = mesh_face(cf.nodes);
+      ASSERT_GE(f, 0) << "a constrained triangle is no face of the mesh";
+      const int32_t o = out.mesh.face_owner[f], n = out.mesh.face_neighbour[f];
+      if (cf.outside_cell < 0) {  // on the model's outer surface: checked below
+        ++surface;
+        EXPECT_EQ(cf.patch, kOuterBoundary);
+        continue;
       }
-      std::sort(key.begin(), key.end());
-      const auto it = faces_of.find(key);
-      ASSERT_NE(it, faces_of.end()) << "a constrained triangle is no face of the mesh";
-      ASSERT_EQ(it->second.size(), 1u) << "a constrained triangle is in the mesh more than once";
-      const int32_t f = it->second[0], o = out.mesh.face_owner[f], n = out.mesh.face_neighbour[f];
+      ++triangles;
       ASSERT_GE(n, 0);
       const int32_t res = out.mesh.cell_region[o] == kReservoir ? o : n, tr = res == o ? n : o;
       EXPECT_EQ(out.mesh.cell_region[tr], kTransition);
@@ -167,6 +197,100 @@ void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
   std::printf("[ figures  ] non-positive two-point halves on the model cells' side: %d\n", model_negative);
   EXPECT_GT(triangles, 0u);
   EXPECT_EQ(joins, triangles);
+  // The model's outer surface (docs/corner-point.md, "Outer surface"): every face of a deactivated
+  // cell with no meshed cell across it, cut into triangles over its own nodes, is exactly one mesh
+  // face: a boundary face (kOuterBoundary) of a transition cell, outward as the model face. Listed
+  // here from the model's faces, not from the cavity.
+  std::set<int32_t> dead_cells;
+  for (const Cavity& cav : out.cavities.cavities) dead_cells.insert(cav.deactivated_cells.begin(), cav.deactivated_cells.end());
+  MeshBuilder scratch;
+  const CornerPointCellFaces model_faces = corner_point_cell_faces(m, std::vector<char>(m.actnum.size(), 1), scratch);
+  std::vector<Vec3> builder_coords(scratch.n_nodes());
+  for (int32_t v = 0; v < scratch.n_nodes(); ++v) builder_coords[v] = scratch.node(v);
+  ASSERT_LE(builder_coords.size(), out.cavity_node_coords.size());
+  for (size_t v = 0; v < builder_coords.size(); ++v)  // the model's nodes have the pipeline's ids
+    ASSERT_EQ(builder_coords[v], out.cavity_node_coords[v]) << v;
+  size_t surface_found = 0;
+  double surface_triangle_area = 0;  // sum of |area| of those triangles
+  // The volume the model's meshed surface (a face as the fan about its node mean, compute_geometry)
+  // loses where it becomes the face's triangles: per face, fan minus triangles (divergence theorem,
+  // about the face's first node). Zero for planar faces.
+  auto fan_volume = [&](const std::vector<int32_t>& poly, Vec3 o) {
+    Vec3 g{0, 0, 0};
+    for (int32_t v : poly) g += builder_coords[v] / static_cast<double>(poly.size());
+    double vol = 0;
+    for (size_t i = 0; i < poly.size(); ++i)
+      vol += dot(g - o, cross(builder_coords[poly[i]] - o, builder_coords[poly[(i + 1) % poly.size()]] - o)) / 6.0;
+    return vol;
+  };
+  double bent_volume = 0;
+  for (int32_t c : dead_cells)
+    for (size_t k = 0; k < model_faces.faces[c].size(); ++k) {
+      if (model_faces.neighbour[c][k] >= 0) continue;
+      const int32_t g = model_faces.group[c][k];
+      bool seen = false;
+      for (size_t e = 0; e < k && g >= 0; ++e) seen = seen || model_faces.group[c][e] == g;
+      if (seen) continue;
+      const std::vector<int32_t>& cycle = g >= 0 ? model_faces.groups[g] : model_faces.faces[c][k].nodes;
+      const Vec3 o = builder_coords[cycle[0]];
+      for (size_t e = 0; e < model_faces.faces[c].size(); ++e)  // the face, or every face of its fan
+        if (e == k || (g >= 0 && model_faces.group[c][e] == g)) bent_volume += fan_volume(model_faces.faces[c][e].nodes, o);
+      for (const auto& t : face_triangles(cycle, builder_coords)) {
+        bent_volume -= fan_volume({t[0], t[1], t[2]}, o);
+        ++surface_found;
+        const int32_t f = mesh_face({t[0], t[1], t[2]});
+        ASSERT_GE(f, 0) << "an outer-surface triangle of deactivated cell " << c << " is no face of the mesh";
+        EXPECT_LT(out.mesh.face_neighbour[f], 0);
+        EXPECT_EQ(out.mesh.face_patch[f], kOuterBoundary);
+        EXPECT_EQ(out.mesh.cell_region[out.mesh.face_owner[f]], kTransition);
+        const Vec3 a = 0.5 * cross(builder_coords[t[1]] - builder_coords[t[0]], builder_coords[t[2]] - builder_coords[t[0]]);
+        EXPECT_GT(dot(out.geometry.face_area[f], a), 0) << "an outer-surface triangle points into the model";
+        surface_triangle_area += norm(out.geometry.face_area[f]);
+      }
+    }
+  EXPECT_EQ(surface_found, surface);
+  // Orthogonality of the boundary faces (measured, not asserted): the angle between a face's normal
+  // and the segment from its cell's FV centre to the face centroid, transition cells (on the
+  // surface triangles) against model cells (their corner mean, on the model's faces).
+  double worst_transition = 0, worst_model = 0;
+  for (int32_t f = 0; f < out.mesh.n_faces(); ++f) {
+    if (out.mesh.face_patch[f] != kOuterBoundary) continue;
+    const int32_t o = out.mesh.face_owner[f];
+    const Vec3 d = out.geometry.face_centroid[f] - out.mesh.cell_fv_center[o], a = out.geometry.face_area[f];
+    const double deg = std::acos(std::clamp(dot(d, a) / (norm(d) * norm(a)), -1.0, 1.0)) * 180 / M_PI;
+    (out.mesh.cell_region[o] == kTransition ? worst_transition : worst_model) =
+        std::max(out.mesh.cell_region[o] == kTransition ? worst_transition : worst_model, deg);
+  }
+  std::printf("[ figures  ] outer-boundary faces, worst angle normal / (centroid - FV centre): transition cells %.1f "
+              "deg, model cells %.1f deg\n",
+              worst_transition, worst_model);
+  // The model's boundary area: the sum of |area| of the kOuterBoundary faces is the bare model's, but
+  // for the deactivated cells' surface faces, now their triangles (a bent face's triangles have more
+  // area than its vector area: the difference is counted, not tolerated).
+  auto outer_area = [](const HybridMesh& h) {
+    double a = 0;
+    for (int32_t f = 0; f < h.mesh.n_faces(); ++f)
+      if (h.mesh.face_patch[f] == kOuterBoundary) a += norm(h.geometry.face_area[f]);
+    return a;
+  };
+  double bare_dead_area = 0;
+  for (int32_t f = 0; f < bare.mesh.n_faces(); ++f) {
+    if (bare.mesh.face_patch[f] != kOuterBoundary) continue;
+    const auto& ijk = bare.mesh.cell_ijk[bare.mesh.face_owner[f]];
+    if (dead_cells.count(ijk[0] + m.nx * (ijk[1] + m.ny * ijk[2]))) bare_dead_area += norm(bare.geometry.face_area[f]);
+  }
+  const double a_wells = outer_area(out), a_bare = outer_area(bare), bend = surface_triangle_area - bare_dead_area;
+  std::printf("[ figures  ] outer surface: %zu triangles of deactivated cells; boundary area %.9f vs model %.9f "
+              "(bent faces' triangles add %.3e relative; the rest differs by %.2e relative)\n",
+              surface, a_wells, a_bare, bend / a_bare, (a_wells - a_bare - bend) / a_bare);
+  EXPECT_GE(bend, -1e-12 * a_bare);
+  EXPECT_NEAR((a_wells - bend) / a_bare, 1.0, 1e-12);
+  // Volume: the model without wells, minus the wellbore holes, minus what the triangles of the bent
+  // surface faces cut off the model's fans.
+  std::printf("[ figures  ] volume vs model - wellbore - bent surface faces %.9f (rel %.2e; the bent faces cut "
+              "%.3e m3, %.2e relative)\n",
+              v0 - hole - bent_volume, v / (v0 - hole - bent_volume) - 1, bent_volume, bent_volume / v0);
+  EXPECT_NEAR(v / (v0 - hole - bent_volume), 1.0, 1e-9);
   // Rock: a transition cell's permeability is that of the deactivated model cell around its centre.
   std::set<int32_t> dead;
   for (const Cavity& cav : out.cavities.cavities) dead.insert(cav.deactivated_cells.begin(), cav.deactivated_cells.end());
@@ -210,16 +334,108 @@ TEST(CornerPointWells, DeviatedWellWithInclinedPillarsMeshes) {
   expect_sound_mesh(cs, out);
 }
 
-// A well whose cavity reaches the model's top is refused (exit 2) with the reason.
-TEST(CornerPointWells, WellReachingTheTopIsRefusedWithTheReason) {
-  TempDir tmp("cpwells");
+namespace {
+
+// A tilted, twisted model of small columns (6 x 6 m, 3 m layers): the top triangles' diametral
+// spheres (radius 4.2 m) clear a well 8 m below the top, whose cavity (dilation 1.5 x 5 m) reaches it.
+TiltedModel small_columns() {
+  TiltedModel g;
+  g.nx = g.ny = 15, g.nz = 16, g.dx = g.dy = 6, g.dz = 3;
+  return g;
+}
+
+// Meshes model g with `wells`, checks the mesh (expect_sound_mesh), and that the cavity reaches the
+// outer surface only where expected: each of its triangles there is on a cell `where` accepts (model
+// cell index) and points into that cell (toward the mean of its corners).
+void expect_meshes_reaching_the_surface(const TiltedModel& g, const std::string& wells,
+                                        const std::function<bool(const CornerPointModel&, int)>& where) {
+  TempDir tmp("cpsurface");
+  const CaseSpec cs = case_of(tmp, g, wells);
+  HybridMesh out;
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  expect_sound_mesh(cs, out);
+  const CornerPointModel& m = *cs.reservoir.corner_point;
+  size_t on_surface = 0;
+  for (const Cavity& cav : out.cavities.cavities)
+    for (const ConstrainedFace& t : cav.faces) {
+      if (t.side != FaceSide::Reservoir || t.outside_cell >= 0) continue;
+      ++on_surface;
+      EXPECT_TRUE(where(m, t.inside_cell)) << "a surface triangle on cell " << t.inside_cell;
+      const Vec3 a = out.cavity_node_coords[t.nodes[0]], b = out.cavity_node_coords[t.nodes[1]],
+                 c = out.cavity_node_coords[t.nodes[2]];
+      Vec3 centre{0, 0, 0};
+      for (int q = 0; q < 8; ++q) centre += model_cell_corner(m, t.inside_cell, q) / 8.0;
+      EXPECT_GT(dot(cross(b - a, c - a), centre - (a + b + c) / 3.0), 0) << "a surface triangle not oriented into the cavity";
+    }
+  EXPECT_GT(on_surface, 0u) << "the cavity does not reach the surface: the case tests nothing";
+}
+
+}  // namespace
+
+// The cavity reaches the model's top (twisted: no top face is planar): it meshes, the top's triangles
+// over the deactivated cells are outer-boundary faces of transition cells (docs/corner-point.md).
+TEST(CornerPointSurface, WellReachingTheTopMeshes) {
+  expect_meshes_reaching_the_surface(small_columns(), vertical_well(45, 45, 1013, 1025),
+                                     [](const CornerPointModel& m, int c) { return c / (m.nx * m.ny) == 0; });
+}
+
+// A well in the corner column of the bent-sided model, its cavity reaching the top and the two sides
+// x = 0 and y = 0 where they meet (the model's corner: transition cells on three bent surfaces).
+TEST(CornerPointSurface, WellReachingACornerMeshes) {
+  TiltedModel g = small_columns();
+  g.inclined_pillars = true, g.pillar_twist = 0.03;
+  expect_meshes_reaching_the_surface(g, vertical_well(14, 14, 1010, 1022), [](const CornerPointModel& m, int c) {
+    return c / (m.nx * m.ny) == 0 || c % m.nx == 0 || (c / m.nx) % m.ny == 0;
+  });
+}
+
+// The same beside a fault of half a layer's throw on pillar line x = 48 m, through the cavity: the top
+// steps down 1.5 m across it, and the up-thrown cells' fault faces above the down-thrown top (no cell
+// across) are surface triangles too.
+TEST(CornerPointSurface, WellReachingTheTopAcrossAFaultStepMeshes) {
+  TiltedModel g = small_columns();
+  g.fault_i = 8, g.throw_m = 1.5;
+  expect_meshes_reaching_the_surface(g, vertical_well(45, 45, 1013, 1025),
+                                     [](const CornerPointModel& m, int c) { return c / (m.nx * m.ny) == 0; });
+}
+
+// A cavity inside the model beside an inactive cell (ACTNUM 0, 9 m from the well's axis): the faces
+// toward it have no meshed cell across and are surface triangles, outer-boundary faces inside the model.
+TEST(CornerPointSurface, WellBesideAnInactiveCellMeshes) {
+  TiltedModel g = small_columns();
+  const int gap = 9 + g.nx * (7 + g.ny * 7);  // (10, 8, 8), beside the cavity's column i = 9
+  g.inactive = {gap};
+  expect_meshes_reaching_the_surface(g, vertical_well(45, 45, 1023, 1035), [gap](const CornerPointModel& m, int c) {
+    return c == gap - 1 || c == gap + 1 || c == gap - m.nx || c == gap + m.nx || c == gap - m.nx * m.ny ||
+           c == gap + m.nx * m.ny;
+  });
+}
+
+// The cavity reaches a side of a model with inclined, non-parallel pillars whose slope varies along
+// the side (the side faces are not planar): it meshes likewise.
+TEST(CornerPointSurface, WellReachingASideMeshes) {
+  TiltedModel g = small_columns();
+  g.inclined_pillars = true, g.pillar_twist = 0.03;
+  expect_meshes_reaching_the_surface(g, vertical_well(14, 45, 1018, 1030),
+                                     [](const CornerPointModel& m, int c) { return c % m.nx == 0; });
+}
+
+// 20 x 20 m columns: a top triangle's diametral sphere (radius 14 m) holds the well block 2.4 m below
+// the top; the top cannot move away (no cell behind it to deactivate): refused (exit 2), naming the
+// top-layer cell and the well.
+TEST(CornerPointSurface, WellTooNearTheTopForItsFacesIsRefusedWithTheReason) {
+  TempDir tmp("cpsurface");
   const CaseSpec cs = case_of(tmp, TiltedModel{}, vertical_well(90, 90, 1012, 1030));
   try {
     build_hybrid_mesh(cs);
-    ADD_FAILURE() << "a cavity reaching the model's top was meshed";
+    ADD_FAILURE() << "a well inside the diametral spheres of the top's triangles was meshed";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("reaches the outer surface of the corner-point model"), std::string::npos)
-        << e.what();
+    const std::string what = e.what();
+    std::printf("[ figures  ] well 2.4 m below a top of 20 m faces: %s\n", e.what());
+    EXPECT_NE(what.find("reaches the model's outer surface"), std::string::npos) << what;
+    EXPECT_NE(what.find("cannot be made Gabriel"), std::string::npos) << what;
+    EXPECT_NE(what.find("wells[0] (P1)"), std::string::npos) << what;
+    EXPECT_NE(what.find(", 1), where"), std::string::npos) << "the named cell is not in the top layer: " << what;
   }
 }
 
@@ -244,8 +460,9 @@ TEST(CornerPointWells, FaceTrianglesCoverTheFaceWithItsNodes) {
 
 // A fault of 10 m throw (2.2 layers) crossed by a deviated well: the cavity's boundary has fault
 // overlaps 1 m and 3.5 m high beside whole faces; the site correction does not converge on the walls'
-// triangles (sites pressed to their minimal height) and the local enlargements reach the model's
-// surface. Measured, and refused with the reason, never a bad mesh (docs/corner-point.md, "Faults").
+// triangles (sites pressed to their minimal height) and the local enlargements move the stuck walls
+// along the fault to the model's sides, whose triangles cannot be moved. Measured, and refused with the
+// reason, never a bad mesh (docs/corner-point.md, "A fault of 10 m throw").
 TEST(CornerPointWells, WellAcrossAFaultOfTenMetresIsRefusedWithTheReason) {
   TempDir tmp("cpwells");
   TiltedModel g;

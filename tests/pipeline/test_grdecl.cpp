@@ -511,8 +511,9 @@ TEST(CornerPoint, InvertedCellAndWellsAreRefusedWithTheReason) {
   try {
     build_hybrid_mesh(cs);
     ADD_FAILURE() << "a well through the bottom of a corner-point model was meshed";
-  } catch (const InputError& e) {  // its cavity reaches the model's bottom (docs/corner-point.md)
-    EXPECT_NE(std::string(e.what()).find("reaches the outer surface of the corner-point model"), std::string::npos) << e.what();
+  } catch (const InputError& e) {  // its block crosses the model's bottom (docs/corner-point.md)
+    EXPECT_NE(std::string(e.what()).find("reaches outside the meshed cells of the corner-point model"), std::string::npos)
+        << e.what();
   }
 }
 
