@@ -18,6 +18,7 @@
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "meshgen/pipeline/summary.hpp"
 
 using namespace hm;
@@ -254,10 +255,12 @@ TEST(NearWellRefinement, ObliquelyShearedCellsAreRefusedWithTheReason) {
 }
 
 // Reek (../shared/data/reek): a vertical well in column (8, 52), layers 6-9, where the model's pillars
-// are nearly vertical (its south-west), drainage radius 5 m. Without refinement the Gabriel repair
-// takes the cavity to the model's top (100-160 m x 3 m faces); refined, it meshes soundly: the
-// self-check passes, every face conforms and the volume is the refined model's minus the wellbore.
+// are nearly vertical (its south-west), drainage radius 5 m. Without refinement it is refused
+// (100-160 m x 3 m faces); refined, it meshes soundly: the self-check passes, every face conforms and
+// the volume is the refined model's minus the wellbore. (R = 10 m, its cavity on the model's bottom,
+// is round-off sensitive: docs/corner-point.md, "Reek, where its pillars are steep".)
 TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
+  const double radius = 5;
   fs::path deck = fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek" / "REEK_GRID.DATA";
   if (!fs::exists(deck)) deck = fs::path(HM_SOURCE_DIR) / ".." / ".." / "shared" / "data" / "reek" / "REEK_GRID.DATA";
   if (!fs::exists(deck)) GTEST_SKIP() << "no " << deck;
@@ -276,14 +279,19 @@ TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
     return "name: reek\nreservoir: {grdecl: " + deck.string() + extra + "}\nwells:\n  - {name: SW1, trajectory: [[" +
            hmtest::grdecl_number(a.x) + ", " + hmtest::grdecl_number(a.y) + ", " + hmtest::grdecl_number(a.z) + "], [" +
            hmtest::grdecl_number(b.x) + ", " + hmtest::grdecl_number(b.y) + ", " + hmtest::grdecl_number(b.z) +
-           "]], radius: 0.1, drainage_radius: 5, end_caps: flat, bhp: 150}\n";
+           "]], radius: 0.1, drainage_radius: " + hmtest::grdecl_number(radius) + ", end_caps: flat, bhp: 150}\n";
   };
   std::ofstream(tmp.path / "off.yaml") << text(", near_well_cell_size: off");
   EXPECT_THROW(build_hybrid_mesh(load_case((tmp.path / "off.yaml").string())), InputError);
   std::ofstream(tmp.path / "reek.yaml") << text("");
   const CaseSpec cs = load_case((tmp.path / "reek.yaml").string());
   HybridMesh out;
-  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  try {
+    // As meshgen does: in the local frame (the model's min corner in plan at the origin).
+    out = build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
   ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
   EXPECT_TRUE(out.build_report.ok);
   double v = 0, v0 = 0;
@@ -297,8 +305,8 @@ TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
             nlohmann::json::array({cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny, 14}));
   int transition = 0;
   for (int c = 0; c < out.mesh.n_cells(); ++c) transition += out.mesh.cell_region[c] == kTransition;
-  std::printf("[ figures  ] Reek, well in column (8, 52), R = 5 m: model 40 x 64 refined to %d x %d, %d cells (%d "
+  std::printf("[ figures  ] Reek, well in column (8, 52), R = %g m: model 40 x 64 refined to %d x %d, %d cells (%d "
               "transition), volume rel. %.1e\n",
-              cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny, out.mesh.n_cells(), transition,
+              radius, cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny, out.mesh.n_cells(), transition,
               v / (v0 - hole) - 1);
 }
