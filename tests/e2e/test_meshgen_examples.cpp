@@ -71,3 +71,25 @@ INSTANTIATE_TEST_SUITE_P(Examples, MeshgenExample,
                          [](const auto& info) { return info.param.name; });
 
 }  // namespace
+
+// The Reek example (../shared/data/reek beside the checkout): meshgen exits 0 only when its
+// self-check passed (fvcheck's checks on every near-well cell; the model's cells are the user's);
+// its report says the model was refined near the well and the cells add up.
+TEST(MeshgenReekExample, MeshesAfterNearWellRefinement) {
+  if (!fs::exists(fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek" / "REEK_GRID.DATA"))
+    GTEST_SKIP() << "no ../shared/data/reek beside the checkout";
+  const fs::path out = hm_test::fresh_dir("example_reek_steep_well");
+  const auto r = hm_test::run_command(std::string(HM_BIN_DIR) + "/meshgen " + HM_SOURCE_DIR +
+                                      "/examples/reek_steep_well.yaml -o '" + out.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(hm_test::slurp(out / "summary.json"));
+  EXPECT_EQ(j["corner_point"]["model"], nlohmann::json::array({40, 64, 14}));
+  EXPECT_GT(j["corner_point"]["meshed"][0].get<int>(), 40);
+  EXPECT_GT(j["corner_point"]["meshed"][1].get<int>(), 64);
+  const auto& cells = j["cells"];
+  EXPECT_EQ(cells["reservoir"].get<int>() + cells["transition"].get<int>() + cells["well"].get<int>(),
+            cells["total"].get<int>());
+  EXPECT_GT(cells["transition"].get<int>(), 0);
+  EXPECT_EQ(j["transition"]["sites"]["internal"].get<int>(), cells["transition"].get<int>());
+  EXPECT_EQ(j["cavities"].get<int>(), 1);
+}
