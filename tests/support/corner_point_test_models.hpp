@@ -1,0 +1,84 @@
+// Helpers of the tests that write synthetic corner-point models (GRDECL text): shared by the
+// pipeline's corner-point tests and the exporters' Flow tests.
+#pragma once
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <sstream>
+#include <string>
+
+namespace hmtest {
+
+/// A double as the shortest text that reads back as the same value (%.17g).
+inline std::string grdecl_number(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+/// The ZCORN values in Eclipse order: per layer k its top then bottom surface, per row j the -j
+/// then +j corners, per column i the -i then +i corner; depth(i_col, I, J, surface) gives the depth
+/// of the corner of column i_col on pillar (I, J) at surface k (top) or k + 1 (bottom).
+inline void write_zcorn(std::ostringstream& o, int nx, int ny, int nz,
+                        const std::function<double(int, int, int, int)>& depth) {
+  for (int k = 0; k < nz; ++k)
+    for (int c = 0; c < 2; ++c)
+      for (int j = 0; j < ny; ++j)
+        for (int b = 0; b < 2; ++b)
+          for (int i = 0; i < nx; ++i)
+            for (int a = 0; a < 2; ++a) o << grdecl_number(depth(i, i + a, j + b, k + c)) << "\n";
+}
+
+/// Vertical pillars every dx, dy; layers of thickness dz dipping `dip_deg` in x, 1 % in y, with a
+/// twist (x y term: the top and bottom faces are not planar); a fault on pillar line I = fault_i
+/// (the +i side down by `throw_m`) when fault_i > 0. PERMX and PORO vary by cell
+/// (docs/corner-point.md, "Measured").
+struct TiltedModel {
+  int nx = 9, ny = 9, nz = 16, fault_i = -1;
+  double dx = 20, dy = 20, dz = 4.5, dip_deg = 5, throw_m = 0;
+  bool inclined_pillars = false;  // non-parallel pillars: the column faces are not planar either
+
+  double depth(int i_col, int I, int J, int k) const {
+    const double x = dx * I, y = dy * J;
+    double z = 1000 + std::tan(dip_deg * M_PI / 180) * x + 0.01 * y + 1e-4 * x * y + dz * k;
+    if (fault_i > 0 && i_col >= fault_i) z += throw_m;
+    return z;
+  }
+  /// The model as GRDECL text (SPECGRID, COORD, ZCORN, PERMX/Y/Z, PORO).
+  std::string text() const {
+    std::ostringstream o;
+    o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
+    for (int J = 0; J <= ny; ++J)
+      for (int I = 0; I <= nx; ++I) {
+        const double x = dx * I, y = dy * J;
+        const double bx = inclined_pillars ? x + 6 + 0.01 * x : x, by = inclined_pillars ? y + 3 - 0.005 * y : y;
+        o << grdecl_number(x) << " " << grdecl_number(y) << " 900 " << grdecl_number(bx) << " " << grdecl_number(by)
+          << " 1200\n";
+      }
+    o << "/\nZCORN\n";
+    write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
+    const int n = nx * ny * nz;
+    o << "/\nPERMX\n";
+    for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
+    o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
+    for (int c = 0; c < n; ++c) o << 0.15 + 0.01 * (c % 5) << "\n";
+    o << "/\n";
+    return o.str();
+  }
+};
+
+/// A case's `wells:` block with one vertical producer P1 at (x, y) from z0 to z1 (R = 5 m, 4 rings,
+/// 12 sectors, flat ends, BHP 150 bar).
+inline std::string vertical_well_yaml(double x, double y, double z0, double z1) {
+  return "wells:\n  - {name: P1, trajectory: [[" + grdecl_number(x) + ", " + grdecl_number(y) + ", " +
+         grdecl_number(z0) + "], [" + grdecl_number(x) + ", " + grdecl_number(y) + ", " + grdecl_number(z1) +
+         "]], radius: 0.1, drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+}
+
+/// The deviated producer P1 of the inclined-pillar case: (90, 90, 1055) to (110, 90, 1068).
+inline std::string deviated_well_yaml() {
+  return "wells:\n  - {name: P1, trajectory: [[90, 90, 1055], [110, 90, 1068]], radius: 0.1, "
+         "drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+}
+
+}  // namespace hmtest
