@@ -227,6 +227,12 @@ PolyMesh in_metric_frame(const PolyMesh& m) {
   return out;
 }
 
+TransmissibilityOptions deck_transmissibility_options() {
+  TransmissibilityOptions o;
+  o.reservoir_halves_absolute = true;
+  return o;
+}
+
 Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeometry& g,
                                               const TransmissibilityOptions& opt) {
   // A mesh built in a permeability frame (docs/anisotropy.md): every formula below is applied
@@ -295,9 +301,12 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
       const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
       t.half_owner[f] = half(o, f);
       bad[f] = is_bad(t.half_owner[f]);
+      if (opt.reservoir_halves_absolute && m.cell_region[o] == kReservoir) t.half_owner[f] = std::abs(t.half_owner[f]);
       if (n >= 0) {
         t.half_neighbour[f] = half(n, f);
         bad[f] += is_bad(t.half_neighbour[f]);
+        if (opt.reservoir_halves_absolute && m.cell_region[n] == kReservoir)
+          t.half_neighbour[f] = std::abs(t.half_neighbour[f]);
         t.face[f] = harmonic(t.half_owner[f], t.half_neighbour[f]);
       } else if (is_wellbore_patch(m.face_patch[f])) {
         t.face[f] = t.half_owner[f];

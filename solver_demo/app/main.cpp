@@ -95,7 +95,8 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mes
   if (const int rc = guarded([&] {
         if (mesh_file.empty()) mesh = hm::build_hybrid_mesh(cs);
         const hm::FlowProblem pb = hm::deck_flow_problem(cs, mesh.mesh, mesh.geometry);
-        sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry));
+        // The transmissibilities of the exported deck (docs/export-eclipse.md, "A corner-point model").
+        sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry, hm::deck_transmissibility_options()));
       }))
     return rc;
 

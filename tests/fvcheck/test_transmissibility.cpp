@@ -358,6 +358,33 @@ TEST(Transmissibility, SkewedAnisotropicHexahedronGivesNegativeGenericHalves) {
   }
 }
 
+// The deck's convention (deck_transmissibility_options): a reservoir cell's negative half (the skewed
+// anisotropic parallelepiped above) is taken as its absolute value and still counted; the checker's
+// default keeps its sign.
+TEST(Transmissibility, DeckOptionsTakeReservoirCellsNegativeHalvesAsAbsoluteValues) {
+  MeshBuilder b;
+  const Vec3 ea{1, 1, 0}, eb{0.95, 0.3, 0}, ec{0, 0, 1};
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c)
+    n[c] = b.add_node(double(c & 1) * ea + double((c >> 1) & 1) * eb + double((c >> 2) & 1) * ec);
+  CellAttributes at;
+  at.region = kReservoir;
+  at.perm = {1000, 1, 1};
+  at.fv_center = 0.5 * (ea + eb + ec);
+  add_hex(b, n, at);
+  PolyMesh m = finish_ok(b);
+  const MeshGeometry g = compute_geometry(m);
+  const Transmissibilities signed_t = compute_transmissibilities(m, g);
+  const Transmissibilities deck_t = compute_transmissibilities(m, g, deck_transmissibility_options());
+  EXPECT_EQ(deck_t.negative, 2);
+  EXPECT_EQ(deck_t.negative_faces, signed_t.negative_faces);
+  for (int f = 0; f < m.n_faces(); ++f) EXPECT_EQ(deck_t.half_owner[f], std::fabs(signed_t.half_owner[f])) << f;
+  for (int32_t f : deck_t.negative_faces) {
+    EXPECT_LT(signed_t.half_owner[f], 0.0);
+    EXPECT_GT(deck_t.half_owner[f], 0.0);
+  }
+}
+
 // ---------------------------------------------------------------- radial ring blocks
 
 TEST(Transmissibility, RadialBlockReproducesSteadyRadialFlowExactly) {
