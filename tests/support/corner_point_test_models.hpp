@@ -75,6 +75,14 @@ inline std::string vertical_well_yaml(double x, double y, double z0, double z1) 
          "]], radius: 0.1, drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
 }
 
+/// A `wells:` entry (no header) with a vertical injector I1 at (x, y) from z0 to z1, the producer's
+/// block parameters, BHP 250 bar.
+inline std::string injector_yaml(double x, double y, double z0, double z1) {
+  return "  - {name: I1, type: injector, trajectory: [[" + grdecl_number(x) + ", " + grdecl_number(y) + ", " +
+         grdecl_number(z0) + "], [" + grdecl_number(x) + ", " + grdecl_number(y) + ", " + grdecl_number(z1) +
+         "]], radius: 0.1, drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 250}\n";
+}
+
 /// The deviated producer P1 of the inclined-pillar case: (90, 90, 1055) to (110, 90, 1068).
 inline std::string deviated_well_yaml() {
   return "wells:\n  - {name: P1, trajectory: [[90, 90, 1055], [110, 90, 1068]], radius: 0.1, "
