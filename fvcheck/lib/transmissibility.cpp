@@ -16,6 +16,13 @@ Vec3 times_perm(Vec3 perm, Vec3 v) { return {perm.x * v.x, perm.y * v.y, perm.z 
 /// Standard TPFA half: t = A n . K c / |c|^2, c from the FV centre to the face centroid.
 double generic_half(Vec3 area_out, Vec3 perm, Vec3 c) { return dot(area_out, times_perm(perm, c)) / norm2(c); }
 
+/// OPM's corner-point half (its EclTransmissibility): the permeability of the face's axis times
+/// |A . c| / |c|^2; `axis` 0, 1, 2 for an I, J, K face.
+double opm_half(Vec3 area_out, Vec3 perm, Vec3 c, int axis) {
+  const double k = axis == 0 ? perm.x : axis == 1 ? perm.y : perm.z;
+  return k * std::abs(dot(area_out, c)) / norm2(c);
+}
+
 /// Power/Voronoi cell: the face is orthogonal to the site-to-site segment, so the flux is
 /// A k_n / d with d the signed distance from the site to the face plane (n . c), exact for
 /// K-orthogonal cells. The generic form would divide by |c| >= n . c and underestimate.
@@ -206,6 +213,49 @@ double harmonic(double t1, double t2) { return 1.0 / (1.0 / t1 + 1.0 / t2); }
 
 bool is_bad(double t) { return !(t >= 0) || std::isinf(t); }
 
+/// The axis (0, 1, 2 for I, J, K) of a face between two model cells a, b: the index that differs.
+int model_face_axis(const PolyMesh& m, int32_t a, int32_t b) {
+  return m.cell_ijk[a][0] != m.cell_ijk[b][0] ? 0 : m.cell_ijk[a][1] != m.cell_ijk[b][1] ? 1 : 2;
+}
+
+/// OPM computes one transmissibility per pair of model cells, from the whole face (or fault overlap) they
+/// share; the mesh may store it as several faces (a whole face with stations on its edges as triangles
+/// about its centre, an overlap cut at a crossing). Per pair of reservoir cells: the halves of the summed
+/// area vector at the area-weighted centroid of the pair's faces, shared among the faces by area (their
+/// sum is the pair's transmissibility, which is what a two-point flux between the two cells sees).
+void opm_pair_halves(const PolyMesh& m, const MeshGeometry& g, double unit, Transmissibilities* t) {
+  std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> pairs;
+  for (int32_t f = 0; f < m.n_faces(); ++f) {
+    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+    if (n < 0 || m.cell_region[o] != kReservoir || m.cell_region[n] != kReservoir) continue;
+    if (m.cell_ijk[o][0] < 0 || m.cell_ijk[n][0] < 0) continue;
+    pairs[{std::min(o, n), std::max(o, n)}].push_back(f);
+  }
+  for (const auto& [cells, faces] : pairs) {
+    if (faces.size() < 2) continue;  // one face: the per-face halves are already the pair's
+    const int32_t a = cells.first, b = cells.second;
+    Vec3 area{0, 0, 0}, centroid{0, 0, 0};
+    double total = 0;
+    for (int32_t f : faces) {
+      const double w = norm(g.face_area[f]);
+      area += m.face_sign(f, a) * g.face_area[f];
+      centroid += w * g.face_centroid[f];
+      total += w;
+    }
+    if (!(total > 0)) continue;
+    centroid = centroid / total;
+    const int axis = model_face_axis(m, a, b);
+    const double ha = unit * opm_half(area, m.cell_perm[a], centroid - m.cell_fv_center[a], axis);
+    const double hb = unit * opm_half(-1.0 * area, m.cell_perm[b], centroid - m.cell_fv_center[b], axis);
+    for (int32_t f : faces) {
+      const double w = norm(g.face_area[f]) / total;
+      t->half_owner[f] = w * (m.face_owner[f] == a ? ha : hb);
+      t->half_neighbour[f] = w * (m.face_owner[f] == a ? hb : ha);
+      t->face[f] = harmonic(t->half_owner[f], t->half_neighbour[f]);
+    }
+  }
+}
+
 }  // namespace
 
 double transverse_permeability(Vec3 k, Vec3 a) {
@@ -229,7 +279,7 @@ PolyMesh in_metric_frame(const PolyMesh& m) {
 
 TransmissibilityOptions deck_transmissibility_options() {
   TransmissibilityOptions o;
-  o.reservoir_halves_absolute = true;
+  o.reservoir_halves_opm = true;
   return o;
 }
 
@@ -288,6 +338,20 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
     // The generic form would divide by |c|^2 and lose the radial offset between the FV centre
     // and the face centroid (a 0.2 m end segment of ring 5: half the transmissibility).
     if (opt.exact_radial && rc.well >= 0) return unit * orthogonal_half(area_out, m.cell_perm[c], to_face);
+    if (opt.reservoir_halves_opm && m.cell_region[c] == kReservoir) {
+      // The face's axis: between two model cells, the index that differs (across a fault: I or J;
+      // across a pinched-out layer: K); otherwise (a cavity's triangle, a boundary face) the largest
+      // component of the face's normal in the model's frame.
+      const int32_t nb = m.face_owner[f] == c ? m.face_neighbour[f] : m.face_owner[f];
+      int axis = -1;
+      if (nb >= 0 && m.cell_region[nb] == kReservoir && m.cell_ijk[c][0] >= 0 && m.cell_ijk[nb][0] >= 0)
+        axis = model_face_axis(m, c, nb);
+      if (axis < 0) {
+        const Vec3 a{std::abs(area_out.x), std::abs(area_out.y), std::abs(area_out.z)};
+        axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+      }
+      return unit * opm_half(area_out, m.cell_perm[c], to_face, axis);
+    }
     return unit * generic_half(area_out, m.cell_perm[c], to_face);
   };
 
@@ -301,18 +365,16 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
       const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
       t.half_owner[f] = half(o, f);
       bad[f] = is_bad(t.half_owner[f]);
-      if (opt.reservoir_halves_absolute && m.cell_region[o] == kReservoir) t.half_owner[f] = std::abs(t.half_owner[f]);
       if (n >= 0) {
         t.half_neighbour[f] = half(n, f);
         bad[f] += is_bad(t.half_neighbour[f]);
-        if (opt.reservoir_halves_absolute && m.cell_region[n] == kReservoir)
-          t.half_neighbour[f] = std::abs(t.half_neighbour[f]);
         t.face[f] = harmonic(t.half_owner[f], t.half_neighbour[f]);
       } else if (is_wellbore_patch(m.face_patch[f])) {
         t.face[f] = t.half_owner[f];
       }
     }
   }, 256);  // small chunks: the end-cap faces (a quadrature each) lie together
+  if (opt.reservoir_halves_opm) opm_pair_halves(m, g, unit, &t);
   for (int f = 0; f < nf; ++f) {
     if (!bad[f]) continue;
     t.negative += bad[f];

@@ -21,18 +21,20 @@ struct TransmissibilityOptions {
   /// true: the exact logarithmic form on ring faces of radial well cells; false: the generic
   /// two-point form everywhere (only useful to measure what the log form buys).
   bool exact_radial = true;
-  /// true: a half-transmissibility on the side of a reservoir cell (a corner-point model's cell: the
-  /// user's cell, exempt from the shape checks) that comes out negative is taken as its absolute
-  /// value, OPM's convention (K |A . d| / |d|^2) for the model's cells. Radial and transition cells
-  /// keep their sign. The halves are counted in `negative` either way. Used for the Eclipse deck and
-  /// by solver_demo (deck_transmissibility_options), never by the checker.
-  bool reservoir_halves_absolute = false;
+  /// true: the half-transmissibility on the side of a reservoir cell that is not a box (a corner-point
+  /// model's cell: the user's cell, exempt from the shape checks) is OPM's corner-point one,
+  /// K_dd |A . c| / |c|^2 with d the face's axis (I, J or K: from the two cells' (i,j,k) between model
+  /// cells, else the largest component of the face normal), c from the FV centre (the mean of the 8
+  /// corners, OPM's cell centre) to the face centroid: never negative. Radial and transition cells keep
+  /// the library's forms. Used for the Eclipse deck and by solver_demo (deck_transmissibility_options),
+  /// never by the checker.
+  bool reservoir_halves_opm = false;
 };
 
 /// The options of the transmissibilities an Eclipse deck carries and solver_demo solves with
-/// (docs/export-eclipse.md, "A corner-point model"): METRIC, exact radial form, reservoir cells'
-/// negative halves taken as their absolute value. On a mesh whose reservoir cells are boxes (a
-/// rectilinear reservoir) they equal the defaults: a box's halves are never negative.
+/// (docs/export-eclipse.md, "A corner-point model"): METRIC, exact radial form, reservoir cells' halves
+/// in OPM's corner-point form. On an axis-aligned box (a rectilinear reservoir's cell, FV centre at its
+/// centre) OPM's form is the library's: the same numbers up to rounding.
 TransmissibilityOptions deck_transmissibility_options();
 
 struct Transmissibilities {
@@ -44,8 +46,8 @@ struct Transmissibilities {
   /// connection factor (= half_owner, q = CF/mu (p_cell - p_w)); other boundary faces: 0.
   std::vector<double> face;
   /// Number of half-transmissibilities that are negative or not finite (FV centre beyond or on
-  /// the face plane). They are kept as computed, never replaced by their absolute value, except
-  /// on reservoir cells with TransmissibilityOptions::reservoir_halves_absolute (still counted).
+  /// the face plane). They are kept as computed, never replaced by their absolute value
+  /// (TransmissibilityOptions::reservoir_halves_opm computes another form, which is never negative).
   int negative = 0;
   /// The first faces (at most kMaxListedNegative, each once) carrying such a half-transmissibility.
   std::vector<int32_t> negative_faces;

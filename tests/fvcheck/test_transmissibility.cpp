@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/fv_quality.hpp"
 #include "meshgen/core/geometry.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 
@@ -328,21 +329,31 @@ TEST(Transmissibility, PowerCellSiteBeyondFacePlaneIsCountedNegative) {
   }
 }
 
+namespace {
+
+// Parallelepiped spanned by a = (1,1,0), b = (0.95,0.3,0), c = (0,0,1), a reservoir cell with its
+// centroid as FV centre and K = (kx, 1, 1). On the two faces spanned by b and c, n . c > 0 but
+// n . K c < 0 when kx >> ky.
+const Vec3 kSkewA{1, 1, 0}, kSkewB{0.95, 0.3, 0}, kSkewC{0, 0, 1};
+PolyMesh skewed_parallelepiped(double kx) {
+  MeshBuilder b;
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c)
+    n[c] = b.add_node(double(c & 1) * kSkewA + double((c >> 1) & 1) * kSkewB + double((c >> 2) & 1) * kSkewC);
+  CellAttributes at;
+  at.region = kReservoir;
+  at.perm = {kx, 1, 1};
+  at.fv_center = 0.5 * (kSkewA + kSkewB + kSkewC);
+  add_hex(b, n, at);
+  return finish_ok(b);
+}
+
+}  // namespace
+
 TEST(Transmissibility, SkewedAnisotropicHexahedronGivesNegativeGenericHalves) {
-  // Parallelepiped spanned by a = (1,1,0), b = (0.95,0.3,0), c = (0,0,1) with its centroid as FV
-  // centre. On the two faces spanned by b and c, n . c > 0 but n . K c < 0 when kx >> ky.
+  const Vec3 eb = kSkewB, ec = kSkewC;
   for (double kx : {1.0, 1000.0}) {  // pass / fail pair
-    MeshBuilder b;
-    const Vec3 ea{1, 1, 0}, eb{0.95, 0.3, 0}, ec{0, 0, 1};
-    int32_t n[8];
-    for (int c = 0; c < 8; ++c)
-      n[c] = b.add_node(double(c & 1) * ea + double((c >> 1) & 1) * eb + double((c >> 2) & 1) * ec);
-    CellAttributes at;
-    at.region = kReservoir;
-    at.perm = {kx, 1, 1};
-    at.fv_center = 0.5 * (ea + eb + ec);
-    add_hex(b, n, at);
-    PolyMesh m = finish_ok(b);
+    PolyMesh m = skewed_parallelepiped(kx);
     const MeshGeometry g = compute_geometry(m);
     const Transmissibilities t = compute_transmissibilities(m, g);
     if (kx == 1.0) {
@@ -358,31 +369,27 @@ TEST(Transmissibility, SkewedAnisotropicHexahedronGivesNegativeGenericHalves) {
   }
 }
 
-// The deck's convention (deck_transmissibility_options): a reservoir cell's negative half (the skewed
-// anisotropic parallelepiped above) is taken as its absolute value and still counted; the checker's
-// default keeps its sign.
-TEST(Transmissibility, DeckOptionsTakeReservoirCellsNegativeHalvesAsAbsoluteValues) {
-  MeshBuilder b;
-  const Vec3 ea{1, 1, 0}, eb{0.95, 0.3, 0}, ec{0, 0, 1};
-  int32_t n[8];
-  for (int c = 0; c < 8; ++c)
-    n[c] = b.add_node(double(c & 1) * ea + double((c >> 1) & 1) * eb + double((c >> 2) & 1) * ec);
-  CellAttributes at;
-  at.region = kReservoir;
-  at.perm = {1000, 1, 1};
-  at.fv_center = 0.5 * (ea + eb + ec);
-  add_hex(b, n, at);
-  PolyMesh m = finish_ok(b);
+// The deck's convention (deck_transmissibility_options): a reservoir cell's half is OPM's corner-point
+// one, K_dd |A . c| / |c|^2 with d the face's axis, never negative; on the skewed anisotropic
+// parallelepiped above (two negative generic halves) it differs from the checker's signed default.
+TEST(Transmissibility, DeckOptionsGiveReservoirCellsOpmsCornerPointHalves) {
+  const PolyMesh m = skewed_parallelepiped(1000);
   const MeshGeometry g = compute_geometry(m);
   const Transmissibilities signed_t = compute_transmissibilities(m, g);
   const Transmissibilities deck_t = compute_transmissibilities(m, g, deck_transmissibility_options());
-  EXPECT_EQ(deck_t.negative, 2);
-  EXPECT_EQ(deck_t.negative_faces, signed_t.negative_faces);
-  for (int f = 0; f < m.n_faces(); ++f) EXPECT_EQ(deck_t.half_owner[f], std::fabs(signed_t.half_owner[f])) << f;
-  for (int32_t f : deck_t.negative_faces) {
-    EXPECT_LT(signed_t.half_owner[f], 0.0);
-    EXPECT_GT(deck_t.half_owner[f], 0.0);
+  EXPECT_EQ(signed_t.negative, 2);
+  EXPECT_EQ(deck_t.negative, 0);
+  const std::vector<Vec3> end = boundary_flux_points(m, g);
+  const Vec3 k = m.cell_perm[0];
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const Vec3 a = m.face_sign(f, 0) * g.face_area[f], c = end[f] - m.cell_fv_center[0];
+    const Vec3 n{std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)};
+    const double kd = n.x >= n.y && n.x >= n.z ? k.x : n.y >= n.z ? k.y : k.z;
+    const double expected = kDarcyMetric * kd * std::fabs(dot(a, c)) / norm2(c);
+    EXPECT_NEAR(deck_t.half_owner[f], expected, 1e-14 * expected) << f;
+    EXPECT_GT(deck_t.half_owner[f], 0.0) << f;
   }
+  for (int32_t f : signed_t.negative_faces) EXPECT_LT(signed_t.half_owner[f], 0.0);
 }
 
 // ---------------------------------------------------------------- radial ring blocks
