@@ -8,6 +8,8 @@
 // (TRANNNC count), the pressures or rates differ by more than 1e-6.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
 #include <set>
 
 #include "corner_point_test_models.hpp"
@@ -99,6 +101,7 @@ void expect_model_columns(const CornerPointFlowRun& r, const fs::path& data) {
       }
   EXPECT_EQ(wrong, 0u);
   EXPECT_EQ(off, cavity.size());
+  std::printf("[ figures  ] ACTNUM 0 on the %zu cavity cells of the model's columns (%zu wrong)\n", cavity.size(), wrong);
   // The separator column is inactive; every near-well cell is active in the extra columns.
   size_t extra_active = 0;
   for (int k = 0; k < m.nz; ++k)
@@ -173,6 +176,20 @@ void expect_flow_is_solver_demo(const CornerPointFlowRun& r) {
   EXPECT_GT(miss, 1e-5);
 }
 
+// Every check of a run (deck = tmp/deck/CPW.DATA).
+void expect_corner_point_run(const char* label, const TempDir& tmp, const CornerPointFlowRun& r) {
+  const hm::EclipseConnections conn = hm::make_eclipse_connections(r.out.mesh, r.info.layout, r.trans);
+  const size_t trannnc = expected_trannnc(r.info.layout, conn);
+  report(label, r, trannnc);
+  EXPECT_EQ(r.trans.negative, 0);  // the deck's form (OPM's on the model's side) is never negative
+  std::printf("[ figures  ] model-side halves negative in the checker's signed two-point form: %d\n",
+              hm::compute_transmissibilities(r.out.mesh, r.out.geometry).negative);
+  expect_model_columns(r, tmp.path / "deck" / "CPW.DATA");
+  EXPECT_EQ(r.c.flow_nnc, trannnc);
+  EXPECT_GT(trannnc, 100u);
+  expect_flow_is_solver_demo(r);
+}
+
 }  // namespace
 
 TEST(FlowCornerPoint, TiltedModelWithTwoVerticalWellsMatchesSolverDemo) {
@@ -181,11 +198,7 @@ TEST(FlowCornerPoint, TiltedModelWithTwoVerticalWellsMatchesSolverDemo) {
   CornerPointFlowRun r;
   run_case(tmp, TiltedModel{}, two_wells_yaml(), &r);
   if (HasFatalFailure()) return;
-  const hm::EclipseConnections conn = hm::make_eclipse_connections(r.out.mesh, r.info.layout, r.trans);
-  const size_t trannnc = expected_trannnc(r.info.layout, conn);
-  report("tilted, two vertical wells", r, trannnc);
-  std::printf("[ figures  ] negative two-point halves on the model cells' side, taken as |.|: %d\n", r.trans.negative);
-  expect_model_columns(r, tmp.path / "deck" / "CPW.DATA");
+  expect_corner_point_run("tilted, two vertical wells", tmp, r);
   // The signed transmissibilities (the checker's): the model-side halves of some constrained
   // triangles are negative, flow would zero those NNCs; the exporter refuses with the reason.
   const hm::Transmissibilities signed_trans = hm::compute_transmissibilities(r.out.mesh, r.out.geometry);
@@ -196,9 +209,6 @@ TEST(FlowCornerPoint, TiltedModelWithTwoVerticalWellsMatchesSolverDemo) {
   EXPECT_NE(refused.message.find("negative transmissibility, which OPM Flow sets to zero"), std::string::npos)
       << refused.message;
   EXPECT_FALSE(fs::exists(tmp.path / "signed" / "CPW.DATA"));
-  EXPECT_EQ(r.c.flow_nnc, trannnc);
-  EXPECT_GT(trannnc, 100u);
-  expect_flow_is_solver_demo(r);
 }
 
 // Inclined, non-parallel pillars (no model face planar), 22 layers, the deviated producer of
@@ -211,14 +221,7 @@ TEST(FlowCornerPoint, InclinedPillarsWithADeviatedWellMatchesSolverDemo) {
   CornerPointFlowRun r;
   run_case(tmp, g, deviated_well_yaml() + injector_yaml(50, 130, 1040, 1052), &r);
   if (HasFatalFailure()) return;
-  const hm::EclipseConnections conn = hm::make_eclipse_connections(r.out.mesh, r.info.layout, r.trans);
-  const size_t trannnc = expected_trannnc(r.info.layout, conn);
-  report("inclined pillars, deviated well", r, trannnc);
-  std::printf("[ figures  ] negative two-point halves on the model cells' side, taken as |.|: %d\n", r.trans.negative);
-  expect_model_columns(r, tmp.path / "deck" / "CPW.DATA");
-  EXPECT_EQ(r.c.flow_nnc, trannnc);
-  EXPECT_GT(trannnc, 100u);
-  expect_flow_is_solver_demo(r);
+  expect_corner_point_run("inclined pillars, deviated well", tmp, r);
 }
 
 // The model's transmissibility multipliers (MULTX.., FAULTS/MULTFLT, MULTZ) are not in the mesh's
@@ -241,4 +244,108 @@ TEST(FlowCornerPoint, ModelWithMultipliersAndWellsIsRefusedWithTheReason) {
   EXPECT_FALSE(st.ok);
   EXPECT_NE(st.message.find("transmissibility multipliers (MULTZ"), std::string::npos) << st.message;
   EXPECT_FALSE(fs::exists(tmp.path / "mult" / "CPW.DATA"));
+}
+
+namespace {
+
+// Our transmissibilities of a corner-point model's connections (deck_transmissibility_options, what the
+// deck with near-well cells carries) against the ones flow computes itself for the model's own deck
+// (no wells: flow's corner-point TPFA), per cell pair. Returns the relative differences (ours - flow) /
+// flow over the pairs both connect; counts the pairs only one side connects.
+struct OwnVsOurs {
+  std::vector<double> rel;
+  std::vector<int> kind;  ///< per entry of rel: 0, 1, 2 logical I, J, K neighbours, 3 any other pair (NNC)
+  size_t only_ours = 0, only_flow = 0;
+};
+
+OwnVsOurs compare_with_flows_own(const hm::CaseSpec& cs, const fs::path& dir) {
+  OwnVsOurs out;
+  const hm::HybridMesh hm_out = hm::build_hybrid_mesh(cs);
+  const hm::Transmissibilities trans =
+      hm::compute_transmissibilities(hm_out.mesh, hm_out.geometry, hm::deck_transmissibility_options());
+  hm::EclipseDeckInfo info;
+  const hm::WriteStatus st = hm::write_eclipse_deck(dir.string(), cs, hm_out.mesh, hm_out.geometry, trans, {}, &info);
+  EXPECT_TRUE(st.ok) << st.message;
+  const std::string name = hm::eclipse_deck_name(cs);
+  const FlowRun run = run_flow(dir, name);
+  EXPECT_EQ(run.flow.exit_code, 0);
+  if (run.results.is_null()) return out;
+  const hm::EclipseLayout& L = info.layout;
+  const hm::EclipseConnections conn = hm::make_eclipse_connections(hm_out.mesh, L, trans);
+  std::map<std::pair<int32_t, int32_t>, double> ours, flow;
+  const int32_t step[3] = {1, L.deck_nx, L.deck_nx * L.ny};
+  const std::vector<double>* t[3] = {&conn.tranx, &conn.trany, &conn.tranz};
+  const char* keys[3] = {"tranx", "trany", "tranz"};
+  const auto& init = run.results["init"];
+  for (int d = 0; d < 3; ++d) {
+    size_t a = 0;
+    for (int32_t g = 0; g < static_cast<int32_t>(L.deck_cell.size()); ++g) {
+      if ((*t[d])[g] != 0) ours[{g, g + step[d]}] += (*t[d])[g];
+      if (L.deck_cell[g] < 0) continue;
+      const double v = init[keys[d]][a++].get<double>();
+      if (v > 0) flow[{g, g + step[d]}] += v;
+    }
+  }
+  for (const auto& r : conn.nnc) ours[{r.a, r.b}] += r.t;
+  for (size_t k = 0; k < init["trannnc"].size(); ++k) {
+    const double v = init["trannnc"][k].get<double>();
+    const int32_t a = init["nnc1"][k].get<int32_t>() - 1, b = init["nnc2"][k].get<int32_t>() - 1;
+    if (v > 0) flow[{std::min(a, b), std::max(a, b)}] += v;
+  }
+  for (const auto& [pair, v] : ours) {
+    const auto it = flow.find(pair);
+    if (it == flow.end()) {
+      ++out.only_ours;
+      continue;
+    }
+    out.rel.push_back((v - it->second) / it->second);
+    const int32_t d = pair.second - pair.first;
+    out.kind.push_back(d == step[0] ? 0 : d == step[1] ? 1 : d == step[2] ? 2 : 3);
+  }
+  for (const auto& [pair, v] : flow) out.only_flow += !ours.count(pair);
+  return out;
+}
+
+void print_own_vs_ours(const char* label, const OwnVsOurs& d, int kind = -1) {
+  if (kind < 0)
+    for (int k = 0; k < 4; ++k) {
+      static const char* names[4] = {"I neighbours", "J neighbours", "K neighbours", "other pairs (NNC)"};
+      print_own_vs_ours((std::string(label) + ", " + names[k]).c_str(), d, k);
+    }
+  std::vector<double> a;
+  for (size_t i = 0; i < d.rel.size(); ++i)
+    if (kind < 0 || d.kind[i] == kind) a.push_back(std::abs(d.rel[i]));
+  std::sort(a.begin(), a.end());
+  auto q = [&](double f) { return a.empty() ? 0.0 : a[std::min(a.size() - 1, static_cast<size_t>(f * a.size()))]; };
+  size_t above_1pct = 0;
+  for (double v : a) above_1pct += v > 0.01;
+  std::printf("[ figures  ] %s: ours vs flow's own model transmissibilities over %zu pairs: |rel| median %.3g, 95 %% %.3g, "
+              "max %.3g, %zu above 1 %%; pairs only ours %zu, only flow's %zu\n",
+              label, a.size(), q(0.5), q(0.95), a.empty() ? 0.0 : a.back(), above_1pct, d.only_ours, d.only_flow);
+}
+
+}  // namespace
+
+// Measurement (docs/export-eclipse.md, "A corner-point model"): how far the transmissibilities the deck
+// with near-well cells carries for the model's own connections are from flow's corner-point ones.
+TEST(FlowCornerPoint, OurModelTransmissibilitiesAgainstFlowsOwn) {
+  REQUIRE_FLOW();
+  for (bool inclined : {false, true}) {
+    TempDir tmp("cpw_own");
+    TiltedModel g;
+    g.inclined_pillars = inclined;
+    g.nz = inclined ? 22 : 16;
+    std::ofstream(tmp.path / "M.GRDECL") << g.text();
+    std::ofstream(tmp.path / "cpm.yaml") << "name: cpm\nreservoir: {grdecl: M.GRDECL}\n";
+    const OwnVsOurs d = compare_with_flows_own(hm::load_case((tmp.path / "cpm.yaml").string()), tmp.path / "deck");
+    print_own_vs_ours(inclined ? "inclined pillars" : "tilted, vertical pillars", d);
+    EXPECT_GT(d.rel.size(), 1000u);
+    EXPECT_EQ(d.only_flow, 0u);
+  }
+  const char* reek = std::getenv("HM_REEK_DECK");  // e.g. shared/data/reek/REEK_GRID.DATA (flow: ~2 min)
+  if (reek == nullptr) return;
+  TempDir tmp("reek_own");
+  const OwnVsOurs d = compare_with_flows_own(
+      hm::parse_case("name: reek\nreservoir: {grdecl: " + std::string(reek) + "}\n"), tmp.path / "deck");
+  print_own_vs_ours("Reek", d);
 }

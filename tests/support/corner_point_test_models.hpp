@@ -1,6 +1,7 @@
 // Helpers of the tests that write synthetic corner-point models (GRDECL text): shared by the
 // pipeline's corner-point tests and the exporters' Flow tests.
 #pragma once
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -29,6 +30,18 @@ inline void write_zcorn(std::ostringstream& o, int nx, int ny, int nz,
             for (int a = 0; a < 2; ++a) o << grdecl_number(depth(i, i + a, j + b, k + c)) << "\n";
 }
 
+/// The COORD lines of (nx + 1)(ny + 1) pillars, I fastest: pillar(I, J) gives its top and bottom x, y
+/// {x_top, y_top, x_bottom, y_bottom}, at depths z_top and z_bottom.
+inline void write_pillars(std::ostringstream& o, int nx, int ny, double z_top, double z_bottom,
+                          const std::function<std::array<double, 4>(int, int)>& pillar) {
+  for (int J = 0; J <= ny; ++J)
+    for (int I = 0; I <= nx; ++I) {
+      const std::array<double, 4> p = pillar(I, J);
+      o << grdecl_number(p[0]) << " " << grdecl_number(p[1]) << " " << grdecl_number(z_top) << " " << grdecl_number(p[2])
+        << " " << grdecl_number(p[3]) << " " << grdecl_number(z_bottom) << "\n";
+    }
+}
+
 /// Vertical pillars every dx, dy; layers of thickness dz dipping `dip_deg` in x, 1 % in y, with a
 /// twist (x y term: the top and bottom faces are not planar); a fault on pillar line I = fault_i
 /// (the +i side down by `throw_m`) when fault_i > 0. PERMX and PORO vary by cell
@@ -48,13 +61,11 @@ struct TiltedModel {
   std::string text() const {
     std::ostringstream o;
     o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
-    for (int J = 0; J <= ny; ++J)
-      for (int I = 0; I <= nx; ++I) {
-        const double x = dx * I, y = dy * J;
-        const double bx = inclined_pillars ? x + 6 + 0.01 * x : x, by = inclined_pillars ? y + 3 - 0.005 * y : y;
-        o << grdecl_number(x) << " " << grdecl_number(y) << " 900 " << grdecl_number(bx) << " " << grdecl_number(by)
-          << " 1200\n";
-      }
+    write_pillars(o, nx, ny, 900, 1200, [&](int I, int J) {
+      const double x = dx * I, y = dy * J;
+      return inclined_pillars ? std::array<double, 4>{x, y, x + 6 + 0.01 * x, y + 3 - 0.005 * y}
+                              : std::array<double, 4>{x, y, x, y};
+    });
     o << "/\nZCORN\n";
     write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
     const int n = nx * ny * nz;
