@@ -1,6 +1,7 @@
 #include "transmissibility.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -218,11 +219,13 @@ int model_face_axis(const PolyMesh& m, int32_t a, int32_t b) {
   return m.cell_ijk[a][0] != m.cell_ijk[b][0] ? 0 : m.cell_ijk[a][1] != m.cell_ijk[b][1] ? 1 : 2;
 }
 
-/// OPM computes one transmissibility per pair of model cells, from the whole face (or fault overlap) they
-/// share; the mesh may store it as several faces (a whole face with stations on its edges as triangles
-/// about its centre, an overlap cut at a crossing). Per pair of reservoir cells: the halves of the summed
-/// area vector at the area-weighted centroid of the pair's faces, shared among the faces by area (their
-/// sum is the pair's transmissibility, which is what a two-point flux between the two cells sees).
+/// OPM computes one transmissibility per pair of model cells (EclTransmissibility with CpGrid): the
+/// pair's area vector (`faceAreaNormalEcl`: the vector area of the face or fault overlap they share) and,
+/// on each side, the distance from the cell centre (the mean of its 8 corners: the FV centre) to the
+/// centre of that cell's whole face (`faceCenterEcl`: the mean of the face's 4 corners, whatever part of
+/// it the neighbour touches). The mesh may store the shared face as several faces (a whole face with
+/// stations on its edges as triangles about a node at the mean of its 4 corners, an overlap cut at a
+/// crossing); the pair's value is shared among them by area.
 void opm_pair_halves(const PolyMesh& m, const MeshGeometry& g, double unit, Transmissibilities* t) {
   std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> pairs;
   for (int32_t f = 0; f < m.n_faces(); ++f) {
@@ -231,8 +234,48 @@ void opm_pair_halves(const PolyMesh& m, const MeshGeometry& g, double unit, Tran
     if (m.cell_ijk[o][0] < 0 || m.cell_ijk[n][0] < 0) continue;
     pairs[{std::min(o, n), std::max(o, n)}].push_back(f);
   }
+  // Side 2 axis + (0: toward +index, 1: toward -index) of cell a toward its pair's other cell b.
+  auto side = [&](int32_t a, int32_t b) {
+    const int axis = model_face_axis(m, a, b);
+    return 2 * axis + (m.cell_ijk[b][axis] > m.cell_ijk[a][axis] ? 0 : 1);
+  };
+  // Pass 1: the whole faces (a plain quad, or the triangles about the node at the mean of the 4 corners)
+  // give the centre of that side of both cells.
+  std::vector<std::array<Vec3, 6>> centre(m.n_cells());
+  std::vector<std::array<char, 6>> known(m.n_cells(), std::array<char, 6>{0, 0, 0, 0, 0, 0});
   for (const auto& [cells, faces] : pairs) {
-    if (faces.size() < 2) continue;  // one face: the per-face halves are already the pair's
+    int32_t apex = -1;
+    Vec3 c{0, 0, 0};
+    if (faces.size() == 1 && m.face_size(faces[0]) == 4) {
+      for (auto it = m.face_begin(faces[0]); it != m.face_end(faces[0]); ++it) c += 0.25 * m.nodes[*it];
+    } else if (faces.size() >= 3) {
+      for (auto it = m.face_begin(faces[0]); it != m.face_end(faces[0]) && apex < 0; ++it) {
+        bool in_all = true;
+        for (int32_t f : faces)
+          in_all = in_all && m.face_size(f) == 3 && std::find(m.face_begin(f), m.face_end(f), *it) != m.face_end(f);
+        if (in_all) apex = *it;
+      }
+      if (apex < 0) continue;
+      c = m.nodes[apex];
+    } else {
+      continue;
+    }
+    const int32_t a = cells.first, b = cells.second;
+    centre[a][side(a, b)] = c;
+    known[a][side(a, b)] = 1;
+    centre[b][side(b, a)] = c;
+    known[b][side(b, a)] = 1;
+  }
+  // The centre of cell a's face toward b: known, or through the opposite face (the 8 corners' mean is
+  // the mean of the two faces' centres), else the area-weighted centroid of the shared faces (a cell
+  // with fault overlaps on both sides of an axis: OPM's value is not reproduced there).
+  auto face_centre = [&](int32_t a, int32_t b, Vec3 fallback) {
+    const int sd = side(a, b), opposite = sd ^ 1;
+    if (known[a][sd]) return centre[a][sd];
+    if (known[a][opposite]) return 2.0 * m.cell_fv_center[a] - centre[a][opposite];
+    return fallback;
+  };
+  for (const auto& [cells, faces] : pairs) {
     const int32_t a = cells.first, b = cells.second;
     Vec3 area{0, 0, 0}, centroid{0, 0, 0};
     double total = 0;
@@ -245,8 +288,9 @@ void opm_pair_halves(const PolyMesh& m, const MeshGeometry& g, double unit, Tran
     if (!(total > 0)) continue;
     centroid = centroid / total;
     const int axis = model_face_axis(m, a, b);
-    const double ha = unit * opm_half(area, m.cell_perm[a], centroid - m.cell_fv_center[a], axis);
-    const double hb = unit * opm_half(-1.0 * area, m.cell_perm[b], centroid - m.cell_fv_center[b], axis);
+    const double ha = unit * opm_half(area, m.cell_perm[a], face_centre(a, b, centroid) - m.cell_fv_center[a], axis);
+    const double hb =
+        unit * opm_half(-1.0 * area, m.cell_perm[b], face_centre(b, a, centroid) - m.cell_fv_center[b], axis);
     for (int32_t f : faces) {
       const double w = norm(g.face_area[f]) / total;
       t->half_owner[f] = w * (m.face_owner[f] == a ? ha : hb);

@@ -21,13 +21,14 @@ struct TransmissibilityOptions {
   /// true: the exact logarithmic form on ring faces of radial well cells; false: the generic
   /// two-point form everywhere (only useful to measure what the log form buys).
   bool exact_radial = true;
-  /// true: the half-transmissibility on the side of a reservoir cell that is not a box (a corner-point
-  /// model's cell: the user's cell, exempt from the shape checks) is OPM's corner-point one,
-  /// K_dd |A . c| / |c|^2 with d the face's axis (I, J or K: from the two cells' (i,j,k) between model
-  /// cells, else the largest component of the face normal), c from the FV centre (the mean of the 8
-  /// corners, OPM's cell centre) to the face centroid: never negative. Radial and transition cells keep
-  /// the library's forms. Used for the Eclipse deck and by solver_demo (deck_transmissibility_options),
-  /// never by the checker.
+  /// true: the halves on the side of a reservoir cell (a corner-point model's cell: the user's cell,
+  /// exempt from the shape checks) are OPM's corner-point ones (EclTransmissibility on a CpGrid): per
+  /// pair of model cells, the pair's summed area vector A and on each side K_dd |A . c| / |c|^2, d the
+  /// pair's axis, c from the FV centre (the mean of the 8 corners) to the mean of the 4 corners of that
+  /// cell's whole face; the pair's value shared among its mesh faces by area. A cavity triangle's model
+  /// side: K_dd |A . c| / |c|^2 with its centroid and its normal's largest axis. Never negative. Radial
+  /// and transition cells keep the library's forms. Used for the Eclipse deck and by solver_demo
+  /// (deck_transmissibility_options), never by the checker (docs/transmissibility.md).
   bool reservoir_halves_opm = false;
 };
 
