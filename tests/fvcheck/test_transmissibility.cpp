@@ -392,6 +392,73 @@ TEST(Transmissibility, DeckOptionsGiveReservoirCellsOpmsCornerPointHalves) {
   for (int32_t f : signed_t.negative_faces) EXPECT_LT(signed_t.half_owner[f], 0.0);
 }
 
+// OPM computes one transmissibility per pair of model cells from the pair's vector area and, on each
+// side, the centre of the cell's whole face (the mean of its 4 corners). Two model cells sharing a
+// twisted face get that value whether the mesh stores the face as one quad or as the triangles about the
+// node at the mean of its corners (how the mesh stores a whole face with stations on its edges).
+TEST(Transmissibility, DeckOptionsGiveOnePairValueWhateverTheSharedFaceIsStoredAs) {
+  double pair_t[2] = {0, 0};
+  // Corners on the pillar lines x = 0, 10, 20.
+  auto point = [](int i, int j, int k) {
+    Vec3 p{10.0 * i, 8.0 * j, 3.0 * k};
+    if (i == 1 && j == 1 && k == 1) p = {10.6, 8, 3.4};  // the shared face is twisted
+    return p;
+  };
+  const Vec3 perm{100, 20, 5};
+  for (int stored = 0; stored < 2; ++stored) {
+    MeshBuilder b;
+    int32_t id[3][2][2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int k = 0; k < 2; ++k) id[i][j][k] = b.add_node(point(i, j, k));
+    const Vec3 mid = 0.25 * (point(1, 0, 0) + point(1, 1, 0) + point(1, 0, 1) + point(1, 1, 1));
+    const int32_t apex = stored == 1 ? b.add_node(mid) : -1;
+    for (int c = 0; c < 2; ++c) {
+      int32_t n[8];
+      Vec3 centre{0, 0, 0};
+      for (int q = 0; q < 8; ++q) {
+        n[q] = id[c + (q & 1)][(q >> 1) & 1][(q >> 2) & 1];
+        centre += 0.125 * point(c + (q & 1), (q >> 1) & 1, (q >> 2) & 1);
+      }
+      CellAttributes at;
+      at.region = kReservoir;
+      at.perm = perm;
+      at.fv_center = centre;
+      at.ijk = {c, 0, 0};
+      const int32_t shared_side = c == 0 ? 1 : 0;  // the x = 10 face: +a of cell 0, -a of cell 1
+      std::vector<std::vector<int32_t>> faces{{n[0], n[2], n[3], n[1]}, {n[4], n[5], n[7], n[6]},
+                                              {n[0], n[1], n[5], n[4]}, {n[2], n[6], n[7], n[3]}};
+      const std::vector<int32_t> x_faces[2] = {{n[0], n[4], n[6], n[2]}, {n[1], n[3], n[7], n[5]}};
+      for (int side = 0; side < 2; ++side) {
+        const std::vector<int32_t>& q = x_faces[side];
+        if (side == shared_side && stored == 1)
+          for (int e = 0; e < 4; ++e) faces.push_back({apex, q[e], q[(e + 1) % 4]});
+        else
+          faces.push_back(q);
+      }
+      add_convex_cell(b, faces, std::vector<int32_t>(faces.size(), kOuterBoundary), at);
+    }
+    const PolyMesh m = finish_ok(b);
+    const Transmissibilities t = compute_transmissibilities(m, compute_geometry(m), deck_transmissibility_options());
+    int shared = 0;
+    for (int f = 0; f < m.n_faces(); ++f)
+      if (m.face_neighbour[f] >= 0) pair_t[stored] += t.face[f], ++shared;
+    EXPECT_EQ(shared, stored == 0 ? 1 : 4);
+    // OPM's value by hand: vector area of the quad (half the cross product of its diagonals).
+    const Vec3 area = 0.5 * cross(point(1, 1, 0) - point(1, 0, 1), point(1, 1, 1) - point(1, 0, 0));
+    double h[2];
+    for (int c = 0; c < 2; ++c) {
+      Vec3 centre{0, 0, 0};
+      for (int q = 0; q < 8; ++q) centre += 0.125 * point(c + (q & 1), (q >> 1) & 1, (q >> 2) & 1);
+      const Vec3 d = mid - centre;
+      h[c] = kDarcyMetric * perm.x * std::fabs(dot(area, d)) / norm2(d);
+    }
+    const double expected = 1 / (1 / h[0] + 1 / h[1]);
+    EXPECT_NEAR(pair_t[stored], expected, 1e-12 * expected) << "stored as " << (stored ? "triangles" : "a quad");
+  }
+  EXPECT_NEAR(pair_t[0], pair_t[1], 1e-12 * pair_t[0]);
+}
+
 // ---------------------------------------------------------------- radial ring blocks
 
 TEST(Transmissibility, RadialBlockReproducesSteadyRadialFlowExactly) {
