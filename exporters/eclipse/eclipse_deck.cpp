@@ -47,10 +47,44 @@ void write_zcorn(TextOut& o, int nx, int ny, int nz, const std::vector<double>& 
 }
 
 // A corner-point model's own COORD and ZCORN, as OPM read them (the user's geometry, in the frame of
-// the deck: MAPAXES is not repeated, the wells of the deck are on cells).
-void write_model_geometry(TextOut& o, const CornerPointModel& m) {
-  o.eclipse_array("COORD", m.coord);
-  o.eclipse_array("ZCORN", m.zcorn);
+// the deck: MAPAXES is not repeated, the wells of the deck are on cells), widened by the layout's
+// separator and extra columns: the pillars of row J are the model's (I = 0..nx, 6 numbers each) then
+// the layout's vertical ones; ZCORN in Eclipse order with the deck's NX, the model's values for
+// I < nx and the layout's flat tops and bottoms beyond. Without extra columns: the model's arrays.
+void write_model_geometry(TextOut& o, const CornerPointModel& m, const EclipseLayout* layout) {
+  if (layout == nullptr || layout->deck_nx == m.nx) {
+    o.eclipse_array("COORD", m.coord);
+    o.eclipse_array("ZCORN", m.zcorn);
+    return;
+  }
+  const EclipseLayout& L = *layout;
+  std::vector<double> coord;
+  coord.reserve(static_cast<size_t>(6) * (L.deck_nx + 1) * (m.ny + 1));
+  for (int J = 0; J <= m.ny; ++J) {
+    for (int I = 0; I <= m.nx; ++I) {
+      const size_t p = 6 * (I + static_cast<size_t>(m.nx + 1) * J);
+      coord.insert(coord.end(), m.coord.begin() + p, m.coord.begin() + p + 6);
+    }
+    for (int I = m.nx + 1; I <= L.deck_nx; ++I)
+      coord.insert(coord.end(), {L.pillar_x[I], L.pillar_y[J], L.pillar_top, L.pillar_x[I], L.pillar_y[J], L.pillar_bottom});
+  }
+  std::vector<double> z;
+  z.reserve(static_cast<size_t>(8) * L.n_deck_cells());
+  for (int k = 0; k < m.nz; ++k)
+    for (int c = 0; c < 2; ++c)
+      for (int j = 0; j < m.ny; ++j)
+        for (int b = 0; b < 2; ++b)
+          for (int i = 0; i < L.deck_nx; ++i)
+            for (int a = 0; a < 2; ++a) {
+              if (i < m.nx) {
+                z.push_back(m.zcorn[zcorn_index(m, i, j, k, a + 2 * b + 4 * c)]);
+              } else {
+                const size_t g = i + static_cast<size_t>(L.deck_nx) * (j + static_cast<size_t>(m.ny) * k);
+                z.push_back(c == 0 ? L.top[g] : L.bottom[g]);
+              }
+            }
+  o.eclipse_array("COORD", coord);
+  o.eclipse_array("ZCORN", z);
 }
 
 std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::string* error) {
@@ -88,7 +122,7 @@ std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::str
     << "-- near-well (cavity) mesh have ACTNUM 0. Units: METRIC (m, mD); depth positive down.\n"
     << "SPECGRID\n" << nx << ' ' << ny << ' ' << nz << " 1 F /\n\n";
   if (res.corner_point) {
-    write_model_geometry(o, *res.corner_point);
+    write_model_geometry(o, *res.corner_point, nullptr);
   } else {
     write_coord(o, res.x, res.y, res.z.front(), res.z.back());
     write_zcorn(o, nx, ny, nz, top, bottom);
@@ -211,17 +245,40 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
                        " days) needs a run beyond flow's calendar: the deck ends at 130000 days");
     end_days = 130000;
   }
-  if (conn.negative_faces > 0 && !L.corner_point)
+  // A corner-point model alone (no near-well cells): flow computes the model's connections and pore
+  // volumes itself. With near-well cells every connection and pore volume is ours, the model's too
+  // (docs/export-eclipse.md, "A corner-point model": flow's corner-point transmissibilities are not
+  // the ones solver_demo solves with).
+  const bool model_only = L.corner_point && L.extra_columns == 0;
+  if (L.corner_point && !model_only) {
+    static const char* kMult[6] = {"MULTX", "MULTX-", "MULTY", "MULTY-", "MULTZ", "MULTZ-"};
+    for (int d = 0; d < 6; ++d)
+      for (double v : cs.reservoir.corner_point->trans_mult[d])
+        if (v != 1.0)
+          return fail(std::string("the corner-point model has transmissibility multipliers (") + kMult[d] +
+                      ", FAULTS/MULTFLT or MULTZ) that the mesh's transmissibilities do not carry yet: a deck of it "
+                      "with near-well cells would not be the model");
+  }
+  if (conn.negative_nnc > 0 && !model_only) {
+    const auto a = L.deck_ijk(conn.first_negative_nnc.a), b = L.deck_ijk(conn.first_negative_nnc.b);
+    std::ostringstream w;
+    w << conn.negative_nnc << " NNC records have a negative transmissibility, which OPM Flow sets to zero (first: ("
+      << a[0] + 1 << "," << a[1] + 1 << "," << a[2] + 1 << ") - (" << b[0] + 1 << "," << b[1] + 1 << "," << b[2] + 1
+      << "), T = " << conn.first_negative_nnc.t
+      << "): the deck would not be the mesh; compute the transmissibilities with deck_transmissibility_options()";
+    return fail(w.str());
+  }
+  if (conn.negative_faces > 0 && !model_only)
     warnings.push_back(std::to_string(conn.negative_faces) +
                        " interior faces have a negative or non-finite transmissibility (written as computed)");
-  if (conn.below_flow_threshold > 0 && !L.corner_point) {
+  if (conn.below_flow_threshold > 0 && !model_only) {
     std::ostringstream w;
     w << conn.below_flow_threshold << " NNC records have T < " << kFlowNncThreshold
       << " cP.rm3/day/bar, which OPM Flow ignores (sum " << conn.below_flow_threshold_sum << " of a total "
       << conn.total << ")";
     warnings.push_back(w.str());
   }
-  if (conn.zero_faces > 0 && !L.corner_point)
+  if (conn.zero_faces > 0 && !model_only)
     warnings.push_back(std::to_string(conn.zero_faces) + " interior faces have a zero transmissibility (no connection)");
 
   const size_t nd = static_cast<size_t>(L.n_deck_cells());
@@ -238,16 +295,21 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       o << ", separator column " << L.nx + 1 << " (inactive), well/transition cells in columns " << L.nx + 2 << ".."
         << L.deck_nx << " (thin boxes at their FV-centre depth, on every other I and J)";
     o << ".\n\n";
-    if (L.corner_point) {
+    if (model_only) {
       o << "-- The model's own corner-point geometry (COORD/ZCORN as OPM read them). flow computes the\n"
         << "-- connections between the model's cells itself, fault NNCs included, with OPM's multipliers\n"
         << "-- of the model (MULTX..MULTZ-, FAULTS/MULTFLT folded in, as TransMult gives them).\n";
-      write_model_geometry(o, *cs.reservoir.corner_point);
+      write_model_geometry(o, *cs.reservoir.corner_point, &L);
       static const char* kMult[6] = {"MULTX", "MULTX-", "MULTY", "MULTY-", "MULTZ", "MULTZ-"};
       for (int d = 0; d < 6; ++d) {
         const std::vector<double>& v = cs.reservoir.corner_point->trans_mult[d];
         if (std::any_of(v.begin(), v.end(), [](double x) { return x != 1.0; })) o.eclipse_array(kMult[d], v);
       }
+    } else if (L.corner_point) {
+      o << "-- Columns 1.." << L.nx << ": the model's own corner-point geometry (COORD/ZCORN as OPM read them),\n"
+        << "-- widened by the separator and extra columns (vertical pillars beyond the model's +x side).\n"
+        << "-- Every connection is HybridMesh's (TRANX/Y/Z in EDIT, NNC): none of flow's geometric ones.\n";
+      write_model_geometry(o, *cs.reservoir.corner_point, &L);
     } else {
       write_coord(o, L.pillar_x, L.pillar_y, L.pillar_top, L.pillar_bottom);
       write_zcorn(o, L.deck_nx, L.ny, L.nz, L.top, L.bottom);
@@ -278,7 +340,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     TextOut o;
     o << "-- Non-neighbour connections (I1 J1 K1 I2 J2 K2 T), T in cP.rm3/day/bar, from HybridMesh's\n"
       << "-- two-point transmissibilities (faces joining the same two cells summed).\n";
-    if (!conn.nnc.empty() && !L.corner_point) {
+    if (!conn.nnc.empty() && !model_only) {
       o << "NNC\n";
       for (const auto& r : conn.nnc) {
         const auto a = L.deck_ijk(r.a), b = L.deck_ijk(r.b);
@@ -293,7 +355,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   // ---- EDIT include: pore volumes and transmissibilities replace flow's geometric ones.
   std::string edit_text;
   int tran_connections = 0;
-  if (L.corner_point) {
+  if (model_only) {
     edit_text = "-- A corner-point model's cells: flow's own pore volumes and transmissibilities (GRID include).\n";
   } else {
     TextOut o;
@@ -432,7 +494,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     info->data_file = (out / (name + ".DATA")).string();
     info->files = files.paths();
     info->layout = std::move(L);
-    info->nnc = L.corner_point ? 0 : static_cast<int>(conn.nnc.size());
+    info->nnc = model_only ? 0 : static_cast<int>(conn.nnc.size());
     info->tran_connections = tran_connections;
     info->well_connections = wells;
     info->warnings = warnings;

@@ -74,8 +74,9 @@ struct EclipseLayout {
   /// deck_nx + 1 pillar x positions; pillar y positions are the lattice's y.
   std::vector<double> pillar_x, pillar_y;
   double pillar_top = 0, pillar_bottom = 0;  ///< depth range of the vertical pillars
-  /// The reservoir is a corner-point model: the deck's grid is the model's COORD/ZCORN (top, bottom
-  /// and pillars above are then unused) and it has no extra columns.
+  /// The reservoir is a corner-point model: columns 1..nx of the deck's grid are the model's
+  /// COORD/ZCORN (pillar_x/pillar_y above then only place the extra columns' vertical pillars, and
+  /// top/bottom of a model cell are its corners' depth range, information only).
   bool corner_point = false;
 
   int n_deck_cells() const { return deck_nx * ny * nz; }
@@ -107,6 +108,10 @@ struct EclipseConnections {
   int zero_faces = 0;        ///< interior faces with T == 0 (nothing to write)
   int negative_faces = 0;    ///< interior faces with T < 0 or not finite (written as computed)
   int below_flow_threshold = 0;        ///< NNC records flow ignores: |t| < kFlowNncThreshold, not logical neighbours
+  /// NNC records flow would also set to zero: t <= -kFlowNncThreshold, not logical neighbours (flow's test
+  /// is t < threshold, sign included). write_eclipse_deck refuses them; `first_negative_nnc` names one.
+  int negative_nnc = 0;
+  Nnc first_negative_nnc;
   double below_flow_threshold_sum = 0; ///< their summed |t|
   double total = 0;          ///< sum of all interior face transmissibilities (for checks)
 };

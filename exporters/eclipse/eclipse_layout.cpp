@@ -77,13 +77,10 @@ bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const E
     res_cell[r] = c;
   }
 
-  if (res.corner_point) {
-    L.corner_point = true;
-    if (!extra.empty()) {
-      *error = "near-well cells in a corner-point model's deck are not written yet (the case's cells are the model's)";
-      return false;
-    }
-  }
+  // A corner-point model: its columns are the model's (COORD/ZCORN as OPM read them); the near-well
+  // cells go to extra columns beyond its +x side as in a rectilinear grid (docs/export-eclipse.md,
+  // "A corner-point model").
+  L.corner_point = static_cast<bool>(res.corner_point);
   // Pack the extra cells by depth: a min-heap of open columns keyed by their current bottom. Cells
   // come in increasing depth, so if the column with the shallowest bottom cannot take a cell, no
   // open column can, and a new one is opened (greedy interval colouring: the fewest columns).
@@ -141,6 +138,14 @@ bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const E
         const size_t g = deck_index(i, j, k);
         L.top[g] = res.z[k];
         L.bottom[g] = res.z[k + 1];
+        if (res.corner_point && i < L.nx) {  // the model cell's depth range (information only)
+          const int mc = i + L.nx * (j + L.ny * k);
+          L.top[g] = L.bottom[g] = corner_depth(*res.corner_point, mc, 0);
+          for (int q = 0; q < 8; ++q) {
+            L.top[g] = std::min(L.top[g], corner_depth(*res.corner_point, mc, q));
+            L.bottom[g] = std::max(L.bottom[g], corner_depth(*res.corner_point, mc, q));
+          }
+        }
         if (i < L.nx) {
           const int32_t c = res_cell[i + static_cast<size_t>(L.nx) * (j + static_cast<size_t>(L.ny) * k)];
           L.deck_cell[g] = c;
@@ -172,8 +177,14 @@ bool make_eclipse_layout(const ReservoirSpec& res, const PolyMesh& mesh, const E
     }
 
   L.pillar_x.assign(res.x.begin(), res.x.end());
+  // The extra pillars are vertical, beyond the model's last x (a corner-point model's pillars may
+  // lean out further than its cells' corners).
+  double x_end = res.x.back();
+  if (res.corner_point)
+    for (size_t p = 0; p + 5 < res.corner_point->coord.size(); p += 6)
+      x_end = std::max({x_end, res.corner_point->coord[p], res.corner_point->coord[p + 3]});
   if (L.extra_columns > 0)
-    for (int m = 1; m <= 1 + L.extra_columns; ++m) L.pillar_x.push_back(res.x.back() + m * opt.extra_column_width);
+    for (int m = 1; m <= 1 + L.extra_columns; ++m) L.pillar_x.push_back(x_end + m * opt.extra_column_width);
   L.pillar_y.assign(res.y.begin(), res.y.end());
   double zmin = res.z.front(), zmax = res.z.back();
   for (size_t g = 0; g < nd; ++g) {
@@ -226,11 +237,15 @@ EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseL
   }
   // Flow's test: index difference not 1, NX or NX*NY (it keeps small logical-neighbour connections).
   const int32_t nxd = L.deck_nx, nxy = L.deck_nx * L.ny;
-  for (const auto& r : out.nnc)
-    if (std::abs(r.t) < kFlowNncThreshold && r.b - r.a != 1 && r.b - r.a != nxd && r.b - r.a != nxy) {
+  for (const auto& r : out.nnc) {
+    if (r.b - r.a == 1 || r.b - r.a == nxd || r.b - r.a == nxy) continue;
+    if (std::abs(r.t) < kFlowNncThreshold) {
       ++out.below_flow_threshold;
       out.below_flow_threshold_sum += std::abs(r.t);
+    } else if (!(r.t > 0)) {
+      if (out.negative_nnc++ == 0) out.first_negative_nnc = r;
     }
+  }
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "transmissibility.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -15,6 +16,13 @@ Vec3 times_perm(Vec3 perm, Vec3 v) { return {perm.x * v.x, perm.y * v.y, perm.z 
 
 /// Standard TPFA half: t = A n . K c / |c|^2, c from the FV centre to the face centroid.
 double generic_half(Vec3 area_out, Vec3 perm, Vec3 c) { return dot(area_out, times_perm(perm, c)) / norm2(c); }
+
+/// OPM's corner-point half (its EclTransmissibility): the permeability of the face's axis times
+/// |A . c| / |c|^2; `axis` 0, 1, 2 for an I, J, K face.
+double opm_half(Vec3 area_out, Vec3 perm, Vec3 c, int axis) {
+  const double k = axis == 0 ? perm.x : axis == 1 ? perm.y : perm.z;
+  return k * std::abs(dot(area_out, c)) / norm2(c);
+}
 
 /// Power/Voronoi cell: the face is orthogonal to the site-to-site segment, so the flux is
 /// A k_n / d with d the signed distance from the site to the face plane (n . c), exact for
@@ -206,6 +214,92 @@ double harmonic(double t1, double t2) { return 1.0 / (1.0 / t1 + 1.0 / t2); }
 
 bool is_bad(double t) { return !(t >= 0) || std::isinf(t); }
 
+/// The axis (0, 1, 2 for I, J, K) of a face between two model cells a, b: the index that differs.
+int model_face_axis(const PolyMesh& m, int32_t a, int32_t b) {
+  return m.cell_ijk[a][0] != m.cell_ijk[b][0] ? 0 : m.cell_ijk[a][1] != m.cell_ijk[b][1] ? 1 : 2;
+}
+
+/// OPM computes one transmissibility per pair of model cells (EclTransmissibility with CpGrid): the
+/// pair's area vector (`faceAreaNormalEcl`: the vector area of the face or fault overlap they share) and,
+/// on each side, the distance from the cell centre (the mean of its 8 corners: the FV centre) to the
+/// centre of that cell's whole face (`faceCenterEcl`: the mean of the face's 4 corners, whatever part of
+/// it the neighbour touches). The mesh may store the shared face as several faces (a whole face with
+/// stations on its edges as triangles about a node at the mean of its 4 corners, an overlap cut at a
+/// crossing); the pair's value is shared among them by area.
+void opm_pair_halves(const PolyMesh& m, const MeshGeometry& g, double unit, Transmissibilities* t) {
+  std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> pairs;
+  for (int32_t f = 0; f < m.n_faces(); ++f) {
+    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+    if (n < 0 || m.cell_region[o] != kReservoir || m.cell_region[n] != kReservoir) continue;
+    if (m.cell_ijk[o][0] < 0 || m.cell_ijk[n][0] < 0) continue;
+    pairs[{std::min(o, n), std::max(o, n)}].push_back(f);
+  }
+  // Side 2 axis + (0: toward +index, 1: toward -index) of cell a toward its pair's other cell b.
+  auto side = [&](int32_t a, int32_t b) {
+    const int axis = model_face_axis(m, a, b);
+    return 2 * axis + (m.cell_ijk[b][axis] > m.cell_ijk[a][axis] ? 0 : 1);
+  };
+  // Pass 1: the whole faces (a plain quad, or the triangles about the node at the mean of the 4 corners)
+  // give the centre of that side of both cells.
+  std::vector<std::array<Vec3, 6>> centre(m.n_cells());
+  std::vector<std::array<char, 6>> known(m.n_cells(), std::array<char, 6>{0, 0, 0, 0, 0, 0});
+  for (const auto& [cells, faces] : pairs) {
+    int32_t apex = -1;
+    Vec3 c{0, 0, 0};
+    if (faces.size() == 1 && m.face_size(faces[0]) == 4) {
+      for (auto it = m.face_begin(faces[0]); it != m.face_end(faces[0]); ++it) c += 0.25 * m.nodes[*it];
+    } else if (faces.size() >= 3) {
+      for (auto it = m.face_begin(faces[0]); it != m.face_end(faces[0]) && apex < 0; ++it) {
+        bool in_all = true;
+        for (int32_t f : faces)
+          in_all = in_all && m.face_size(f) == 3 && std::find(m.face_begin(f), m.face_end(f), *it) != m.face_end(f);
+        if (in_all) apex = *it;
+      }
+      if (apex < 0) continue;
+      c = m.nodes[apex];
+    } else {
+      continue;
+    }
+    const int32_t a = cells.first, b = cells.second;
+    centre[a][side(a, b)] = c;
+    known[a][side(a, b)] = 1;
+    centre[b][side(b, a)] = c;
+    known[b][side(b, a)] = 1;
+  }
+  // The centre of cell a's face toward b: known, or through the opposite face (the 8 corners' mean is
+  // the mean of the two faces' centres), else the area-weighted centroid of the shared faces (a cell
+  // with fault overlaps on both sides of an axis: OPM's value is not reproduced there).
+  auto face_centre = [&](int32_t a, int32_t b, Vec3 fallback) {
+    const int sd = side(a, b), opposite = sd ^ 1;
+    if (known[a][sd]) return centre[a][sd];
+    if (known[a][opposite]) return 2.0 * m.cell_fv_center[a] - centre[a][opposite];
+    return fallback;
+  };
+  for (const auto& [cells, faces] : pairs) {
+    const int32_t a = cells.first, b = cells.second;
+    Vec3 area{0, 0, 0}, centroid{0, 0, 0};
+    double total = 0;
+    for (int32_t f : faces) {
+      const double w = norm(g.face_area[f]);
+      area += m.face_sign(f, a) * g.face_area[f];
+      centroid += w * g.face_centroid[f];
+      total += w;
+    }
+    if (!(total > 0)) continue;
+    centroid = centroid / total;
+    const int axis = model_face_axis(m, a, b);
+    const double ha = unit * opm_half(area, m.cell_perm[a], face_centre(a, b, centroid) - m.cell_fv_center[a], axis);
+    const double hb =
+        unit * opm_half(-1.0 * area, m.cell_perm[b], face_centre(b, a, centroid) - m.cell_fv_center[b], axis);
+    for (int32_t f : faces) {
+      const double w = norm(g.face_area[f]) / total;
+      t->half_owner[f] = w * (m.face_owner[f] == a ? ha : hb);
+      t->half_neighbour[f] = w * (m.face_owner[f] == a ? hb : ha);
+      t->face[f] = harmonic(t->half_owner[f], t->half_neighbour[f]);
+    }
+  }
+}
+
 }  // namespace
 
 double transverse_permeability(Vec3 k, Vec3 a) {
@@ -225,6 +319,12 @@ PolyMesh in_metric_frame(const PolyMesh& m) {
   for (Vec3& k : out.cell_perm) k = {det * k.x / (s.x * s.x), det * k.y / (s.y * s.y), det * k.z / (s.z * s.z)};
   out.metric_scale = {1, 1, 1};
   return out;
+}
+
+TransmissibilityOptions deck_transmissibility_options() {
+  TransmissibilityOptions o;
+  o.reservoir_halves_opm = true;
+  return o;
 }
 
 Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeometry& g,
@@ -282,6 +382,20 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
     // The generic form would divide by |c|^2 and lose the radial offset between the FV centre
     // and the face centroid (a 0.2 m end segment of ring 5: half the transmissibility).
     if (opt.exact_radial && rc.well >= 0) return unit * orthogonal_half(area_out, m.cell_perm[c], to_face);
+    if (opt.reservoir_halves_opm && m.cell_region[c] == kReservoir) {
+      // The face's axis: between two model cells, the index that differs (across a fault: I or J;
+      // across a pinched-out layer: K); otherwise (a cavity's triangle, a boundary face) the largest
+      // component of the face's normal in the model's frame.
+      const int32_t nb = m.face_owner[f] == c ? m.face_neighbour[f] : m.face_owner[f];
+      int axis = -1;
+      if (nb >= 0 && m.cell_region[nb] == kReservoir && m.cell_ijk[c][0] >= 0 && m.cell_ijk[nb][0] >= 0)
+        axis = model_face_axis(m, c, nb);
+      if (axis < 0) {
+        const Vec3 a{std::abs(area_out.x), std::abs(area_out.y), std::abs(area_out.z)};
+        axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+      }
+      return unit * opm_half(area_out, m.cell_perm[c], to_face, axis);
+    }
     return unit * generic_half(area_out, m.cell_perm[c], to_face);
   };
 
@@ -304,6 +418,7 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
       }
     }
   }, 256);  // small chunks: the end-cap faces (a quadrature each) lie together
+  if (opt.reservoir_halves_opm) opm_pair_halves(m, g, unit, &t);
   for (int f = 0; f < nf; ++f) {
     if (!bad[f]) continue;
     t.negative += bad[f];

@@ -21,7 +21,22 @@ struct TransmissibilityOptions {
   /// true: the exact logarithmic form on ring faces of radial well cells; false: the generic
   /// two-point form everywhere (only useful to measure what the log form buys).
   bool exact_radial = true;
+  /// true: the halves on the side of a reservoir cell (a corner-point model's cell: the user's cell,
+  /// exempt from the shape checks) are OPM's corner-point ones (EclTransmissibility on a CpGrid): per
+  /// pair of model cells, the pair's summed area vector A and on each side K_dd |A . c| / |c|^2, d the
+  /// pair's axis, c from the FV centre (the mean of the 8 corners) to the mean of the 4 corners of that
+  /// cell's whole face; the pair's value shared among its mesh faces by area. A cavity triangle's model
+  /// side: K_dd |A . c| / |c|^2 with its centroid and its normal's largest axis. Never negative. Radial
+  /// and transition cells keep the library's forms. Used for the Eclipse deck and by solver_demo
+  /// (deck_transmissibility_options), never by the checker (docs/transmissibility.md).
+  bool reservoir_halves_opm = false;
 };
+
+/// The options of the transmissibilities an Eclipse deck carries and solver_demo solves with
+/// (docs/export-eclipse.md, "A corner-point model"): METRIC, exact radial form, reservoir cells' halves
+/// in OPM's corner-point form. On an axis-aligned box (a rectilinear reservoir's cell, FV centre at its
+/// centre) OPM's form is the library's: the same numbers up to rounding.
+TransmissibilityOptions deck_transmissibility_options();
 
 struct Transmissibilities {
   /// n_faces: half-transmissibility from the owner's FV centre to the face.
@@ -32,7 +47,8 @@ struct Transmissibilities {
   /// connection factor (= half_owner, q = CF/mu (p_cell - p_w)); other boundary faces: 0.
   std::vector<double> face;
   /// Number of half-transmissibilities that are negative or not finite (FV centre beyond or on
-  /// the face plane). They are kept as computed, never replaced by their absolute value.
+  /// the face plane). They are kept as computed, never replaced by their absolute value
+  /// (TransmissibilityOptions::reservoir_halves_opm computes another form, which is never negative).
   int negative = 0;
   /// The first faces (at most kMaxListedNegative, each once) carrying such a half-transmissibility.
   std::vector<int32_t> negative_faces;

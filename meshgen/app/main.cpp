@@ -136,7 +136,9 @@ int main(int argc, char** argv) {
   const std::vector<hm::VtuCellArray> extra =
       hm::mesh_file_quality_arrays(m, result.geometry, result.cell_cavity, result.cell_h_ref);
   std::optional<hm::Transmissibilities> trans;
-  if (export_eclipse) trans = hm::compute_transmissibilities(result.mesh, result.geometry);
+  // The deck's transmissibilities are the ones solver_demo solves with (deck_transmissibility_options).
+  if (export_eclipse)
+    trans = hm::compute_transmissibilities(result.mesh, result.geometry, hm::deck_transmissibility_options());
   const nlohmann::json summary = hm::make_summary(cs, result);
   hm::translate_mesh(result.mesh, origin);
 

@@ -110,7 +110,11 @@ std::vector<std::string> export_mesh(Mesh& m, const std::string& out_dir, const 
   }
   if (eclipse) {
     hm::EclipseDeckInfo info;
-    need(hm::write_eclipse_deck(dir + "eclipse", m.cs, r.mesh, r.geometry, m.transmissibilities(), {}, &info));
+    // The deck's transmissibilities, as meshgen --export eclipse writes them and solver_demo solves with
+    // (on a corner-point model's cells OPM's form; `transmissibilities` above stays the checker's).
+    const hm::Transmissibilities deck_trans =
+        hm::compute_transmissibilities(r.mesh, r.geometry, hm::deck_transmissibility_options());
+    need(hm::write_eclipse_deck(dir + "eclipse", m.cs, r.mesh, r.geometry, deck_trans, {}, &info));
     written.push_back(info.data_file);
   }
   if (openfoam) {

@@ -20,6 +20,7 @@
 #include "meshgen/core/text_file.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "solver_demo/lib/accuracy.hpp"
+#include "solver_demo/lib/case_problem.hpp"
 #include "solver_demo/lib/tpfa.hpp"
 
 namespace fs = std::filesystem;
@@ -93,20 +94,9 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mes
   }
   if (const int rc = guarded([&] {
         if (mesh_file.empty()) mesh = hm::build_hybrid_mesh(cs);
-        hm::FlowProblem pb;
-        pb.mesh = &mesh.mesh;
-        pb.geo = &mesh.geometry;
-        pb.viscosity_cp = cs.fluid.viscosity;
-        pb.density = cs.fluid.density;
-        pb.gravity = true;
-        // The deck's PVTW: Pref = initial pressure, B_ref = 1, Cw raised to 1e-8 /bar as the exporter does.
-        pb.compressibility = std::max(cs.fluid.compressibility, 1e-8);
-        pb.reference_pressure = cs.reservoir.initial_pressure;
-        pb.formation_volume_factor = 1.0;
-        for (int w = 0; w < static_cast<int>(cs.wells.size()); ++w) {
-          pb.wells.push_back({w, cs.wells[w].bhp, cs.wells[w].trajectory.front().z});
-        }
-        sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry));
+        const hm::FlowProblem pb = hm::deck_flow_problem(cs, mesh.mesh, mesh.geometry);
+        // The transmissibilities of the exported deck (docs/export-eclipse.md, "A corner-point model").
+        sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry, hm::deck_transmissibility_options()));
       }))
     return rc;
 

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 
+#include "corner_point_test_models.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
@@ -30,10 +31,10 @@ bool have(const std::string& exe) { return run_command("sh -c 'command -v " + ex
 
 // The example with its fluid made nearly incompressible (1e-8 /bar, the deck's floor): the fail
 // half, solver_demo of that case must miss flow's run of the shipped case when Cw matters.
-fs::path incompressible_copy(const std::string& example, const fs::path& dir) {
-  std::string text = slurp(std::string(HM_SOURCE_DIR) + "/examples/" + example + ".yaml");
+fs::path incompressible_copy(const fs::path& yaml, const fs::path& dir) {
+  std::string text = slurp(yaml);
   text = std::regex_replace(text, std::regex(R"(compressibility:\s*[0-9.eE+-]+)"), "compressibility: 1.0e-8");
-  const fs::path p = dir / (example + "_incompressible.yaml");
+  const fs::path p = dir / (yaml.stem().string() + "_incompressible.yaml");
   std::ofstream(p) << text;
   return p;
 }
@@ -80,13 +81,16 @@ Differences differences(const nlohmann::json& res, const nlohmann::json& ours) {
   return d;
 }
 
-void run_example(const std::string& example, bool expect_compressibility_visible, double gate = 1e-5) {
-  if (!have("flow") || !fs::exists("/usr/bin/python3"))
-    GTEST_SKIP() << "OPM Flow (Debian packages libopm-simulators-bin, python3-opm-common) is not installed; "
-                    "scripts/install-deps.sh --validators installs it";
-  const fs::path d = fresh_dir("flow_" + example);
-  const RemoveAtExit cleanup{d};
-  const fs::path yaml = std::string(HM_SOURCE_DIR) + "/examples/" + example + ".yaml";
+bool flow_installed() { return have("flow") && fs::exists("/usr/bin/python3"); }
+#define REQUIRE_FLOW_E2E()                                                                                      \
+  if (!flow_installed())                                                                                        \
+  GTEST_SKIP() << "OPM Flow (Debian packages libopm-simulators-bin, python3-opm-common) is not installed; " \
+                  "scripts/install-deps.sh --validators installs it"
+
+// meshgen CASE --export eclipse, flow NAME.DATA as typed, solver_demo CASE: the same steady state.
+// `d` is the test's folder (the fail half's incompressible copy of the case is written there).
+void run_case_file(const fs::path& yaml, const std::string& example, const fs::path& d,
+                   bool expect_compressibility_visible, double gate) {
   const auto mg = run_command(kMeshgen + " " + q(yaml) + " -o " + q(d / "mesh") + " --export eclipse", 900);
   if (mg.exit_code == 2 && mg.err.find("--export") != std::string::npos)
     GTEST_SKIP() << "meshgen does not accept --export eclipse yet: " << mg.err;
@@ -131,13 +135,21 @@ void run_example(const std::string& example, bool expect_compressibility_visible
   // Fail half, where the case's compressibility matters: solver_demo of the case made nearly
   // incompressible misses flow's run of the shipped case by more than the gate.
   if (expect_compressibility_visible) {
-    const fs::path inc = incompressible_copy(example, d);
+    const fs::path inc = incompressible_copy(yaml, d);
     const auto si = run_command(kSolver + " " + q(inc) + " -o " + q(d / "solve_incompressible"), 900);
     ASSERT_EQ(si.exit_code, 0) << si.out << si.err;
     const Differences di = differences(res, nlohmann::json::parse(slurp(d / "solve_incompressible" / "solution.json")));
     std::printf("[ figures  ] %s: flow vs solver_demo with Cw = 1e-8: worst %.3g\n", example.c_str(), di.worst());
     EXPECT_GT(di.worst(), 1e-5);
   }
+}
+
+void run_example(const std::string& example, bool expect_compressibility_visible, double gate = 1e-5) {
+  REQUIRE_FLOW_E2E();
+  const fs::path d = fresh_dir("flow_" + example);
+  const RemoveAtExit cleanup{d};
+  run_case_file(std::string(HM_SOURCE_DIR) + "/examples/" + example + ".yaml", example, d,
+                expect_compressibility_visible, gate);
 }
 
 // Shipped with Cw = 1e-8 /bar: no fail half (nothing to switch off).
@@ -165,6 +177,21 @@ TEST(FlowMeshgen, AccuracyExamplesDecksMatchSolverDemo) {
 
 // A survey well perforated over part of its length (closed wellbore faces elsewhere).
 TEST(FlowMeshgen, PerforatedSurveyDeckMatchesSolverDemo) { run_example("perforated_survey", false, 1e-6); }
+
+// A corner-point model with wells (docs/export-eclipse.md, "A corner-point model"): the tilted,
+// twisted synthetic model of tests/support with a producer and an injector (Cw 4e-5 /bar, so the fail
+// half applies); the deck keeps the model's columns and carries our transmissibilities everywhere.
+TEST(FlowMeshgen, CornerPointModelWithWellsDeckMatchesSolverDemo) {
+  REQUIRE_FLOW_E2E();
+  const fs::path d = fresh_dir("flow_corner_point");
+  const RemoveAtExit cleanup{d};
+  std::ofstream(d / "M.GRDECL") << hmtest::TiltedModel{}.text();
+  std::ofstream(d / "cpw.yaml") << "name: cpw\nreservoir: {grdecl: M.GRDECL, initial_pressure: 200}\n"
+                                << "fluid: {viscosity: 0.5, density: 1000, compressibility: 4.0e-5}\n"
+                                << hmtest::vertical_well_yaml(90, 90, 1034, 1046)
+                                << hmtest::injector_yaml(50, 130, 1030, 1042);
+  run_case_file(d / "cpw.yaml", "corner_point_two_wells", d, true, 1e-6);
+}
 
 TEST(FlowMeshgen, UnwritableExportDirectoryExitsTwoAndLeavesNoDeck) {
   const fs::path d = fresh_dir("flow_unwritable");

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/fv_quality.hpp"
 #include "meshgen/core/geometry.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 
@@ -328,21 +329,31 @@ TEST(Transmissibility, PowerCellSiteBeyondFacePlaneIsCountedNegative) {
   }
 }
 
+namespace {
+
+// Parallelepiped spanned by a = (1,1,0), b = (0.95,0.3,0), c = (0,0,1), a reservoir cell with its
+// centroid as FV centre and K = (kx, 1, 1). On the two faces spanned by b and c, n . c > 0 but
+// n . K c < 0 when kx >> ky.
+const Vec3 kSkewA{1, 1, 0}, kSkewB{0.95, 0.3, 0}, kSkewC{0, 0, 1};
+PolyMesh skewed_parallelepiped(double kx) {
+  MeshBuilder b;
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c)
+    n[c] = b.add_node(double(c & 1) * kSkewA + double((c >> 1) & 1) * kSkewB + double((c >> 2) & 1) * kSkewC);
+  CellAttributes at;
+  at.region = kReservoir;
+  at.perm = {kx, 1, 1};
+  at.fv_center = 0.5 * (kSkewA + kSkewB + kSkewC);
+  add_hex(b, n, at);
+  return finish_ok(b);
+}
+
+}  // namespace
+
 TEST(Transmissibility, SkewedAnisotropicHexahedronGivesNegativeGenericHalves) {
-  // Parallelepiped spanned by a = (1,1,0), b = (0.95,0.3,0), c = (0,0,1) with its centroid as FV
-  // centre. On the two faces spanned by b and c, n . c > 0 but n . K c < 0 when kx >> ky.
+  const Vec3 eb = kSkewB, ec = kSkewC;
   for (double kx : {1.0, 1000.0}) {  // pass / fail pair
-    MeshBuilder b;
-    const Vec3 ea{1, 1, 0}, eb{0.95, 0.3, 0}, ec{0, 0, 1};
-    int32_t n[8];
-    for (int c = 0; c < 8; ++c)
-      n[c] = b.add_node(double(c & 1) * ea + double((c >> 1) & 1) * eb + double((c >> 2) & 1) * ec);
-    CellAttributes at;
-    at.region = kReservoir;
-    at.perm = {kx, 1, 1};
-    at.fv_center = 0.5 * (ea + eb + ec);
-    add_hex(b, n, at);
-    PolyMesh m = finish_ok(b);
+    PolyMesh m = skewed_parallelepiped(kx);
     const MeshGeometry g = compute_geometry(m);
     const Transmissibilities t = compute_transmissibilities(m, g);
     if (kx == 1.0) {
@@ -356,6 +367,96 @@ TEST(Transmissibility, SkewedAnisotropicHexahedronGivesNegativeGenericHalves) {
       }
     }
   }
+}
+
+// The deck's convention (deck_transmissibility_options): a reservoir cell's half is OPM's corner-point
+// one, K_dd |A . c| / |c|^2 with d the face's axis, never negative; on the skewed anisotropic
+// parallelepiped above (two negative generic halves) it differs from the checker's signed default.
+TEST(Transmissibility, DeckOptionsGiveReservoirCellsOpmsCornerPointHalves) {
+  const PolyMesh m = skewed_parallelepiped(1000);
+  const MeshGeometry g = compute_geometry(m);
+  const Transmissibilities signed_t = compute_transmissibilities(m, g);
+  const Transmissibilities deck_t = compute_transmissibilities(m, g, deck_transmissibility_options());
+  EXPECT_EQ(signed_t.negative, 2);
+  EXPECT_EQ(deck_t.negative, 0);
+  const std::vector<Vec3> end = boundary_flux_points(m, g);
+  const Vec3 k = m.cell_perm[0];
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const Vec3 a = m.face_sign(f, 0) * g.face_area[f], c = end[f] - m.cell_fv_center[0];
+    const Vec3 n{std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)};
+    const double kd = n.x >= n.y && n.x >= n.z ? k.x : n.y >= n.z ? k.y : k.z;
+    const double expected = kDarcyMetric * kd * std::fabs(dot(a, c)) / norm2(c);
+    EXPECT_NEAR(deck_t.half_owner[f], expected, 1e-14 * expected) << f;
+    EXPECT_GT(deck_t.half_owner[f], 0.0) << f;
+  }
+  for (int32_t f : signed_t.negative_faces) EXPECT_LT(signed_t.half_owner[f], 0.0);
+}
+
+// OPM computes one transmissibility per pair of model cells from the pair's vector area and, on each
+// side, the centre of the cell's whole face (the mean of its 4 corners). Two model cells sharing a
+// twisted face get that value whether the mesh stores the face as one quad or as the triangles about the
+// node at the mean of its corners (how the mesh stores a whole face with stations on its edges).
+TEST(Transmissibility, DeckOptionsGiveOnePairValueWhateverTheSharedFaceIsStoredAs) {
+  double pair_t[2] = {0, 0};
+  // Corners on the pillar lines x = 0, 10, 20.
+  auto point = [](int i, int j, int k) {
+    Vec3 p{10.0 * i, 8.0 * j, 3.0 * k};
+    if (i == 1 && j == 1 && k == 1) p = {10.6, 8, 3.4};  // the shared face is twisted
+    return p;
+  };
+  const Vec3 perm{100, 20, 5};
+  for (int stored = 0; stored < 2; ++stored) {
+    MeshBuilder b;
+    int32_t id[3][2][2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int k = 0; k < 2; ++k) id[i][j][k] = b.add_node(point(i, j, k));
+    const Vec3 mid = 0.25 * (point(1, 0, 0) + point(1, 1, 0) + point(1, 0, 1) + point(1, 1, 1));
+    const int32_t apex = stored == 1 ? b.add_node(mid) : -1;
+    for (int c = 0; c < 2; ++c) {
+      int32_t n[8];
+      Vec3 centre{0, 0, 0};
+      for (int q = 0; q < 8; ++q) {
+        n[q] = id[c + (q & 1)][(q >> 1) & 1][(q >> 2) & 1];
+        centre += 0.125 * point(c + (q & 1), (q >> 1) & 1, (q >> 2) & 1);
+      }
+      CellAttributes at;
+      at.region = kReservoir;
+      at.perm = perm;
+      at.fv_center = centre;
+      at.ijk = {c, 0, 0};
+      const int32_t shared_side = c == 0 ? 1 : 0;  // the x = 10 face: +a of cell 0, -a of cell 1
+      std::vector<std::vector<int32_t>> faces{{n[0], n[2], n[3], n[1]}, {n[4], n[5], n[7], n[6]},
+                                              {n[0], n[1], n[5], n[4]}, {n[2], n[6], n[7], n[3]}};
+      const std::vector<int32_t> x_faces[2] = {{n[0], n[4], n[6], n[2]}, {n[1], n[3], n[7], n[5]}};
+      for (int side = 0; side < 2; ++side) {
+        const std::vector<int32_t>& q = x_faces[side];
+        if (side == shared_side && stored == 1)
+          for (int e = 0; e < 4; ++e) faces.push_back({apex, q[e], q[(e + 1) % 4]});
+        else
+          faces.push_back(q);
+      }
+      add_convex_cell(b, faces, std::vector<int32_t>(faces.size(), kOuterBoundary), at);
+    }
+    const PolyMesh m = finish_ok(b);
+    const Transmissibilities t = compute_transmissibilities(m, compute_geometry(m), deck_transmissibility_options());
+    int shared = 0;
+    for (int f = 0; f < m.n_faces(); ++f)
+      if (m.face_neighbour[f] >= 0) pair_t[stored] += t.face[f], ++shared;
+    EXPECT_EQ(shared, stored == 0 ? 1 : 4);
+    // OPM's value by hand: vector area of the quad (half the cross product of its diagonals).
+    const Vec3 area = 0.5 * cross(point(1, 1, 0) - point(1, 0, 1), point(1, 1, 1) - point(1, 0, 0));
+    double h[2];
+    for (int c = 0; c < 2; ++c) {
+      Vec3 centre{0, 0, 0};
+      for (int q = 0; q < 8; ++q) centre += 0.125 * point(c + (q & 1), (q >> 1) & 1, (q >> 2) & 1);
+      const Vec3 d = mid - centre;
+      h[c] = kDarcyMetric * perm.x * std::fabs(dot(area, d)) / norm2(d);
+    }
+    const double expected = 1 / (1 / h[0] + 1 / h[1]);
+    EXPECT_NEAR(pair_t[stored], expected, 1e-12 * expected) << "stored as " << (stored ? "triangles" : "a quad");
+  }
+  EXPECT_NEAR(pair_t[0], pair_t[1], 1e-12 * pair_t[0]);
 }
 
 // ---------------------------------------------------------------- radial ring blocks

@@ -33,49 +33,7 @@ namespace {
 
 std::string num(double v) { return hmtest::grdecl_number(v); }
 
-// Vertical pillars every dx, dy; layers of thickness dz dipping `dip_deg` in x, 1 % in y, with a
-// twist (x y term: the top and bottom faces are not planar); a fault on pillar line I = fault_i
-// (the +i side down by `throw_m`) when fault_i > 0. PERMX varies by cell.
-struct TiltedModel {
-  int nx = 9, ny = 9, nz = 16, fault_i = -1;
-  double dx = 20, dy = 20, dz = 4.5, dip_deg = 5, throw_m = 0;
-  bool inclined_pillars = false;  // non-parallel pillars: the column faces are not planar either
-  double pillar_twist = 0;        // inclined pillars whose slope also varies along the model's sides (bent sides)
-  std::vector<int> inactive;      // cells with ACTNUM 0 (natural index)
-
-  double depth(int i_col, int I, int J, int k) const {
-    const double x = dx * I, y = dy * J;
-    double z = 1000 + std::tan(dip_deg * M_PI / 180) * x + 0.01 * y + 1e-4 * x * y + dz * k;
-    if (fault_i > 0 && i_col >= fault_i) z += throw_m;
-    return z;
-  }
-  std::string text() const {
-    std::ostringstream o;
-    o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
-    for (int J = 0; J <= ny; ++J)
-      for (int I = 0; I <= nx; ++I)
-      {
-        const double x = dx * I, y = dy * J;
-        const double bx = inclined_pillars ? x + 6 + 0.01 * x + pillar_twist * y : x,
-                     by = inclined_pillars ? y + 3 - 0.005 * y + pillar_twist * x : y;
-        o << num(x) << " " << num(y) << " 900 " << num(bx) << " " << num(by) << " 1200\n";
-      }
-    o << "/\nZCORN\n";
-    hmtest::write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
-    const int n = nx * ny * nz;
-    if (!inactive.empty()) {
-      o << "/\nACTNUM\n";
-      for (int c = 0; c < n; ++c) o << (std::find(inactive.begin(), inactive.end(), c) == inactive.end() ? 1 : 0) << "\n";
-    }
-    o << "/\nPERMX\n";
-    for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
-    o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
-    for (int c = 0; c < n; ++c) o << 0.15 + 0.01 * (c % 5) << "\n";
-    o << "/\n";
-    return o.str();
-  }
-};
-
+using hmtest::TiltedModel;
 using hmtest::TempDir;
 
 CaseSpec case_of(const TempDir& tmp, const TiltedModel& m, const std::string& wells) {
@@ -84,11 +42,7 @@ CaseSpec case_of(const TempDir& tmp, const TiltedModel& m, const std::string& we
   return load_case((tmp.path / "m.yaml").string());
 }
 
-std::string vertical_well(double x, double y, double z0, double z1) {
-  return "wells:\n  - {name: P1, trajectory: [[" + num(x) + ", " + num(y) + ", " + num(z0) + "], [" + num(x) + ", " +
-         num(y) + ", " + num(z1) + "]], radius: 0.1, drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4,"
-         " end_caps: flat, bhp: 150}\n";
-}
+std::string vertical_well(double x, double y, double z0, double z1) { return hmtest::vertical_well_yaml(x, y, z0, z1); }
 
 double total_volume(const HybridMesh& out) {
   double v = 0;
@@ -326,8 +280,7 @@ TEST(CornerPointWells, DeviatedWellWithInclinedPillarsMeshes) {
   TempDir tmp("cpwells");
   TiltedModel g;
   g.nz = 22, g.inclined_pillars = true;
-  const std::string well = "wells:\n  - {name: P1, trajectory: [[90, 90, 1055], [110, 90, 1068]], radius: 0.1, "
-                           "drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+  const std::string well = hmtest::deviated_well_yaml();
   const CaseSpec cs = case_of(tmp, g, well);
   HybridMesh out;
   ASSERT_NO_THROW(out = build_hybrid_mesh(cs));  // gtest prints the exception's what()
@@ -467,8 +420,7 @@ TEST(CornerPointWells, WellAcrossAFaultOfTenMetresIsRefusedWithTheReason) {
   TempDir tmp("cpwells");
   TiltedModel g;
   g.nz = 22, g.fault_i = 5, g.throw_m = 10;
-  const std::string well = "wells:\n  - {name: P1, trajectory: [[90, 90, 1055], [110, 90, 1068]], radius: 0.1, "
-                           "drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+  const std::string well = hmtest::deviated_well_yaml();
   const CaseSpec cs = case_of(tmp, g, well);
   try {
     build_hybrid_mesh(cs);

@@ -237,12 +237,11 @@ struct SyntheticCpg {
   std::string text() const {
     std::ostringstream o;
     o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
-    for (int J = 0; J <= ny; ++J)
-      for (int I = 0; I <= nx; ++I) {
-        const double x = pillar_x(I), y = pillar_y(J);
-        const double bx = vertical_pillars ? x : x + 6 + 0.01 * x, by = vertical_pillars ? y : y + 3 - 0.005 * y;
-        o << num(x) << " " << num(y) << " 1400 " << num(bx) << " " << num(by) << " 1700\n";
-      }
+    hmtest::write_pillars(o, nx, ny, 1400, 1700, [&](int I, int J) {
+      const double x = pillar_x(I), y = pillar_y(J);
+      return vertical_pillars ? std::array<double, 4>{x, y, x, y}
+                              : std::array<double, 4>{x, y, x + 6 + 0.01 * x, y + 3 - 0.005 * y};
+    });
     o << "/\nZCORN\n";
     hmtest::write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return surface(i, I, J, k); });
     const int n = nx * ny * nz;

@@ -1,0 +1,145 @@
+// Helpers of the tests that write synthetic corner-point models (GRDECL text): shared by the
+// pipeline's corner-point tests and the exporters' Flow tests.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace hmtest {
+
+/// A double as the shortest text that reads back as the same value (%.17g).
+inline std::string grdecl_number(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+/// The ZCORN values in Eclipse order: per layer k its top then bottom surface, per row j the -j
+/// then +j corners, per column i the -i then +i corner; depth(i_col, I, J, surface) gives the depth
+/// of the corner of column i_col on pillar (I, J) at surface k (top) or k + 1 (bottom).
+inline void write_zcorn(std::ostringstream& o, int nx, int ny, int nz,
+                        const std::function<double(int, int, int, int)>& depth) {
+  for (int k = 0; k < nz; ++k)
+    for (int c = 0; c < 2; ++c)
+      for (int j = 0; j < ny; ++j)
+        for (int b = 0; b < 2; ++b)
+          for (int i = 0; i < nx; ++i)
+            for (int a = 0; a < 2; ++a) o << grdecl_number(depth(i, i + a, j + b, k + c)) << "\n";
+}
+
+/// The COORD lines of (nx + 1)(ny + 1) pillars, I fastest: pillar(I, J) gives its top and bottom x, y
+/// {x_top, y_top, x_bottom, y_bottom}, at depths z_top and z_bottom.
+inline void write_pillars(std::ostringstream& o, int nx, int ny, double z_top, double z_bottom,
+                          const std::function<std::array<double, 4>(int, int)>& pillar) {
+  for (int J = 0; J <= ny; ++J)
+    for (int I = 0; I <= nx; ++I) {
+      const std::array<double, 4> p = pillar(I, J);
+      o << grdecl_number(p[0]) << " " << grdecl_number(p[1]) << " " << grdecl_number(z_top) << " " << grdecl_number(p[2])
+        << " " << grdecl_number(p[3]) << " " << grdecl_number(z_bottom) << "\n";
+    }
+}
+
+/// Vertical pillars every dx, dy; layers of thickness dz dipping `dip_deg` in x, 1 % in y, with a
+/// twist (x y term: the top and bottom faces are not planar); a fault on pillar line I = fault_i
+/// (the +i side down by `throw_m`) when fault_i > 0. PERMX and PORO vary by cell
+/// (docs/corner-point.md, "Measured").
+struct TiltedModel {
+  int nx = 9, ny = 9, nz = 16, fault_i = -1;
+  double dx = 20, dy = 20, dz = 4.5, dip_deg = 5, throw_m = 0;
+  bool inclined_pillars = false;  // non-parallel pillars: the column faces are not planar either
+  double pillar_twist = 0;        // inclined pillars whose slope also varies along the model's sides (bent sides)
+  std::vector<int> inactive;      // cells with ACTNUM 0 (natural index)
+
+  double depth(int i_col, int I, int J, int k) const {
+    const double x = dx * I, y = dy * J;
+    double z = 1000 + std::tan(dip_deg * M_PI / 180) * x + 0.01 * y + 1e-4 * x * y + dz * k;
+    if (fault_i > 0 && i_col >= fault_i) z += throw_m;
+    return z;
+  }
+  /// The model as GRDECL text (SPECGRID, COORD, ZCORN, PERMX/Y/Z, PORO).
+  std::string text() const {
+    std::ostringstream o;
+    o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
+    write_pillars(o, nx, ny, 900, 1200, [&](int I, int J) {
+      const double x = dx * I, y = dy * J;
+      return inclined_pillars ? std::array<double, 4>{x, y, x + 6 + 0.01 * x + pillar_twist * y,
+                                                      y + 3 - 0.005 * y + pillar_twist * x}
+                              : std::array<double, 4>{x, y, x, y};
+    });
+    o << "/\nZCORN\n";
+    write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
+    const int n = nx * ny * nz;
+    if (!inactive.empty()) {
+      o << "/\nACTNUM\n";
+      for (int c = 0; c < n; ++c) o << (std::find(inactive.begin(), inactive.end(), c) == inactive.end() ? 1 : 0) << "\n";
+    }
+    o << "/\nPERMX\n";
+    for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
+    o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
+    for (int c = 0; c < n; ++c) o << 0.15 + 0.01 * (c % 5) << "\n";
+    o << "/\n";
+    return o.str();
+  }
+};
+
+/// Planar layers (depth 1000 + dz k + tan(dip) x + 0.01 y at pillar (x, y) = (dx I, dy J)) on
+/// parallel straight pillars inclined `pillar_deg` from the vertical toward azimuth `pillar_azimuth_deg`
+/// (0: +x, 90: +y), so every cell face is
+/// planar; an optional fault on pillar line I = fault_i (columns i >= fault_i down by throw_m).
+/// PERMX varies by cell; PERMY 120, PERMZ 12 mD; PORO 0.2.
+struct LayeredModel {
+  int nx = 7, ny = 7, nz = 40, fault_i = -1;
+  double dx = 100, dy = 100, dz = 3, dip_deg = 5, pillar_deg = 0, pillar_azimuth_deg = 0, throw_m = 0;
+
+  double depth(int i_col, int I, int J, int k) const {
+    double z = 1000 + dz * k + std::tan(dip_deg * M_PI / 180) * dx * I + 0.01 * dy * J;
+    if (fault_i > 0 && i_col >= fault_i) z += throw_m;
+    return z;
+  }
+  std::string text() const {
+    std::ostringstream o;
+    const double lean = std::tan(pillar_deg * M_PI / 180), az = pillar_azimuth_deg * M_PI / 180;
+    const double lx = lean * std::cos(az), ly = lean * std::sin(az);
+    o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
+    write_pillars(o, nx, ny, 900, 1300, [&](int I, int J) {
+      const double x = dx * I, y = dy * J;  // the pillar's point at depth 1000
+      return std::array<double, 4>{x - 100 * lx, y - 100 * ly, x + 300 * lx, y + 300 * ly};
+    });
+    o << "/\nZCORN\n";
+    write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
+    const int n = nx * ny * nz;
+    o << "/\nPERMX\n";
+    for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
+    o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n" << n << "*0.2 /\n";
+    return o.str();
+  }
+};
+
+/// A case's `wells:` block with one vertical producer P1 at (x, y) from z0 to z1 (R = 5 m, 4 rings,
+/// 12 sectors, flat ends, BHP 150 bar).
+inline std::string vertical_well_yaml(double x, double y, double z0, double z1) {
+  return "wells:\n  - {name: P1, trajectory: [[" + grdecl_number(x) + ", " + grdecl_number(y) + ", " +
+         grdecl_number(z0) + "], [" + grdecl_number(x) + ", " + grdecl_number(y) + ", " + grdecl_number(z1) +
+         "]], radius: 0.1, drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+}
+
+/// A `wells:` entry (no header) with a vertical injector I1 at (x, y) from z0 to z1, the producer's
+/// block parameters, BHP 250 bar.
+inline std::string injector_yaml(double x, double y, double z0, double z1) {
+  return "  - {name: I1, type: injector, trajectory: [[" + grdecl_number(x) + ", " + grdecl_number(y) + ", " +
+         grdecl_number(z0) + "], [" + grdecl_number(x) + ", " + grdecl_number(y) + ", " + grdecl_number(z1) +
+         "]], radius: 0.1, drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 250}\n";
+}
+
+/// The deviated producer P1 of the inclined-pillar case: (90, 90, 1055) to (110, 90, 1068).
+inline std::string deviated_well_yaml() {
+  return "wells:\n  - {name: P1, trajectory: [[90, 90, 1055], [110, 90, 1068]], radius: 0.1, "
+         "drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+}
+
+}  // namespace hmtest
