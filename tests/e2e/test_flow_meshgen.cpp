@@ -198,7 +198,10 @@ TEST(FlowMeshgen, CornerPointModelWithWellsDeckMatchesSolverDemo) {
 // Reek with the well of examples/reek_steep_well.yaml (refined near the well, ~100k cells): its
 // deck runs in flow as typed and matches solver_demo. The deck's MULTFLT/MULTZ are left out: the
 // export refuses model multipliers with near-well cells (mesh.vtu does not carry them,
-// docs/export-eclipse.md). HM_LONG_TESTS=1 (flow on ~100k cells).
+// docs/export-eclipse.md). HM_LONG_TESTS=1 (flow on ~100k cells). Not passing yet, measured: the deck
+// is written and flow reads all 99,948 cells as active, but as typed it had reached day 1.27 of 65,448
+// after 10 min (steps cut to 0.003 days, ~300 linear iterations each): the target for the schedule of
+// heterogeneous models (docs/export-eclipse.md).
 TEST(FlowMeshgen, ReekWellDeckWithoutMultipliersMatchesSolverDemo) {
   REQUIRE_FLOW_E2E();
   if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: ~100k cells in flow)";
