@@ -1,8 +1,7 @@
 // Near-well refinement of a corner-point model's columns (docs/corner-point.md, "Near-well
-// refinement"). A model whose columns are many times wider than a well's drainage radius (Reek:
-// 100-160 m cells around blocks of 10-30 m) gives cavity walls whose constrained triangles have
-// diametral spheres far larger than the block, and the Gabriel repair grows the cavity through
-// the whole model. Splitting the model's i-columns and j-rows near the wells brings the cells
+// refinement"). A model whose columns are many times wider than a well's drainage radius (Reek's)
+// gives cavity walls whose constrained triangles have diametral spheres far larger than the block,
+// and the Gabriel repair grows the cavity through the whole model. Splitting the model's i-columns and j-rows near the wells brings the cells
 // there to the block's scale, like an Eclipse CARFIN extended along whole rows so that the
 // refined model is again a corner-point grid: new pillars interpolate the model's pillars,
 // children's ZCORN interpolate their parent's, so faults stay on the model's pillars and every
