@@ -170,15 +170,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
                            (out.build_report.problems.empty() ? std::string("?") : out.build_report.problems[0]));
   close_unperforated_wellbore(out.mesh, out.geometry, cs);
   if (!opts.build_transition) return out;
-  auto quality_of = [&](const TransitionCells& t) {
-    const PolyMesh sub = transition_submesh(t, coords);
-    return transition_quality(sub, compute_geometry(sub), t.h_ref);
-  };
-  for (const TransitionCells& t : transitions) {
-    out.optimized = out.optimized || t.unoptimized != nullptr;
-    add_quality(out.transition_before, quality_of(t.unoptimized ? *t.unoptimized : t));
-    if (t.unoptimized) add_quality(out.transition_after, quality_of(t));
-  }
+  summarize_transitions(out, transitions, coords);
   std::vector<std::vector<int>> cavity_wells;
   for (const Cavity& c : out.cavities.cavities) cavity_wells.push_back(c.wells);
   out.self_check = self_check(out.mesh, out.geometry, out.build_report, out.cell_cavity, cavity_wells, cs);

@@ -381,22 +381,8 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
   close_unperforated_wellbore(out.mesh, out.geometry, cs);
   if (!opts.build_transition) return out;
 
-  // Before/after figures of the transition cells, each cavity's cells on their own (the
-  // cavity's polygons are their boundary faces): only the transition cells are measured.
-  auto quality_of = [&](const TransitionCells& t) {
-    const PolyMesh sub = transition_submesh(t, coords);
-    return transition_quality(sub, compute_geometry(sub), t.h_ref);
-  };
   std::optional<Progress> quality_progress(std::in_place, "transition quality before/after");
-  for (const TransitionCells& t : transitions) {
-    out.optimized = out.optimized || t.unoptimized != nullptr;
-    add_quality(out.transition_before, quality_of(t.unoptimized ? *t.unoptimized : t));
-    if (t.unoptimized) add_quality(out.transition_after, quality_of(t));
-    const SiteOptimizeReport& o = t.report.optimization;
-    SiteOptimizeReport& a = out.optimize_report;
-    a.rounds = std::max(a.rounds, o.rounds);
-    a.proposed += o.proposed, a.kept += o.kept, a.refused += o.refused, a.invalid += o.invalid;
-  }
+  summarize_transitions(out, transitions, coords);
   quality_progress.reset();
   timer.mark("transition_quality");
   std::vector<std::vector<int>> cavity_wells;

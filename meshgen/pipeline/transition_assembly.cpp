@@ -45,3 +45,24 @@ void fill_cell_maps(HybridMesh& out, const TransitionCellMaps& maps) {
 }
 
 }  // namespace hm
+
+namespace hm {
+
+void summarize_transitions(HybridMesh& out, const std::vector<TransitionCells>& transitions,
+                           const std::vector<Vec3>& coords) {
+  auto quality_of = [&](const TransitionCells& t) {
+    const PolyMesh sub = transition_submesh(t, coords);
+    return transition_quality(sub, compute_geometry(sub), t.h_ref);
+  };
+  for (const TransitionCells& t : transitions) {
+    out.optimized = out.optimized || t.unoptimized != nullptr;
+    add_quality(out.transition_before, quality_of(t.unoptimized ? *t.unoptimized : t));
+    if (t.unoptimized) add_quality(out.transition_after, quality_of(t));
+    const SiteOptimizeReport& o = t.report.optimization;
+    SiteOptimizeReport& a = out.optimize_report;
+    a.rounds = std::max(a.rounds, o.rounds);
+    a.proposed += o.proposed, a.kept += o.kept, a.refused += o.refused, a.invalid += o.invalid;
+  }
+}
+
+}  // namespace hm

@@ -26,4 +26,10 @@ TransitionCellMaps add_transition_cells(const std::vector<TransitionCells>& tran
 /// out.reservoir_cell_of (reservoir cells, from their ijk) over out.mesh.
 void fill_cell_maps(HybridMesh& out, const TransitionCellMaps& maps);
 
+/// out.optimized, out.transition_before/after (each cavity's cells on their own, its polygons
+/// their boundary faces: only the transition cells are measured) and out.optimize_report (summed,
+/// rounds: the largest) from the cavities' transitions; `coords`: the cavities' node coordinates.
+void summarize_transitions(HybridMesh& out, const std::vector<TransitionCells>& transitions,
+                           const std::vector<Vec3>& coords);
+
 }  // namespace hm

@@ -193,13 +193,14 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   // The site optimiser rebuilds the diagram without the boundary planes' mirror sites: a cavity
   // that touches the outer boundary is left as built (docs/optimization.md).
   const bool optimize = options.optimize && images.empty();
+  std::shared_ptr<const TransitionCells> raw;
   if (optimize) {
-    auto raw = std::make_shared<const TransitionCells>(out);
+    raw = std::make_shared<const TransitionCells>(out);
     optimization = optimize_sites(set, cavity, node_coords, frames, options, out);
-    out.unoptimized = std::move(raw);
-  } else if (images.empty()) {
-    sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, out);
   }
+  // The optimiser's removals need a Q_S gain: sliver edges it left are removed here too.
+  if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, out);
+  if (raw) out.unoptimized = std::move(raw);
   // Merge the stage reports.
   TransitionReport& r = out.report;
   r.optimization = optimization;

@@ -209,8 +209,9 @@ class SiteOptimizer {
     else site.p = st.p, site.w2 = st.w2;
   }
   // The move of site d (or of its partner) that puts the power vertex it shares with
-  // reference site a at x; false if it leaves the admissible range. Changes nothing.
-  bool trial_move(int d, int a, Vec3 x, double max_shift, Move* m);
+  // reference site a at x; false if it leaves the admissible range widened by `range_slack`
+  // on either side. Changes nothing.
+  bool trial_move(int d, int a, Vec3 x, double max_shift, double range_slack, Move* m);
   // A step of site s: a polygon site toward (or away from) its polygon by the correction's
   // factor 0.95 (size 2: 0.8), a free site toward (or away from) `other` by a tenth (a fifth)
   // of their distance. Small steps first: sites left by the correction at the edge of
@@ -243,7 +244,7 @@ bool SiteOptimizer::rebuild(TransitionCells& fresh, int32_t base) {
   return tip_sites_in_bad_cells(set_, fresh).empty();
 }
 
-bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, Move* m) {
+bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, double range_slack, Move* m) {
   const Site& ds = set_.sites[d];
   const double target = power_of(set_.sites[a], x);
   int mover = d;
@@ -257,7 +258,7 @@ bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, Move* m) 
     const double slope = ds.kind == SiteKind::InternalPolygon ? -2.0 * dot(n, x - xbar) : 2.0 * dot(n, x - 2.0 * o + xbar);
     if (!(std::abs(slope) > 0)) return false;
     const double t = (target - norm2(x - o) + r2) / slope;
-    if (!(t >= min_t(frames_, q) && t <= max_t(set_, q, frames_))) return false;
+    if (!(t >= min_t(frames_, q) - range_slack && t <= max_t(set_, q, frames_) + range_slack)) return false;
     if (std::abs(t - set_.sites[mover].t) > max_shift) return false;
     m->site = mover;
     m->before = state(mover);
@@ -446,7 +447,10 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
         const std::array<int, 4> ku = key_of(out, global[u]), kv = key_of(out, global[v]);
         m.tag = {ku[0], ku[1], ku[2], ku[3], kv[0], kv[1], kv[2], kv[3], d};
         if (refused_.count(m.tag)) continue;
-        if (!trial_move(d, around.front(), x, opt_.max_shift * e.h, &m) || locked[m.site]) continue;
+        // A sliver's sites may sit at a bound of their range (an end face's height cap): the
+        // co-spherical position is then beyond it by rounding, the size of the edge itself.
+        const double range_slack = slivers_only_ ? kSliverEdge * e.h : 0.0;
+        if (!trial_move(d, around.front(), x, opt_.max_shift * e.h, range_slack, &m) || locked[m.site]) continue;
         const double shift = norm(m.after.p - m.before.p);
         m.removal = removal;
         if (shift < best_shift) best = m, best_shift = shift;

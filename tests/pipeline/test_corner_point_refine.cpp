@@ -257,30 +257,49 @@ TEST(NearWellRefinement, ObliquelyShearedCellsAreRefusedWithTheReason) {
 // Reek (../shared/data/reek): a vertical well in column (8, 52), layers 6-9, where the model's pillars
 // are nearly vertical (its south-west), drainage radius 5 m. Without refinement it is refused
 // (100-160 m x 3 m faces); refined, it meshes soundly: the self-check passes, every face conforms and
-// the volume is the refined model's minus the wellbore. (R = 10 m, its cavity on the model's bottom,
-// is round-off sensitive: docs/corner-point.md, "Reek, where its pillars are steep".)
-TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
-  const double radius = 5;
+// the volume is the refined model's minus the wellbore.
+namespace {
+
+fs::path reek_deck() {
   fs::path deck = fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek" / "REEK_GRID.DATA";
   if (!fs::exists(deck)) deck = fs::path(HM_SOURCE_DIR) / ".." / ".." / "shared" / "data" / "reek" / "REEK_GRID.DATA";
+  return deck;
+}
+
+// Reek's well SW1: a vertical well in column (8, 52) (0-based (7, 51)), from the top face centre of
+// layer 6 to the bottom face centre of layer 9, in map coordinates as a user gives a well.
+struct ReekSteepWell {
+  Vec3 top, bottom;
+  explicit ReekSteepWell(const CornerPointModel& m) {
+    const int i = 7, j = 51;
+    auto face_centre = [&](int k, bool lower) {
+      const int c = i + m.nx * (j + m.ny * k);
+      Vec3 p{0, 0, 0};
+      for (int q = 0; q < 4; ++q) p += 0.25 * m.corners[c][q + (lower ? 4 : 0)];
+      return Vec3{m.map_origin[0] + p.x * m.map_unit_x[0] + p.y * m.map_unit_y[0],
+                  m.map_origin[1] + p.x * m.map_unit_x[1] + p.y * m.map_unit_y[1], p.z};
+    };
+    top = face_centre(5, false), bottom = face_centre(8, true);
+  }
+  std::string case_text(const fs::path& deck, double radius, const std::string& reservoir_extra = "") const {
+    return "name: reek\nreservoir: {grdecl: " + deck.string() + reservoir_extra +
+           "}\nwells:\n  - {name: SW1, trajectory: [[" + hmtest::grdecl_number(top.x) + ", " +
+           hmtest::grdecl_number(top.y) + ", " + hmtest::grdecl_number(top.z) + "], [" +
+           hmtest::grdecl_number(bottom.x) + ", " + hmtest::grdecl_number(bottom.y) + ", " +
+           hmtest::grdecl_number(bottom.z) + "]], radius: 0.1, drainage_radius: " + hmtest::grdecl_number(radius) +
+           ", end_caps: flat, bhp: 150}\n";
+  }
+};
+
+}  // namespace
+
+TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
+  const double radius = 5;
+  const fs::path deck = reek_deck();
   if (!fs::exists(deck)) GTEST_SKIP() << "no " << deck;
-  const CornerPointModel m = read_corner_point_model(deck.string(), "reservoir.grdecl");
-  const int i = 7, j = 51;
-  auto face_centre = [&](int k, bool bottom) {  // in map coordinates, as a user gives a well
-    const int c = i + m.nx * (j + m.ny * k);
-    Vec3 p{0, 0, 0};
-    for (int q = 0; q < 4; ++q) p += 0.25 * m.corners[c][q + (bottom ? 4 : 0)];
-    return Vec3{m.map_origin[0] + p.x * m.map_unit_x[0] + p.y * m.map_unit_y[0],
-                m.map_origin[1] + p.x * m.map_unit_x[1] + p.y * m.map_unit_y[1], p.z};
-  };
-  const Vec3 a = face_centre(5, false), b = face_centre(8, true);
+  const ReekSteepWell well(read_corner_point_model(deck.string(), "reservoir.grdecl"));
   TempDir tmp("cprefine");
-  auto text = [&](const std::string& extra) {
-    return "name: reek\nreservoir: {grdecl: " + deck.string() + extra + "}\nwells:\n  - {name: SW1, trajectory: [[" +
-           hmtest::grdecl_number(a.x) + ", " + hmtest::grdecl_number(a.y) + ", " + hmtest::grdecl_number(a.z) + "], [" +
-           hmtest::grdecl_number(b.x) + ", " + hmtest::grdecl_number(b.y) + ", " + hmtest::grdecl_number(b.z) +
-           "]], radius: 0.1, drainage_radius: " + hmtest::grdecl_number(radius) + ", end_caps: flat, bhp: 150}\n";
-  };
+  auto text = [&](const std::string& extra) { return well.case_text(deck, radius, extra); };
   std::ofstream(tmp.path / "off.yaml") << text(", near_well_cell_size: off");
   EXPECT_THROW(build_hybrid_mesh(load_case((tmp.path / "off.yaml").string())), InputError);
   std::ofstream(tmp.path / "reek.yaml") << text("");
@@ -309,4 +328,42 @@ TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
               "transition), volume rel. %.1e\n",
               radius, cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny, out.mesh.n_cells(), transition,
               v / (v0 - hole) - 1);
+}
+
+// The same well at R = 10 m (its cavity reaches the model's bottom; the flat end cap lies 4.5 mm above
+// the bottom face's nodes) with its end depth as a user types it and one ulp deeper: both mesh, with the
+// same cells and the refined model's volume minus the wellbore. The second was refused by the
+// self-check (a transition cell beside sliver power edges of 1e-7 m whose sites stood at their end-face
+// cap; docs/transition.md, "Sliver edges").
+TEST(NearWellRefinement, ReekWellMeshesWhereverItsEndIsRounded) {
+  const double radius = 10;
+  const fs::path deck = reek_deck();
+  if (!fs::exists(deck)) GTEST_SKIP() << "no " << deck;
+  ReekSteepWell well(read_corner_point_model(deck.string(), "reservoir.grdecl"));
+  well.bottom.z = 1738.5255;
+  TempDir tmp("cprefine");
+  std::vector<int> cells;
+  for (int ulps = 0; ulps < 2; ++ulps) {
+    const std::string name = "reek" + std::to_string(ulps) + ".yaml";
+    std::ofstream(tmp.path / name) << well.case_text(deck, radius);
+    const CaseSpec cs = load_case((tmp.path / name).string());
+    ASSERT_EQ(cs.wells[0].trajectory.back().z, well.bottom.z) << "the case file does not carry the end depth exactly";
+    HybridMesh out;
+    try {
+      out = build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
+    } catch (const std::exception& e) {
+      FAIL() << "end depth " << (ulps ? "1738.5255 + 1 ulp" : "1738.5255") << ": " << e.what();
+    }
+    ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
+    double v = 0, v0 = 0;
+    for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
+    for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
+    EXPECT_NEAR(v / (v0 - exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors)), 1.0, 1e-9);
+    cells.push_back(out.mesh.n_cells());
+    std::printf("[ figures  ] Reek SW1, R = 10 m, end depth %s: %d cells, %d sliver removals\n",
+                ulps ? "1738.5255 + 1 ulp" : "1738.5255", out.mesh.n_cells(),
+                make_summary(cs, out)["transition"]["sliver_removals"].get<int>());
+    well.bottom.z = std::nextafter(well.bottom.z, 2e3);
+  }
+  EXPECT_EQ(cells[0], cells[1]);
 }
