@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/corner_point_path.hpp"
 #include "meshgen/case/corner_point_refine.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/case/meshed_trajectory.hpp"
@@ -315,6 +316,34 @@ double read_near_well_cell_size(const YAML::Node& n, const std::string& path) {
   const double v = read_number(n, path);
   require(v > 0, path, "must be > 0");
   return v;
+}
+
+// Wells in a corner-point model: the part of each path inside the model's active cells is meshed
+// (meshgen/case/corner_point_path.hpp); the case says so in its notes.
+void clip_paths_to_model(CaseSpec& cs) {
+  if (!cs.reservoir.corner_point) return;
+  for (size_t i = 0; i < cs.wells.size(); ++i) {
+    WellSpec& w = cs.wells[i];
+    const std::string key = index_path("wells", i);
+    const ClippedPath path = clip_path_to_model(*cs.reservoir.corner_point, w, key);
+    if (!path.clipped()) continue;
+    if (w.end_caps == EndCaps::Hemisphere && !w.end_caps_fallback)
+      fail(key + ".end_caps", "hemisphere caps need both ends of the path inside the corner-point model; this well "
+                              "crosses the model's surface (use flat or auto)");
+    w.end_caps = EndCaps::Flat;
+    w.end_caps_fallback = false;
+    std::string note = key + " (" + w.name + "): its path crosses the corner-point model's surface; the radial block is "
+                       "built from measured depth " + fmt6(path.md.front()) + " to " + fmt6(path.md.back()) +
+                       " m (flat ends " + fmt(kSurfaceGap) + " x drainage_radius from the surface) and the transition "
+                       "fills the rest to the surface";
+    bool open_outside = false;
+    for (const auto& iv : w.perforations) open_outside = open_outside || iv[0] < path.md.front() || iv[1] > path.md.back();
+    if (w.perforations.empty()) note += "; the path between the surface and the block has no wellbore connection";
+    if (open_outside) note += "; perforated depths outside that range have no wellbore connection";
+    cs.notes.push_back(note);
+    w.trajectory = path.points;
+    w.trajectory_md = path.md;
+  }
 }
 
 // A corner-point model with wells: its columns near the wells split to the wells' scale
@@ -613,6 +642,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   }
   for (WellSpec& w : cs.wells)
     for (Vec3& p : w.trajectory) p = map_to_grid(cs.reservoir, p);
+  clip_paths_to_model(cs);
   check_wells(cs);
   refine_near_wells(cs);
   return cs;

@@ -133,6 +133,9 @@ struct CaseSpec {
   std::vector<WellSpec> wells;     ///< may be empty (then there is no cavity)
   TransitionSpec transition;
   FluidSpec fluid;
+  /// What reading the case changed in it (a well's path clipped to a corner-point model): the
+  /// job's notes start with these.
+  std::vector<std::string> notes;
 };
 
 /// Parses and validates a YAML case file. Throws InputError (never anything else for

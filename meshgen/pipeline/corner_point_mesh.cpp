@@ -49,6 +49,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   const CornerPointModel& model = *input.reservoir.corner_point;
   CaseSpec cs = input;
   HybridMesh out;
+  out.notes = cs.notes;
   Stages stage(out, opts);
   out.grid = make_reservoir_grid(cs.reservoir);  // index arithmetic only (nx, ny, nz)
   const int nw = static_cast<int>(cs.wells.size());

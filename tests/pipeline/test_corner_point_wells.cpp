@@ -18,6 +18,7 @@
 #include <set>
 #include <sstream>
 
+#include "meshgen/case/corner_point_path.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
@@ -371,6 +372,99 @@ TEST(CornerPointSurface, WellReachingASideMeshes) {
   g.inclined_pillars = true, g.pillar_twist = 0.03;
   expect_meshes_reaching_the_surface(g, vertical_well(14, 45, 1018, 1030),
                                      [](const CornerPointModel& m, int c) { return c % m.nx == 0; });
+}
+
+// A well whose path starts above the model (as a survey from the wellhead does) or ends below it: the
+// radial block is built around its part inside the model, its flat end kSurfaceGap x R inside the
+// surface, the transition fills the rest to the surface (docs/corner-point.md, "Wells through the
+// model's surface"). What can fail: the meshed path is the user's (same line, measured depths carried),
+// its crossing end keeps the gap from the model's top under it, the mesh is sound, and it is the mesh of
+// the same well given from its meshed start.
+TEST(CornerPointSurface, WellFromAboveTheModelIsMeshedFromInsideIt) {
+  const TiltedModel g = small_columns();
+  const double x = 45, y = 45, z_head = 985, z_end = 1025, R = 5;
+  TempDir tmp("cpsurface");
+  const CaseSpec cs = case_of(tmp, g, vertical_well(x, y, z_head, z_end));
+  const WellSpec& w = cs.wells[0];
+  ASSERT_EQ(w.trajectory.size(), 2u);
+  const Vec3 start = w.trajectory.front();
+  EXPECT_EQ(start.x, x);
+  EXPECT_EQ(start.y, y);
+  EXPECT_EQ(w.trajectory.back(), (Vec3{x, y, z_end}));
+  ASSERT_EQ(w.trajectory_md.size(), 2u);
+  EXPECT_NEAR(w.trajectory_md[0], start.z - z_head, 1e-9);
+  EXPECT_NEAR(w.trajectory_md[1], z_end - z_head, 1e-9);
+  // The model's top under the well: its top-layer cell's top face (planar layers, twisted by 1e-4 x y),
+  // bilinear in the column holding (x, y).
+  const int I = static_cast<int>(x / g.dx), J = static_cast<int>(y / g.dy);
+  const double u = x / g.dx - I, v = y / g.dy - J;
+  const double top = (1 - u) * (1 - v) * g.depth(I, I, J, 0) + u * (1 - v) * g.depth(I, I + 1, J, 0) +
+                     (1 - u) * v * g.depth(I, I, J + 1, 0) + u * v * g.depth(I, I + 1, J + 1, 0);
+  std::printf("[ figures  ] well from z = %g above the top (%.3f under the well): block from z = %.3f (%.3f m = %.3f R "
+              "below the top)\n",
+              z_head, top, start.z, start.z - top, (start.z - top) / R);
+  // The disc's rim keeps the gap from the top, which dips (its slope at the well, from depth()):
+  // the axis clears it by gap + R slope, to a step of R / 16.
+  const double slope = std::hypot(std::tan(g.dip_deg * M_PI / 180) + 1e-4 * y, 0.01 + 1e-4 * x);
+  EXPECT_GE(start.z - top, kSurfaceGap * R);
+  EXPECT_LE(start.z - top, (kSurfaceGap + slope) * R * std::sqrt(1 + slope * slope) + R / 16);
+  bool noted = false;
+  for (const std::string& n : cs.notes) noted = noted || n.find("crosses the corner-point model's surface") != std::string::npos;
+  EXPECT_TRUE(noted);
+  HybridMesh out;
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  expect_sound_mesh(cs, out);
+  EXPECT_EQ(out.notes.front(), cs.notes.front());
+  // The same well given from its meshed start: the same mesh.
+  TempDir tmp2("cpsurface");
+  const CaseSpec inside = case_of(tmp2, g, vertical_well(x, y, start.z, z_end));
+  ASSERT_EQ(inside.wells[0].trajectory, w.trajectory);
+  const HybridMesh same = build_hybrid_mesh(inside);
+  EXPECT_EQ(same.mesh.nodes, out.mesh.nodes);
+  EXPECT_EQ(same.mesh.face_nodes, out.mesh.face_nodes);
+  EXPECT_EQ(same.mesh.cell_faces, out.mesh.cell_faces);
+}
+
+// A deviated well entering through the top at 40 degrees from the vertical and leaving through the
+// bottom: both ends are cut back inside, and it meshes soundly.
+TEST(CornerPointSurface, DeviatedWellThroughTopAndBottomMeshes) {
+  TiltedModel g = small_columns();
+  const double dip = std::tan(40 * M_PI / 180);
+  const Vec3 a{20, 40, 980}, b{20 + dip * 100, 40, 1080};
+  TempDir tmp("cpsurface");
+  const CaseSpec cs = case_of(tmp, g,
+                              "wells:\n  - {name: P1, trajectory: [[" + num(a.x) + ", " + num(a.y) + ", " + num(a.z) +
+                                  "], [" + num(b.x) + ", " + num(b.y) + ", " + num(b.z) +
+                                  "]], radius: 0.1, drainage_radius: 5, rings: 4, sectors: 12, segment_length: 4, bhp: 150}\n");
+  const WellSpec& w = cs.wells[0];
+  EXPECT_EQ(w.end_caps, EndCaps::Flat);  // auto caps: flat where the path is cut
+  EXPECT_GT(w.trajectory_md.front(), 20 / std::cos(40 * M_PI / 180));  // the top is >= 1000 deep, 20 m under the head
+  EXPECT_LT(w.trajectory_md.back(), norm(b - a));
+  std::printf("[ figures  ] deviated 40 deg through top and bottom: meshed from md %.3f to %.3f of %.3f m\n",
+              w.trajectory_md.front(), w.trajectory_md.back(), norm(b - a));
+  HybridMesh out;
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  expect_sound_mesh(cs, out);
+}
+
+// Paths the model cannot take, refused with the reason (exit 2): none of it inside, explicit
+// hemispherical caps on a cut path.
+TEST(CornerPointSurface, PathsOutsideTheModelAreRefusedWithTheReason) {
+  TempDir tmp("cpsurface");
+  auto refusal = [&](const std::string& wells) {
+    try {
+      case_of(tmp, small_columns(), wells);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  std::string what = refusal(vertical_well(45, 45, 900, 990));
+  EXPECT_NE(what.find("wells[0].trajectory: no part of it lies inside"), std::string::npos) << what;
+  std::string caps = vertical_well(45, 45, 985, 1025);
+  caps.replace(caps.find("end_caps: flat"), 14, "end_caps: hemisphere");
+  what = refusal(caps);
+  EXPECT_NE(what.find("wells[0].end_caps: hemisphere caps need both ends"), std::string::npos) << what;
 }
 
 // 20 x 20 m columns: a top triangle's diametral sphere (radius 14 m) holds the well block 2.4 m below

@@ -1,0 +1,179 @@
+#include "corner_point_path.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace hm {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The 6 faces of a cell as corner quads, all oriented alike (corner bit 0 +i, bit 1 +j, bit 2 +k).
+constexpr int kFaces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+
+// Solid angle of triangle (a, b, c) seen from the origin, signed by its orientation
+// (Van Oosterom and Strackee).
+double solid_angle(Vec3 a, Vec3 b, Vec3 c) {
+  const double la = norm(a), lb = norm(b), lc = norm(c);
+  const double num = dot(a, cross(b, c));
+  const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  return 2.0 * std::atan2(num, den);
+}
+
+std::string metres(double x) {
+  std::ostringstream os;
+  os << std::setprecision(4) << x << " m";
+  return os.str();
+}
+
+// A polyline parametrised by its length.
+class Polyline {
+ public:
+  explicit Polyline(const std::vector<Vec3>& p) : p_(p), arc_(p.size(), 0.0) {
+    for (size_t i = 1; i < p.size(); ++i) arc_[i] = arc_[i - 1] + norm(p[i] - p[i - 1]);
+  }
+  double length() const { return arc_.back(); }
+  const std::vector<double>& arc() const { return arc_; }
+  // The leg holding length s (the last leg for s at or beyond the end).
+  size_t leg(double s) const {
+    const size_t k = static_cast<size_t>(std::upper_bound(arc_.begin(), arc_.end(), s) - arc_.begin());
+    return std::min(k == 0 ? 0 : k - 1, p_.size() - 2);
+  }
+  Vec3 at(double s) const {
+    const size_t k = leg(s);
+    const double t = (s - arc_[k]) / (arc_[k + 1] - arc_[k]);
+    return p_[k] + t * (p_[k + 1] - p_[k]);
+  }
+  Vec3 direction(double s) const {
+    const size_t k = leg(s);
+    return normalized(p_[k + 1] - p_[k]);
+  }
+  double interpolate(const std::vector<double>& v, double s) const {
+    const size_t k = leg(s);
+    const double t = (s - arc_[k]) / (arc_[k + 1] - arc_[k]);
+    return v[k] + t * (v[k + 1] - v[k]);
+  }
+
+ private:
+  const std::vector<Vec3>& p_;
+  std::vector<double> arc_;
+};
+
+}  // namespace
+
+CornerPointInterior::CornerPointInterior(const CornerPointModel& m, Vec3 lo, Vec3 hi) {
+  for (size_t c = 0; c < m.corners.size(); ++c) {
+    if (!m.actnum[c]) continue;
+    Cell cell{m.corners[c][0], m.corners[c][0], m.corners[c]};
+    for (const Vec3& p : m.corners[c])
+      for (int k = 0; k < 3; ++k) cell.lo[k] = std::min(cell.lo[k], p[k]), cell.hi[k] = std::max(cell.hi[k], p[k]);
+    bool meets = true;
+    for (int k = 0; k < 3; ++k) meets = meets && cell.lo[k] <= hi[k] && cell.hi[k] >= lo[k];
+    if (meets && cell.hi.z > cell.lo.z) cells_.push_back(cell);
+  }
+}
+
+bool CornerPointInterior::contains(Vec3 p) const {
+  for (const Cell& c : cells_) {
+    bool in_box = true;
+    for (int k = 0; k < 3; ++k) in_box = in_box && p[k] >= c.lo[k] && p[k] <= c.hi[k];
+    if (!in_box) continue;
+    double w = 0;
+    for (const auto& f : kFaces) {
+      const Vec3 a = c.corners[f[0]] - p, b = c.corners[f[1]] - p, q = c.corners[f[2]] - p, d = c.corners[f[3]] - p;
+      w += solid_angle(a, b, q) + solid_angle(a, q, d);
+    }
+    if (std::abs(w) > 2.0 * kPi) return true;  // winding number 1 (4 pi), not 0
+  }
+  return false;
+}
+
+ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, const std::string& key) {
+  const std::string tkey = key + ".trajectory";
+  const Polyline path(ws.trajectory);
+  const std::vector<double> md = well_measured_depths(ws);
+  const double R = ws.drainage_radius, gap = kSurfaceGap * R, L = path.length();
+  Vec3 lo = ws.trajectory.front(), hi = lo;
+  for (const Vec3& p : ws.trajectory)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const double reach = R + 2.0 * gap;
+  const CornerPointInterior interior(m, lo - Vec3{reach, reach, reach}, hi + Vec3{reach, reach, reach});
+
+  // 1. Samples every R / 8 along the path: one connected run inside the model.
+  const int n = static_cast<int>(std::ceil(L / (R / 8.0))) + 1;
+  auto s_of = [&](int k) { return k == n - 1 ? L : L * k / (n - 1); };
+  std::vector<char> inside(n);
+  for (int k = 0; k < n; ++k) inside[k] = interior.contains(path.at(s_of(k)));
+  const auto first_it = std::find(inside.begin(), inside.end(), 1);
+  if (first_it == inside.end())
+    throw InputError(tkey + ": no part of it lies inside the corner-point model's active cells");
+  const int first = static_cast<int>(first_it - inside.begin());
+  const int last = n - 1 - static_cast<int>(std::find(inside.rbegin(), inside.rend(), 1) - inside.rbegin());
+  for (int k = first; k <= last; ++k)
+    if (!inside[k])
+      throw InputError(tkey + ": leaves the corner-point model's active cells and comes back (at measured depth " +
+                       metres(path.interpolate(md, s_of(k))) + "); only one connected part inside can be meshed");
+  ClippedPath out;
+  if (first == 0 && last == n - 1) {
+    out.points = ws.trajectory;
+    out.md = md;
+    return out;
+  }
+
+  // 2. The crossings (bisection between the samples on either side), then each crossing end moved
+  //    inward until the block's end cross-section and the gap beyond it are inside.
+  auto crossing = [&](double s_out, double s_in) {
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (s_out + s_in);
+      (interior.contains(path.at(mid)) ? s_in : s_out) = mid;
+    }
+    return s_in;
+  };
+  // The end cross-section (its centre and 16 points of its rim) with the gap around it in 26
+  // directions (the cube's faces, edges and corners) inside the model.
+  std::vector<Vec3> around;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k)
+        if (i || j || k) around.push_back(gap * normalized(Vec3{double(i), double(j), double(k)}));
+  auto end_clear = [&](double s) {
+    const Vec3 p = path.at(s), d = path.direction(s);
+    const Vec3 helper = std::abs(d.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 u = normalized(cross(d, helper)), v = cross(d, u);
+    for (int k = -1; k < 16; ++k) {
+      const Vec3 q = k < 0 ? p : p + R * (std::cos(2 * kPi * k / 16) * u + std::sin(2 * kPi * k / 16) * v);
+      for (const Vec3& g : around)
+        if (!interior.contains(q + g)) return false;
+    }
+    return true;
+  };
+  double a = first > 0 ? crossing(s_of(first - 1), s_of(first)) : 0.0;
+  double b = last < n - 1 ? crossing(s_of(last + 1), s_of(last)) : L;
+  const double step = R / 16.0;
+  const double a0 = a, b0 = b;
+  if (first > 0)
+    while (a < b && !end_clear(a)) a += step;
+  if (last < n - 1)
+    while (b > a && !end_clear(b)) b -= step;
+  if (!(b - a > std::min(ws.segment_length, R)))
+    throw InputError(tkey + ": only " + metres(std::max(0.0, b - a)) + " of its " + metres(b0 - a0) +
+                     " inside the corner-point model's active cells keep " + metres(gap) + " (" +
+                     std::to_string(kSurfaceGap).substr(0, 3) +
+                     " x drainage_radius) from the model's surface with the whole end cross-section of the radial "
+                     "block; a well must run farther into the model, or take a smaller drainage_radius "
+                     "(docs/corner-point.md)");
+
+  out.points.push_back(path.at(a));
+  out.md.push_back(path.interpolate(md, a));
+  for (size_t i = 0; i < ws.trajectory.size(); ++i)
+    if (path.arc()[i] > a && path.arc()[i] < b) out.points.push_back(ws.trajectory[i]), out.md.push_back(md[i]);
+  out.points.push_back(path.at(b));
+  out.md.push_back(path.interpolate(md, b));
+  out.cut = {a, L - b};
+  return out;
+}
+
+}  // namespace hm
