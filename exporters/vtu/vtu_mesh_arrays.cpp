@@ -1,8 +1,11 @@
 #include "vtu_mesh_arrays.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
+
+#include "meshgen/core/parallel.hpp"
 
 namespace hm {
 
@@ -113,17 +116,31 @@ RestoredArrays restore_mesh_cell_arrays(const std::vector<VtuCellArray>& arrays,
       r.error = a.name + ": " + std::to_string(a.values.size()) + " values for " + std::to_string(nc) + " cells";
       return r;
     }
-    for (size_t c = 0; c < nc; ++c)
-      for (int d = 0; d < f.components; ++d) {
-        const double v = a.values[c * a.components + (isotropic ? 0 : d)];
-        const bool ok = std::isfinite(v) && (!f.integer || (v == std::floor(v) && std::fabs(v) < 2147483647.0));
-        if (!ok) {
-          r.error = a.name + ": cell " + std::to_string(c) + ": " +
-                    (f.integer ? "not a 32-bit integer" : "not a finite number");
-          return r;
+    // Cells in parallel (each writes its own cell), except metric_scale: every cell writes the
+    // mesh's one value, the last cell's wins. The error names the first bad cell in cell order.
+    const bool per_mesh = std::string(f.name) == "metric_scale";
+    std::atomic<int64_t> first_bad{static_cast<int64_t>(nc)};
+    auto restore = [&](int64_t b, int64_t e) {
+      for (int64_t c = b; c < e; ++c)
+        for (int d = 0; d < f.components; ++d) {
+          const double v = a.values[static_cast<size_t>(c) * a.components + (isotropic ? 0 : d)];
+          const bool ok = std::isfinite(v) && (!f.integer || (v == std::floor(v) && std::fabs(v) < 2147483647.0));
+          if (!ok) {
+            int64_t seen = first_bad.load();
+            while (c < seen && !first_bad.compare_exchange_weak(seen, c)) {
+            }
+            return;
+          }
+          f.set(m, static_cast<size_t>(c), d, v);
         }
-        f.set(m, c, d, v);
-      }
+    };
+    if (per_mesh) restore(0, static_cast<int64_t>(nc));
+    else parallel_ranges(static_cast<int64_t>(nc), restore);
+    if (first_bad.load() < static_cast<int64_t>(nc)) {
+      r.error = a.name + ": cell " + std::to_string(first_bad.load()) + ": " +
+                (f.integer ? "not a 32-bit integer" : "not a finite number");
+      return r;
+    }
   }
   return r;
 }

@@ -301,19 +301,33 @@ Array read_array(const Source& src, vtkXMLDataElement* e, int64_t values) {
     fail(what + std::to_string(values) + " values cannot be in a file of this size");
   if (values == 0) return a;
   const size_t word = src.parser->GetWordTypeSize(type);
-  std::vector<unsigned char> buf(static_cast<size_t>(values) * word);
   const std::string format = attr(e, "format");
+  const bool compressed = src.compressed && (format == "appended" || format == "binary");
+  // Float64 and signed 64-bit words are the values' own type: VTK decodes them straight into the
+  // array (no byte buffer, no conversion copy). Other types go through a buffer and convert_words.
+  const bool direct = !compressed && ((!a.is_int && type == VTK_DOUBLE) ||
+                                      (a.is_int && word == sizeof(int64_t) &&
+                                       (type == VTK_LONG_LONG || type == VTK_ID_TYPE || type == VTK_LONG)));
+  std::vector<unsigned char> buf;
+  void* dst = nullptr;
+  if (direct) {
+    if (a.is_int) a.i.resize(static_cast<size_t>(values)), dst = a.i.data();
+    else a.d.resize(static_cast<size_t>(values)), dst = a.d.data();
+  } else if (!compressed) {
+    buf.resize(static_cast<size_t>(values) * word);
+    dst = buf.data();
+  }
   size_t got = 0;
-  if (src.compressed && (format == "appended" || format == "binary")) {
+  if (compressed) {
     const int64_t offset =
         format == "appended" ? count_attr(e, "offset", std::numeric_limits<int64_t>::max() / 2) : 0;
-    buf = read_compressed(src, e, format, offset, buf.size(), word);
+    buf = read_compressed(src, e, format, offset, static_cast<size_t>(values) * word, word);
     got = static_cast<size_t>(values);
   } else if (format == "appended") {
     const int64_t offset = count_attr(e, "offset", std::numeric_limits<int64_t>::max() / 2);
-    got = src.parser->ReadAppendedData(offset, buf.data(), 0, static_cast<size_t>(values), type);
+    got = src.parser->ReadAppendedData(offset, dst, 0, static_cast<size_t>(values), type);
   } else if (format == "ascii" || format == "binary") {
-    got = src.parser->ReadInlineData(e, format == "ascii", buf.data(), 0, static_cast<size_t>(values), type);
+    got = src.parser->ReadInlineData(e, format == "ascii", dst, 0, static_cast<size_t>(values), type);
   } else {
     fail(what + "unknown format '" + format + "'");
   }
@@ -321,9 +335,11 @@ Array read_array(const Source& src, vtkXMLDataElement* e, int64_t values) {
   if (!src.stream->good()) fail(what + "the file ends inside the data (truncated?)");
   if (got != static_cast<size_t>(values))
     fail(what + "expected " + std::to_string(values) + " values, the file holds " + std::to_string(got));
-  switch (type) {
-    vtkTemplateMacro(convert_words(reinterpret_cast<const VTK_TT*>(buf.data()), static_cast<size_t>(values), a));
-    default: fail(what + "unsupported type");
+  if (!direct) {
+    switch (type) {
+      vtkTemplateMacro(convert_words(reinterpret_cast<const VTK_TT*>(buf.data()), static_cast<size_t>(values), a));
+      default: fail(what + "unsupported type");
+    }
   }
   if (!a.is_int)
     for (double v : a.d)
@@ -372,6 +388,12 @@ struct RawCells {
 struct Parsed {
   std::vector<Vec3> points;
   RawCells cells;
+  struct CellDataPiece {
+    vtkXMLDataElement* piece;
+    int64_t cells;       // the piece's cells
+    int64_t point_base;  // points of the pieces before it
+  };
+  std::vector<CellDataPiece> cell_data_pieces;  // read by read_cell_data
   std::vector<Array> cell_data;
   std::vector<int32_t> face_patch;
   bool has_face_patch = false;
@@ -473,34 +495,43 @@ void read_piece(const Source& src, vtkXMLDataElement* piece, Parsed& out) {
       rc.end_cell();
     }
   }
-  // Cell data of this piece, appended to the previous pieces' arrays of the same name.
-  std::vector<Array> mine;
-  if (vtkXMLDataElement* cd = child(piece, "CellData"))
-    for (int k = 0; k < cd->GetNumberOfNestedElements(); ++k) {
-      vtkXMLDataElement* e = cd->GetNestedElement(k);
-      if (!e || !e->GetName() || std::strcmp(e->GetName(), "DataArray") != 0) continue;
-      int comps = 1;
-      if (e->GetAttribute("NumberOfComponents")) comps = static_cast<int>(count_attr(e, "NumberOfComponents", 1 << 16));
-      mine.push_back(read_array(src, e, nc * comps));
-    }
-  if (base == 0 && out.cell_data.empty()) {
-    out.cell_data = std::move(mine);
-    return;
-  }
-  std::vector<Array> merged;
-  for (Array& a : out.cell_data) {
-    auto it = std::find_if(mine.begin(), mine.end(), [&](const Array& b) {
-      return b.name == a.name && b.components == a.components && b.is_int == a.is_int;
-    });
-    if (it == mine.end()) {
-      out.warnings.push_back("cell array '" + a.name + "' missing in some piece: ignored");
+  // Cell data: read after the mesh is assembled (read_cell_data), when the file's cells are gone.
+  out.cell_data_pieces.push_back({piece, nc, base});
+}
+
+// The cell data of every piece, appended to the previous pieces' arrays of the same name.
+void read_cell_data(const Source& src, Parsed& out) {
+  for (const Parsed::CellDataPiece& p : out.cell_data_pieces) {
+    const int64_t nc = p.cells;
+    std::vector<Array> mine;
+    if (vtkXMLDataElement* cd = child(p.piece, "CellData"))
+      for (int k = 0; k < cd->GetNumberOfNestedElements(); ++k) {
+        vtkXMLDataElement* e = cd->GetNestedElement(k);
+        if (!e || !e->GetName() || std::strcmp(e->GetName(), "DataArray") != 0) continue;
+        int comps = 1;
+        if (e->GetAttribute("NumberOfComponents")) comps = static_cast<int>(count_attr(e, "NumberOfComponents", 1 << 16));
+        mine.push_back(read_array(src, e, nc * comps));
+      }
+    if (p.point_base == 0 && out.cell_data.empty()) {
+      out.cell_data = std::move(mine);
       continue;
     }
-    a.i.insert(a.i.end(), it->i.begin(), it->i.end());
-    a.d.insert(a.d.end(), it->d.begin(), it->d.end());
-    merged.push_back(std::move(a));
+    std::vector<Array> merged;
+    for (Array& a : out.cell_data) {
+      auto it = std::find_if(mine.begin(), mine.end(), [&](const Array& b) {
+        return b.name == a.name && b.components == a.components && b.is_int == a.is_int;
+      });
+      if (it == mine.end()) {
+        out.warnings.push_back("cell array '" + a.name + "' missing in some piece: ignored");
+        continue;
+      }
+      a.i.insert(a.i.end(), it->i.begin(), it->i.end());
+      a.d.insert(a.d.end(), it->d.begin(), it->d.end());
+      merged.push_back(std::move(a));
+    }
+    out.cell_data = std::move(merged);
   }
-  out.cell_data = std::move(merged);
+  out.cell_data_pieces.clear();
 }
 
 Parsed parse_document(Source& src) {
@@ -799,10 +830,9 @@ void build_with_mesh_builder(Parsed& in, ReadResult& res) {
   res.mesh = mb.finish(&res.build);
 }
 
-ReadResult convert(Parsed&& in, VtuAssembly assembly) {
+ReadResult convert(const Source& src, Parsed&& in, VtuAssembly assembly) {
   ReadResult res;
   res.has_face_patch = in.has_face_patch;
-  res.warnings = std::move(in.warnings);
   if (assembly == VtuAssembly::Parallel && res.has_face_patch &&
       build_regular_mesh(in.cells, in.points, in.face_patch, &res.mesh, &res.build)) {
     res.assembled_in_parallel = true;
@@ -812,12 +842,16 @@ ReadResult convert(Parsed&& in, VtuAssembly assembly) {
   } else {
     build_with_mesh_builder(in, res);
   }
+  read_cell_data(src, in);  // now: the file's cells no longer take memory
+  res.warnings = std::move(in.warnings);
   PolyMesh& m = res.mesh;
   for (Array& a : in.cell_data) {  // as doubles; a Float64 array is moved, not copied
     std::vector<double> v;
     if (a.is_int) {
       v.resize(a.size());
-      for (size_t q = 0; q < a.size(); ++q) v[q] = a.as_double(q);
+      parallel_ranges(static_cast<int64_t>(a.size()), [&](int64_t b, int64_t e) {
+        for (int64_t q = b; q < e; ++q) v[q] = static_cast<double>(a.i[q]);
+      });
     } else {
       v = std::move(a.d);
     }
@@ -862,7 +896,8 @@ ReadResult read_stream(std::istream& in, uint64_t file_bytes, VtuAssembly assemb
     src.file_bytes = file_bytes;
     Parsed doc = parse_document(src);
     if (!catcher->errors.empty()) fail(catcher->errors.front());
-    r = convert(std::move(doc), assembly);
+    r = convert(src, std::move(doc), assembly);
+    if (!catcher->errors.empty()) fail(catcher->errors.front());
   } catch (const VtuError& e) {
     r = ReadResult{};
     r.error = e.what;

@@ -345,10 +345,9 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
   // A boundary face's half ends on its boundary flux point (docs/fvcheck.md, "Boundary faces"):
   // the foot of the perpendicular from the FV centre when it lies in the face, where the
   // solver takes the Dirichlet value; an interior face's half on its centroid.
-  const std::vector<Vec3> face_end = boundary_flux_points(m, g);
   auto half = [&](int c, int32_t f) {
     const Vec3 area_out = m.face_sign(f, c) * g.face_area[f];
-    const Vec3 to_face = face_end[f] - m.cell_fv_center[c];
+    const Vec3 to_face = boundary_flux_point(m, g, f) - m.cell_fv_center[c];
     const RadialSides& rs = radial[c];
     const RadialCellInfo& rc = m.cell_radial[c];
     if (opt.exact_radial && rc.well >= 0 && rc.band >= 0) {

@@ -132,28 +132,31 @@ Vec3 edge_vector(const PolyMesh& m, uint64_t e) {
 }
 }  // namespace
 
-std::vector<Vec3> boundary_flux_points(const PolyMesh& m, const MeshGeometry& geo) {
-  std::vector<Vec3> out(geo.face_centroid);
+Vec3 boundary_flux_point(const PolyMesh& m, const MeshGeometry& geo, int f) {
+  if (m.face_neighbour[f] >= 0) return geo.face_centroid[f];
   const Vec3 s = m.metric_scale;
   auto to_frame = [&](Vec3 p) { return Vec3{p.x / s.x, p.y / s.y, p.z / s.z}; };
+  const Vec3 x = to_frame(m.cell_fv_center[m.face_owner[f]]);
+  const int k = m.face_size(f);
+  const int32_t* v = m.face_begin(f);
+  Vec3 g;
+  for (int i = 0; i < k; ++i) g += m.nodes[v[i]];
+  g = to_frame(g / k);
+  double best = std::numeric_limits<double>::infinity();
+  Vec3 best_p = geo.face_centroid[f];
+  for (int i = 0; i < k; ++i) {
+    const Vec3 p = closest_point_on_triangle(x, g, to_frame(m.nodes[v[i]]), to_frame(m.nodes[v[(i + 1) % k]]));
+    const double d2 = norm2(p - x);
+    if (d2 < best) best = d2, best_p = Vec3{p.x * s.x, p.y * s.y, p.z * s.z};
+  }
+  return std::isfinite(best) ? best_p : geo.face_centroid[f];
+}
+
+std::vector<Vec3> boundary_flux_points(const PolyMesh& m, const MeshGeometry& geo) {
+  std::vector<Vec3> out(geo.face_centroid);
   parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
-    for (int f = static_cast<int>(fb); f < fe; ++f) {
-      if (m.face_neighbour[f] >= 0) continue;
-      const Vec3 x = to_frame(m.cell_fv_center[m.face_owner[f]]);
-      const int k = m.face_size(f);
-      const int32_t* v = m.face_begin(f);
-      Vec3 g;
-      for (int i = 0; i < k; ++i) g += m.nodes[v[i]];
-      g = to_frame(g / k);
-      double best = std::numeric_limits<double>::infinity();
-      Vec3 best_p = geo.face_centroid[f];
-      for (int i = 0; i < k; ++i) {
-        const Vec3 p = closest_point_on_triangle(x, g, to_frame(m.nodes[v[i]]), to_frame(m.nodes[v[(i + 1) % k]]));
-        const double d2 = norm2(p - x);
-        if (d2 < best) best = d2, best_p = Vec3{p.x * s.x, p.y * s.y, p.z * s.z};
-      }
-      if (std::isfinite(best)) out[f] = best_p;
-    }
+    for (int f = static_cast<int>(fb); f < fe; ++f)
+      if (m.face_neighbour[f] < 0) out[f] = boundary_flux_point(m, geo, f);
   });
   return out;
 }
@@ -170,11 +173,11 @@ double face_orthogonality_of(const PolyMesh& m, const MeshGeometry& geo, int f, 
 
 std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& geo, BoundaryPoint boundary) {
   std::vector<double> q(m.n_faces(), 0.0);
-  std::vector<Vec3> flux;  // no copy of the centroids when they are the end points
-  if (boundary == BoundaryPoint::Flux) flux = boundary_flux_points(m, geo);
-  const std::vector<Vec3>& end = boundary == BoundaryPoint::Flux ? flux : geo.face_centroid;
+  // The end points face by face: no array of them (an interior face's is its centroid).
+  const bool flux = boundary == BoundaryPoint::Flux;
   parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
-    for (int f = static_cast<int>(fb); f < fe; ++f) q[f] = face_orthogonality_of(m, geo, f, end[f]);
+    for (int f = static_cast<int>(fb); f < fe; ++f)
+      q[f] = face_orthogonality_of(m, geo, f, flux ? boundary_flux_point(m, geo, f) : geo.face_centroid[f]);
   });
   return q;
 }
@@ -189,13 +192,12 @@ std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometr
     const Vec3 ns{r.x * area.x, r.y * area.y, r.z * area.z}, ds{d.x / r.x, d.y / r.y, d.z / r.z};
     return std::atan2(norm(cross(ds, ns)), std::fabs(dot(ds, ns))) * kDeg;
   };
-  const std::vector<Vec3> end = boundary_flux_points(m, geo);
   parallel_ranges(m.n_faces(), [&](int64_t fb, int64_t fe) {
     for (int f = static_cast<int>(fb); f < fe; ++f) {
       const Vec3 a = geo.face_area[f];
       const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
       const Vec3 p1 = m.cell_fv_center[o];
-      const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : end[f]) - p1;
+      const Vec3 d = (n >= 0 ? m.cell_fv_center[n] : boundary_flux_point(m, geo, f)) - p1;
       if (!(norm(a) > 0) || !(norm(d) > 0)) {
         q[f] = 90.0;  // degenerate
         continue;

@@ -20,6 +20,8 @@ namespace hm {
 /// face's edge. Interior faces: their centroid. The solver's Dirichlet value, the boundary
 /// half-transmissibility and Q_O of boundary faces all use this point.
 std::vector<Vec3> boundary_flux_points(const PolyMesh& mesh, const MeshGeometry& geo);
+/// The same point for one face f (its centroid for an interior face), without an array of them all.
+Vec3 boundary_flux_point(const PolyMesh& mesh, const MeshGeometry& geo, int f);
 
 /// Which point the boundary faces' two-point segment ends on in face_orthogonality.
 enum class BoundaryPoint {
