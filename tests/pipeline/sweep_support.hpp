@@ -6,7 +6,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <thread>
 
@@ -88,15 +90,16 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
   return res;
 }
 
-/// mesh_and_check in a forked child: a signal is a Crash, more than `timeout_s` a Hang.
-inline CaseResult mesh_and_check_isolated(const RealisticCase& rc, double timeout_s) {
+/// `job` in a forked child: a signal is a Crash, more than `timeout_s` a Hang.
+inline CaseResult run_isolated(const std::function<CaseResult()>& job, double timeout_s) {
   int fds[2];
   if (pipe(fds) != 0) return {Outcome::Failed, "pipe() failed", 0, {}};
   const auto t0 = std::chrono::steady_clock::now();
+  std::fflush(nullptr);  // else the child's copy of unwritten output is written again when it flushes
   const pid_t pid = fork();
   if (pid == 0) {
     close(fds[0]);
-    const CaseResult r = mesh_and_check(rc);
+    const CaseResult r = job();
     const std::string msg = std::to_string(static_cast<int>(r.outcome)) + "\n" + r.reason;
     ssize_t left = static_cast<ssize_t>(msg.size());
     const char* p = msg.data();
@@ -138,6 +141,11 @@ inline CaseResult mesh_and_check_isolated(const RealisticCase& rc, double timeou
   res.outcome = static_cast<Outcome>(std::stoi(msg.substr(0, nl)));
   res.reason = msg.substr(nl + 1);
   return res;
+}
+
+/// mesh_and_check in a forked child (run_isolated).
+inline CaseResult mesh_and_check_isolated(const RealisticCase& rc, double timeout_s) {
+  return run_isolated([&] { return mesh_and_check(rc); }, timeout_s);
 }
 
 }  // namespace hm::testing
