@@ -50,14 +50,30 @@ inline double box_minus_holes(const CaseSpec& cs, const HybridMesh& h) {
   return v;
 }
 
+/// Runs `job` (which sets the outcome and reason of a case that meshed), timed; an InputError is a
+/// Refused outcome, any other exception a Failed one, each with its message.
+inline CaseResult run_classified(const std::function<void(CaseResult&)>& job) {
+  CaseResult res;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    job(res);
+  } catch (const InputError& e) {
+    res.outcome = Outcome::Refused;
+    res.reason = e.what();
+  } catch (const std::exception& e) {
+    res.outcome = Outcome::Failed;
+    res.reason = e.what();
+  }
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
 /// Meshes the case and checks: the builder matched every face, fvcheck passes (convexity,
 /// conformity, closure, volumes, orthogonality, auto-centering, planarity) and the total volume is
 /// the box minus the exact holes (relative 1e-9), every block closed as requested (a fallback to
 /// flat ends counts as a failed check). Refusals (InputError) and failures are outcomes.
 inline CaseResult mesh_and_check(const RealisticCase& rc) {
-  CaseResult res;
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
+  return run_classified([&](CaseResult& res) {
     // As meshgen does: mesh in the local frame (a field-coordinate case is moved to its origin).
     const HybridMesh h = build_hybrid_mesh(translated_case(rc.spec, -1.0 * case_origin(rc.spec)));
     std::string bad;
@@ -79,15 +95,7 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
       for (const auto& [k, v] : c.counts)
         if (res.outcome == Outcome::Meshed && k == "boundary_faces_below_threshold_at_centroid" && v > 0)
           res.reason = "passes; the centroid rule would fail " + std::to_string(v) + " boundary faces";
-  } catch (const InputError& e) {
-    res.outcome = Outcome::Refused;
-    res.reason = e.what();
-  } catch (const std::exception& e) {
-    res.outcome = Outcome::Failed;
-    res.reason = e.what();
-  }
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return res;
+  });
 }
 
 /// `job` in a forked child: a signal is a Crash, more than `timeout_s` a Hang.

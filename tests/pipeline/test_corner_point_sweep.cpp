@@ -79,9 +79,7 @@ double volume_of(const HybridMesh& h) {
 
 // Meshes the case (in the local frame, as meshgen does) and checks what the module promises.
 CaseResult mesh_corner_point_case(const CornerPointSweepCase& c) {
-  CaseResult res;
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
+  return run_classified([&](CaseResult& res) {
     hmtest::TempDir tmp("cpsweep");
     std::ofstream(tmp.path / "M.GRDECL") << c.model.text();
     std::ofstream(tmp.path / "c.yaml") << "name: s\nreservoir: {grdecl: M.GRDECL}\n" << c.wells;
@@ -98,15 +96,7 @@ CaseResult mesh_corner_point_case(const CornerPointSweepCase& c) {
     int transition = 0;
     for (int k = 0; k < h.mesh.n_cells(); ++k) transition += h.mesh.cell_region[k] == kTransition;
     res.reason = bad.empty() ? std::to_string(h.mesh.n_cells()) + " cells (" + std::to_string(transition) + " transition)" : bad;
-  } catch (const InputError& e) {
-    res.outcome = Outcome::Refused;
-    res.reason = e.what();
-  } catch (const std::exception& e) {
-    res.outcome = Outcome::Failed;
-    res.reason = e.what();
-  }
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return res;
+  });
 }
 
 bool long_tests() {
