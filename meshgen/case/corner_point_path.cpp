@@ -74,9 +74,16 @@ CornerPointInterior::CornerPointInterior(const CornerPointModel& m, Vec3 lo, Vec
     for (int k = 0; k < 3; ++k) meets = meets && cell.lo[k] <= hi[k] && cell.hi[k] >= lo[k];
     if (meets && cell.hi.z > cell.lo.z) cells_.push_back(cell);
   }
+  const double scale = std::max({1.0, std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x), std::abs(hi.y),
+                                 std::abs(hi.z)});
+  nudge_ = kFaceNudge * scale * normalized(Vec3{0.5772156649, 0.3183098862, -1.0});
 }
 
-bool CornerPointInterior::contains(Vec3 p) const {
+bool CornerPointInterior::contains(Vec3 q) const {
+  // A point on a face (a path's end given on a layer boundary) is moved off it, up and sideways by
+  // kFaceNudge of the model's scale in a direction no face has (symbolic perturbation): on a face
+  // between two cells it is then inside one of them, on the model's top outside it.
+  const Vec3 p = q + nudge_;
   for (const Cell& c : cells_) {
     bool in_box = true;
     for (int k = 0; k < 3; ++k) in_box = in_box && p[k] >= c.lo[k] && p[k] <= c.hi[k];

@@ -19,9 +19,13 @@ namespace hm {
 /// of a near-well cell about R wide (the refinement's target) has a circumradius of ~0.7 R.
 constexpr double kSurfaceGap = 1.0;
 
+/// Relative size (of the coordinates) of the shift that moves a point off the faces it lies on before
+/// the inside test: far above rounding, far below any cell.
+constexpr double kFaceNudge = 1e-12;
+
 /// Whether points lie inside the active, non-degenerate cells of a model whose corner box meets the
 /// box [lo, hi] (each cell the closed surface of its 6 faces cut into 2 triangles along a diagonal:
-/// winding number).
+/// winding number). A point on a face counts as the point kFaceNudge above it (and aside).
 class CornerPointInterior {
  public:
   CornerPointInterior(const CornerPointModel& m, Vec3 lo, Vec3 hi);
@@ -33,6 +37,7 @@ class CornerPointInterior {
     std::array<Vec3, 8> corners;
   };
   std::vector<Cell> cells_;
+  Vec3 nudge_;
 };
 
 /// A path clipped to a model: its points and measured depths, and per end (0 start, 1 end) how far

@@ -13,6 +13,7 @@
 
 #include "meshgen/case/case.hpp"
 #include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/corner_point_path.hpp"
 #include "meshgen/case/segment_distance.hpp"
 
 using namespace hm;
@@ -824,4 +825,30 @@ TEST(SegmentDistance, PolylineCutoffIsExactBelowAndBoundAbove) {
   EXPECT_DOUBLE_EQ(polyline_distance(a, b), 3.0);
   EXPECT_DOUBLE_EQ(polyline_distance(a, b, 3.5), 3.0);
   EXPECT_GE(polyline_distance(a, b, 2.0), 2.0);
+}
+
+// The inside test of the corner-point path cut (corner_point_path.hpp) on two stacked unit cubes: a
+// point on the face between them is inside, one on the model's top is outside, one on its bottom is
+// inside (a point on a face counts as the point just above it), and points off the faces as they are.
+TEST(CornerPointPath, PointsOnFacesAreDecidedAsJustAboveThem) {
+  CornerPointModel m;
+  m.nx = 1, m.ny = 1, m.nz = 2;
+  for (int k = 0; k < 2; ++k) {
+    std::array<Vec3, 8> c;
+    for (int q = 0; q < 8; ++q) c[q] = Vec3{double(q & 1), double((q >> 1) & 1), double(k + ((q >> 2) & 1))};
+    m.corners.push_back(c);
+    m.actnum.push_back(1);
+  }
+  const CornerPointInterior inside(m, Vec3{-1, -1, -1}, Vec3{2, 2, 3});
+  EXPECT_TRUE(inside.contains({0.5, 0.5, 1}));    // the face between the cells
+  EXPECT_FALSE(inside.contains({0.5, 0.5, 0}));   // the top (depth 0)
+  EXPECT_TRUE(inside.contains({0.5, 0.5, 2}));    // the bottom
+  EXPECT_TRUE(inside.contains({0.5, 0.5, 0.5}));
+  EXPECT_TRUE(inside.contains({0.25, 0.75, 1.5}));
+  EXPECT_FALSE(inside.contains({0.5, 0.5, -0.5}));
+  EXPECT_FALSE(inside.contains({1.5, 0.5, 1.5}));
+  m.actnum[1] = 0;  // the lower cell inactive: its top face is the model's bottom now
+  const CornerPointInterior upper(m, Vec3{-1, -1, -1}, Vec3{2, 2, 3});
+  EXPECT_TRUE(upper.contains({0.5, 0.5, 1}));
+  EXPECT_FALSE(upper.contains({0.5, 0.5, 1.5}));
 }
