@@ -250,15 +250,13 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   // (docs/export-eclipse.md, "A corner-point model": flow's corner-point transmissibilities are not
   // the ones solver_demo solves with).
   const bool model_only = L.corner_point && L.extra_columns == 0;
-  if (L.corner_point && !model_only) {
-    static const char* kMult[6] = {"MULTX", "MULTX-", "MULTY", "MULTY-", "MULTZ", "MULTZ-"};
-    for (int d = 0; d < 6; ++d)
-      for (double v : cs.reservoir.corner_point->trans_mult[d])
-        if (v != 1.0)
-          return fail(std::string("the corner-point model has transmissibility multipliers (") + kMult[d] +
-                      ", FAULTS/MULTFLT or MULTZ) that the mesh's transmissibilities do not carry yet: a deck of it "
-                      "with near-well cells would not be the model");
-  }
+  // With near-well cells the model's multipliers are in `trans` (PolyMesh::face_trans_mult): a mesh
+  // without them would not be the model.
+  if (L.corner_point && !model_only && has_transmissibility_multipliers(*cs.reservoir.corner_point) &&
+      mesh.face_trans_mult.empty())
+    return fail("the corner-point model has transmissibility multipliers (MULTX..MULTZ-, FAULTS/MULTFLT) that the "
+                "mesh does not carry (PolyMesh::face_trans_mult): a deck of it with near-well cells would not be "
+                "the model");
   if (conn.negative_nnc > 0 && !model_only) {
     const auto a = L.deck_ijk(conn.first_negative_nnc.a), b = L.deck_ijk(conn.first_negative_nnc.b);
     std::ostringstream w;
@@ -310,6 +308,11 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
         << "-- widened by the separator and extra columns (vertical pillars beyond the model's +x side).\n"
         << "-- Every connection is HybridMesh's (TRANX/Y/Z in EDIT, NNC): none of flow's geometric ones.\n";
       write_model_geometry(o, *cs.reservoir.corner_point, &L);
+      // TRANX/Y/Z replace flow's values between logical neighbours only; its geometric connections
+      // across faults would stay beside our NNC records (docs/export-eclipse.md, "Faults").
+      o << "-- flow's own geometric connections x 0 (those across faults among them): TRANX/Y/Z and NNC are the deck's.\n";
+      const std::vector<double> zero(nd, 0.0);
+      for (const char* k : {"MULTX", "MULTY", "MULTZ"}) o.eclipse_array(k, zero);
     } else {
       write_coord(o, L.pillar_x, L.pillar_y, L.pillar_top, L.pillar_bottom);
       write_zcorn(o, L.deck_nx, L.ny, L.nz, L.top, L.bottom);

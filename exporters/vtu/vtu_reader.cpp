@@ -397,6 +397,7 @@ struct Parsed {
   std::vector<Array> cell_data;
   std::vector<int32_t> face_patch;
   bool has_face_patch = false;
+  std::vector<double> face_mult;  ///< field data face_trans_mult, in face_patch's order (empty: none)
   std::vector<std::string> warnings;
 };
 
@@ -579,6 +580,18 @@ Parsed parse_document(Source& src) {
       out.has_face_patch = true;
     } else {
       out.warnings.push_back("field data face_patch does not match the faces: ignored");
+    }
+  }
+  if (vtkXMLDataElement* fm = data_array(child(grid, "FieldData"), "face_trans_mult")) {
+    const int64_t n = count_attr(fm, "NumberOfTuples", kMaxIds);
+    if (n != total_faces || pieces != 1) fail("field data face_trans_mult does not match the faces");
+    const Array a = read_array(src, fm, n);
+    if (a.components != 1) fail("face_trans_mult must be a 1-component array");
+    out.face_mult.resize(static_cast<size_t>(n));
+    for (int64_t q = 0; q < n; ++q) {
+      const double v = a.is_int ? static_cast<double>(a.i[q]) : a.d[q];
+      if (!(std::isfinite(v) && v >= 0)) fail("face_trans_mult: " + std::to_string(v) + " is not a finite value >= 0");
+      out.face_mult[q] = v;
     }
   }
   return out;
@@ -830,6 +843,18 @@ void build_with_mesh_builder(Parsed& in, ReadResult& res) {
   res.mesh = mb.finish(&res.build);
 }
 
+// The file's face multipliers (one per cell face, both sides of a face alike) on the mesh's faces.
+void place_face_multipliers(const std::vector<double>& per_use, PolyMesh& m) {
+  if (m.cell_faces.size() != per_use.size()) fail("face_trans_mult does not match the assembled faces");
+  m.face_trans_mult.assign(static_cast<size_t>(m.n_faces()), -1.0);
+  for (size_t q = 0; q < per_use.size(); ++q) {
+    double& v = m.face_trans_mult[m.cell_faces[q]];
+    if (v >= 0 && v != per_use[q])
+      fail("face_trans_mult: the two sides of face " + std::to_string(m.cell_faces[q]) + " differ");
+    v = per_use[q];
+  }
+}
+
 ReadResult convert(const Source& src, Parsed&& in, VtuAssembly assembly) {
   ReadResult res;
   res.has_face_patch = in.has_face_patch;
@@ -842,6 +867,7 @@ ReadResult convert(const Source& src, Parsed&& in, VtuAssembly assembly) {
   } else {
     build_with_mesh_builder(in, res);
   }
+  if (!in.face_mult.empty()) place_face_multipliers(in.face_mult, res.mesh);
   read_cell_data(src, in);  // now: the file's cells no longer take memory
   res.warnings = std::move(in.warnings);
   PolyMesh& m = res.mesh;

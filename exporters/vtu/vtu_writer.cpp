@@ -146,11 +146,15 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   std::vector<int64_t> connectivity, offsets, faces, faceoffsets;
   std::vector<uint8_t> types(nc, 42);
   std::vector<int32_t> face_patch;
+  // The faces' transmissibility multipliers (PolyMesh::face_trans_mult), in face_patch's order.
+  const bool has_mult = !m.face_trans_mult.empty();
+  std::vector<double> face_mult;
   std::vector<int64_t> stamp(m.nodes.size(), -1);
   // The cell's outward cycles, flat (reused from cell to cell).
   std::vector<int32_t> local;
   std::vector<int> local_off;
   std::vector<int32_t> local_patch;
+  std::vector<double> local_mult;
   bool any_polyhedron = false;
   connectivity.reserve(8 * nc);
   offsets.reserve(nc);
@@ -161,6 +165,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
     local.clear();
     local_off.assign(1, 0);
     local_patch.clear();
+    local_mult.clear();
     for (const int32_t* fp = m.cell_begin(ci); fp != m.cell_end(ci); ++fp) {
       const int f = *fp, k = m.face_size(f);
       const int32_t* v = m.face_begin(f);
@@ -169,6 +174,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
       for (int i = 0; i < k; ++i) local.push_back(own ? v[i] : v[(k - i) % k]);
       local_off.push_back(static_cast<int>(local.size()));
       local_patch.push_back(m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f]);
+      if (has_mult) local_mult.push_back(m.face_trans_mult[f]);
     }
     std::array<int32_t, 8> hex{};
     std::array<int, 6> which{};
@@ -176,6 +182,8 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
       types[c] = 12;
       connectivity.insert(connectivity.end(), hex.begin(), hex.end());
       for (int k = 0; k < 6; ++k) face_patch.push_back(local_patch[which[k]]);
+      if (has_mult)
+        for (int k = 0; k < 6; ++k) face_mult.push_back(local_mult[which[k]]);
     } else {
       any_polyhedron = true;
       const size_t n_local = local_off.size() - 1;
@@ -191,6 +199,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
           }
         }
         face_patch.push_back(local_patch[q]);
+        if (has_mult) face_mult.push_back(local_mult[q]);
       }
     }
     offsets.push_back(static_cast<int64_t>(connectivity.size()));
@@ -206,6 +215,8 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   }
   Block field = make_block("Int32", "face_patch", 1, face_patch);
   field.tuples = static_cast<int64_t>(face_patch.size());
+  Block mult_field = make_block("Float64", "face_trans_mult", 1, face_mult);
+  mult_field.tuples = static_cast<int64_t>(face_mult.size());
   std::vector<Block> point_blocks{make_block("Float64", "Points", 3, points)};
   std::vector<Block> cell_blocks{make_block("Int64", "connectivity", 1, connectivity),
                                  make_block("Int64", "offsets", 1, offsets), make_block("UInt8", "types", 1, types)};
@@ -233,6 +244,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
       << (host_is_little_endian() ? "LittleEndian" : "BigEndian") << "\" header_type=\"UInt64\">\n";
   xml << "  <UnstructuredGrid>\n    <FieldData>\n";
   place(field, "      ");
+  if (has_mult) place(mult_field, "      ");
   xml << "    </FieldData>\n    <Piece NumberOfPoints=\"" << m.nodes.size() << "\" NumberOfCells=\"" << nc << "\">\n";
   xml << "      <Points>\n";
   for (const Block& b : point_blocks) place(b, "        ");
@@ -253,6 +265,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
     out.write(b.data, static_cast<std::streamsize>(b.size));
   };
   emit(field);
+  if (has_mult) emit(mult_field);
   for (const Block& b : point_blocks) emit(b);
   for (const Block& b : cell_blocks) emit(b);
   for (const Block& b : data_blocks) emit(b);

@@ -418,6 +418,9 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
     }
   }, 256);  // small chunks: the end-cap faces (a quadrature each) lie together
   if (opt.reservoir_halves_opm) opm_pair_halves(m, g, unit, &t);
+  // A corner-point model's multipliers act on the connection, not on its halves (as in OPM Flow).
+  if (!m.face_trans_mult.empty())
+    for (int f = 0; f < nf; ++f) t.face[f] *= m.face_trans_mult[f];
   for (int f = 0; f < nf; ++f) {
     if (!bad[f]) continue;
     t.negative += bad[f];

@@ -44,7 +44,8 @@ struct Transmissibilities {
   /// n_faces: the same from the neighbour's side; 0 on boundary faces.
   std::vector<double> half_neighbour;
   /// n_faces: interior faces: harmonic combination of the two halves; wellbore faces: the
-  /// connection factor (= half_owner, q = CF/mu (p_cell - p_w)); other boundary faces: 0.
+  /// connection factor (= half_owner, q = CF/mu (p_cell - p_w)); other boundary faces: 0. Times
+  /// PolyMesh::face_trans_mult (a corner-point model's multipliers) where the mesh has them.
   std::vector<double> face;
   /// Number of half-transmissibilities that are negative or not finite (FV centre beyond or on
   /// the face plane). They are kept as computed, never replaced by their absolute value

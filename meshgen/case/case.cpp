@@ -280,9 +280,9 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
   if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
   auto shared = std::make_shared<const CornerPointModel>(read_corner_point_model(path, f.path("grdecl")));
   const CornerPointModel& model = *shared;
-  // Axis-aligned boxes, all active: the rectilinear grid (the same mesh as the box form); else the
-  // model's own cells (meshgen/grids/corner_point_grid.hpp).
-  ReservoirSpec r = is_rectilinear(model) ? rectilinear_reservoir(model, f.path("grdecl"))
+  // Axis-aligned boxes, all active, no multiplier: the rectilinear grid (the same mesh as the box
+  // form); else the model's own cells (meshgen/grids/corner_point_grid.hpp), which carry multipliers.
+  ReservoirSpec r = is_rectilinear(model) && !has_transmissibility_multipliers(model) ? rectilinear_reservoir(model, f.path("grdecl"))
                                           : corner_point_reservoir(shared, f.path("grdecl"));
   for (size_t c = 0; c < r.cell_poro.size(); ++c) {
     if (!model.actnum[c]) continue;  // inactive cells carry no rock

@@ -172,6 +172,12 @@ Vec3 pillar_point(const CornerPointModel& m, int p, double z) {
   return {a[0] + t * (a[3] - a[0]), a[1] + t * (a[4] - a[1]), z};
 }
 
+bool has_transmissibility_multipliers(const CornerPointModel& m) {
+  for (const std::vector<double>& v : m.trans_mult)
+    if (std::any_of(v.begin(), v.end(), [](double x) { return x != 1.0; })) return true;
+  return false;
+}
+
 bool is_rectilinear(const CornerPointModel& m) {
   try {
     rectilinear_reservoir(m, "");

@@ -53,6 +53,9 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
 /// InputError naming `key` and the first cell that is not (corner-point geometry is not meshed yet).
 ReservoirSpec rectilinear_reservoir(const CornerPointModel& model, const std::string& key);
 
+/// Whether any of the model's transmissibility multipliers (trans_mult) is not 1.
+bool has_transmissibility_multipliers(const CornerPointModel& model);
+
 /// Whether every cell is an axis-aligned box on common axes and active (exact equality, no tolerance):
 /// such a model is meshed as the rectilinear grid of `rectilinear_reservoir`.
 bool is_rectilinear(const CornerPointModel& model);

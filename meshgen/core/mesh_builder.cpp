@@ -1,6 +1,7 @@
 #include "mesh_builder.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace hm {
@@ -229,6 +230,13 @@ CsrReport check_csr_invariants(const PolyMesh& m) {
     bad("cell_face_ptr must have n_cells + 1 entries starting at 0");
   if (m.face_neighbour.size() != static_cast<size_t>(nf) || m.face_patch.size() != static_cast<size_t>(nf))
     bad("face_neighbour/face_patch sizes differ from n_faces");
+  if (!m.face_trans_mult.empty() && m.face_trans_mult.size() != static_cast<size_t>(nf))
+    bad("face_trans_mult is neither empty nor of size n_faces");
+  for (size_t f = 0; f < m.face_trans_mult.size(); ++f)
+    if (!(std::isfinite(m.face_trans_mult[f]) && m.face_trans_mult[f] >= 0)) {
+      bad("face_trans_mult[" + std::to_string(f) + "] is not a finite value >= 0");
+      break;
+    }
   if (m.cell_fv_center.size() != static_cast<size_t>(nc) || m.cell_ijk.size() != static_cast<size_t>(nc) ||
       m.cell_perm.size() != static_cast<size_t>(nc) || m.cell_porosity.size() != static_cast<size_t>(nc) ||
       m.cell_radial.size() != static_cast<size_t>(nc))

@@ -57,6 +57,10 @@ struct PolyMesh {
   std::vector<int32_t> face_owner;        ///< n_faces, a valid cell id
   std::vector<int32_t> face_neighbour;    ///< n_faces, cell id or -1 on the boundary
   std::vector<int32_t> face_patch;        ///< n_faces, kInteriorFace iff face_neighbour >= 0, else a patch code
+  /// n_faces or empty (every face 1): the transmissibility multiplier of a corner-point model's face
+  /// (MULTX..MULTZ-, FAULTS/MULTFLT as OPM Flow applies them; docs/corner-point.md), finite and >= 0,
+  /// 1 on boundary faces and on faces the model's multipliers do not reach.
+  std::vector<double> face_trans_mult;
 
   // ---- cells (CSR cell -> faces)
   std::vector<int32_t> cell_face_ptr{0};  ///< n_cells + 1

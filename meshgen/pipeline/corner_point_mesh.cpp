@@ -5,12 +5,14 @@
 // transition per cavity with a polygon site and a mirror per triangle (no box site).
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <memory>
 #include <string>
 
 #include "hybrid_mesh.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
+#include "meshgen/grids/corner_point_multipliers.hpp"
 #include "perforations.hpp"
 #include "transition_assembly.hpp"
 
@@ -35,6 +37,29 @@ class Stages {
 };
 
 std::vector<char> all_present(const CornerPointModel& m) { return std::vector<char>(m.actnum.size(), 1); }
+
+// The model's transmissibility multipliers on the mesh's faces, with notes on what they reach.
+void apply_model_multipliers(HybridMesh& out, const CornerPointModel& model, const CornerPointCellFaces* cells,
+                             const std::vector<char>& active, const std::vector<Vec3>& coords) {
+  FaceMultipliers fm = face_multipliers(out.mesh, model, cells, active, coords);
+  if (fm.unmatched_walls > 0)
+    throw MeshingError("assembly", {},
+                       "assembly: " + std::to_string(fm.unmatched_walls) +
+                           " faces between model cells and near-well cells are none of the cavities' triangles: the "
+                           "model's transmissibility multipliers cannot be placed on them");
+  out.mesh.face_trans_mult = std::move(fm.face);
+  if (fm.model_faces + fm.wall_faces > 0)
+    out.notes.push_back("reservoir: the model's transmissibility multipliers (MULTX..MULTZ-, FAULTS/MULTFLT) act on " +
+                        std::to_string(fm.model_faces) + " faces between model cells and " + std::to_string(fm.wall_faces) +
+                        " faces between model cells and near-well cells (docs/corner-point.md)");
+  if (fm.inside_cavities > 0) {
+    char range[96];
+    std::snprintf(range, sizeof range, "%.6g to %.6g", fm.inside_min, fm.inside_max);
+    out.notes.push_back("cavity: " + std::to_string(fm.inside_cavities) +
+                        " model faces between cavity cells carry transmissibility multipliers (" + range +
+                        ") that the near-well cells replacing those cells do not (docs/corner-point.md)");
+  }
+}
 
 std::string well_names(const CaseSpec& cs, const std::vector<int>& wells) {
   std::string s;
@@ -161,6 +186,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   const TransitionCellMaps maps = add_transition_cells(transitions, set_rock, builder, out.transition_reports);
   out.mesh = builder.finish(&out.build_report);
   fill_cell_maps(out, maps);
+  if (out.build_report.ok) apply_model_multipliers(out, model, &faces, out.cavities.reservoir_active, coords);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   std::vector<int> all_wells(nw);
@@ -193,6 +219,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
   out.mesh = builder.finish(&out.build_report);
   stage.mark("reservoir_cells");
   fill_cell_maps(out, TransitionCellMaps{});
+  if (out.build_report.ok) apply_model_multipliers(out, model, nullptr, all_present(model), {});
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   if (cells.zero_volume_cells > 0)

@@ -18,6 +18,8 @@
 #include <set>
 #include <sstream>
 
+#include "exporters/vtu/vtu_reader.hpp"
+#include "exporters/vtu/vtu_writer.hpp"
 #include "meshgen/case/corner_point_path.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
@@ -564,5 +566,94 @@ TEST(CornerPointWells, ReekWellIsMeshedSoundlyOrRefusedWithTheReason) {
   } catch (const MeshingError& e) {
     std::printf("[ figures  ] Reek, one well: refused at stage %s: %s\n", e.stage.c_str(), e.what());
     EXPECT_GT(std::string(e.what()).size(), 20u);
+  }
+}
+
+// The model's transmissibility multipliers on the mesh (docs/corner-point.md, "Transmissibility
+// multipliers"), decided here from the geometry, not from the cells' indices: a face of model cell a
+// takes OPM's product m_d(a) m_-d(b), d the largest axis of its normal out of a, b the model cell across
+// it: the other model cell, or for a cavity-wall face the deactivated cell holding the point 1e-4 m
+// beyond its centroid. Faces of near-well cells only: 1. The multipliers between cavity cells (MULTZ
+// 0.02 of layer 6 among them) are named in a note, and the multipliers survive mesh.vtu.
+TEST(CornerPointWells, ModelMultipliersAreOnTheModelFacesAndTheCavityWalls) {
+  TempDir tmp("cpmult");
+  TiltedModel g;
+  g.keywords = hmtest::multiplier_keywords(g, 6);
+  const CaseSpec cs = case_of(tmp, g, vertical_well(90, 90, 1034, 1046));
+  const HybridMesh out = build_hybrid_mesh(cs);
+  expect_sound_mesh(cs, out);
+  const CornerPointModel& model = *cs.reservoir.corner_point;
+  const PolyMesh& m = out.mesh;
+  ASSERT_EQ(m.face_trans_mult.size(), static_cast<size_t>(m.n_faces()));
+
+  MeshBuilder scratch;
+  const CornerPointCellFaces faces = corner_point_cell_faces(model, std::vector<char>(model.actnum.size(), 1), scratch);
+  std::vector<Vec3> coords(scratch.n_nodes());
+  for (int32_t i = 0; i < scratch.n_nodes(); ++i) coords[i] = scratch.node(i);
+  std::vector<int32_t> dead;
+  for (const Cavity& cav : out.cavities.cavities) dead.insert(dead.end(), cav.deactivated_cells.begin(), cav.deactivated_cells.end());
+  std::sort(dead.begin(), dead.end());
+  const CornerPointLocator across(model, faces, dead, coords);
+  auto natural = [&](int32_t c) {
+    const auto& ijk = m.cell_ijk[c];
+    return ijk[0] + model.nx * (ijk[1] + model.ny * ijk[2]);
+  };
+  int walls = 0, model_faces = 0;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const int32_t o = m.face_owner[f], n = m.face_neighbour[f];
+    if (n < 0) {
+      EXPECT_EQ(m.face_trans_mult[f], 1.0) << f;
+      continue;
+    }
+    const bool ro = m.cell_region[o] == kReservoir, rn = m.cell_region[n] == kReservoir;
+    if (!ro && !rn) {
+      EXPECT_EQ(m.face_trans_mult[f], 1.0) << f;
+      continue;
+    }
+    const int32_t a = ro ? o : n;
+    const Vec3 out_of_a = (a == o ? 1.0 : -1.0) * out.geometry.face_area[f];
+    const double comp[3] = {out_of_a.x, out_of_a.y, out_of_a.z};
+    int axis = 0;
+    for (int d = 1; d < 3; ++d)
+      if (std::abs(comp[d]) > std::abs(comp[axis])) axis = d;
+    const bool plus = comp[axis] > 0;
+    int b = -1;
+    if (ro && rn) {
+      b = natural(a == o ? n : o);
+      ++model_faces;
+    } else {
+      b = across.cell_at(out.geometry.face_centroid[f] + (1e-4 / norm(out_of_a)) * out_of_a);
+      ASSERT_GE(b, 0) << "no cavity cell across wall face " << f;
+      ++walls;
+    }
+    const double expected =
+        model.trans_mult[2 * axis + (plus ? 0 : 1)][natural(a)] * model.trans_mult[2 * axis + (plus ? 1 : 0)][b];
+    ASSERT_EQ(m.face_trans_mult[f], expected) << "face " << f << " of model cell " << natural(a) << " toward " << b;
+  }
+  std::printf("[ figures  ] multipliers checked on %d model faces and %d cavity-wall faces\n", model_faces, walls);
+  EXPECT_GT(walls, 50);
+  const auto note = std::find_if(out.notes.begin(), out.notes.end(), [](const std::string& s) {
+    return s.find("model faces between cavity cells carry transmissibility multipliers (0.02 to") != std::string::npos;
+  });
+  EXPECT_NE(note, out.notes.end());
+
+  // mesh.vtu carries them: the same multiplier on the same face (faces keyed by their nodes).
+  const std::string path = (tmp.path / "mesh.vtu").string();
+  ASSERT_TRUE(write_vtu(path, m).ok);
+  const ReadResult back = read_vtu(path);
+  ASSERT_TRUE(back.ok) << back.error;
+  ASSERT_EQ(back.mesh.n_faces(), m.n_faces());
+  ASSERT_EQ(back.mesh.face_trans_mult.size(), static_cast<size_t>(m.n_faces()));
+  std::map<std::vector<int32_t>, double> by_nodes;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    std::vector<int32_t> key(m.face_begin(f), m.face_end(f));
+    std::sort(key.begin(), key.end());
+    by_nodes[key] = m.face_trans_mult[f];
+  }
+  for (int f = 0; f < back.mesh.n_faces(); ++f) {
+    std::vector<int32_t> key(back.mesh.face_begin(f), back.mesh.face_end(f));
+    std::sort(key.begin(), key.end());
+    ASSERT_EQ(by_nodes.count(key), 1u) << f;
+    ASSERT_EQ(back.mesh.face_trans_mult[f], by_nodes[key]) << f;
   }
 }

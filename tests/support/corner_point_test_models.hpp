@@ -54,6 +54,7 @@ struct TiltedModel {
   bool inclined_pillars = false;  // non-parallel pillars: the column faces are not planar either
   double pillar_twist = 0;        // inclined pillars whose slope also varies along the model's sides (bent sides)
   std::vector<int> inactive;      // cells with ACTNUM 0 (natural index)
+  std::string keywords;           // GRDECL text appended (multipliers, FAULTS; multiplier_keywords)
 
   double depth(int i_col, int I, int J, int k) const {
     const double x = dx * I, y = dy * J;
@@ -82,10 +83,33 @@ struct TiltedModel {
     for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
     o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
     for (int c = 0; c < n; ++c) o << 0.15 + 0.01 * (c % 5) << "\n";
-    o << "/\n";
+    o << "/\n" << keywords;
     return o.str();
   }
 };
+
+/// Transmissibility multipliers of a TiltedModel (GRDECL text for TiltedModel::keywords): MULTX by cell
+/// (0.3 to 1.0), MULTY- 0.5 on every third cell, MULTZ 0.02 on layer `barrier_k` (0-based; its face
+/// toward the layer below) and 0.5 to 0.7 on the others, and, when the model has a fault, FAULTS 'F1'
+/// on its pillar line (faces +I of the cells just before it) with MULTFLT 0.05.
+inline std::string multiplier_keywords(const TiltedModel& g, int barrier_k) {
+  std::ostringstream o;
+  const int n = g.nx * g.ny * g.nz;
+  o << "MULTX\n";
+  for (int c = 0; c < n; ++c) o << 0.3 + 0.1 * (c % 8) << "\n";
+  o << "/\nMULTY-\n";
+  for (int c = 0; c < n; ++c) o << (c % 3 == 0 ? 0.5 : 1.0) << "\n";
+  o << "/\nMULTZ\n";
+  for (int c = 0; c < n; ++c) {
+    const int k = c / (g.nx * g.ny);
+    o << (k == barrier_k ? 0.02 : 0.5 + 0.05 * (k % 5)) << "\n";
+  }
+  o << "/\n";
+  if (g.fault_i > 0)
+    o << "FAULTS\n 'F1' " << g.fault_i << " " << g.fault_i << " 1 " << g.ny << " 1 " << g.nz << " 'X' /\n/\n"
+      << "MULTFLT\n 'F1' 0.05 /\n/\n";
+  return o.str();
+}
 
 /// Planar layers (depth 1000 + dz k + tan(dip) x + 0.01 y at pillar (x, y) = (dx I, dy J)) on
 /// parallel straight pillars inclined `pillar_deg` from the vertical toward azimuth `pillar_azimuth_deg`

@@ -1,0 +1,94 @@
+#include "corner_point_multipliers.hpp"
+
+#include <algorithm>
+#include <array>
+#include <map>
+
+namespace hm {
+
+namespace {
+
+double multiplier(const CornerPointModel& model, int dir, int64_t c) {
+  const std::vector<double>& v = model.trans_mult[dir];
+  return v.empty() ? 1.0 : v[static_cast<size_t>(c)];
+}
+
+// A triangle by its corners' coordinates, sorted: the mesh's node ids are compacted after the
+// builder's (unused nodes of cavity cells dropped), the coordinates are the same doubles.
+using TriangleKey = std::array<std::array<double, 3>, 3>;
+
+TriangleKey triangle_key(const std::vector<Vec3>& xyz, const int32_t* v) {
+  TriangleKey t;
+  for (int i = 0; i < 3; ++i) t[i] = {xyz[v[i]].x, xyz[v[i]].y, xyz[v[i]].z};
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+}  // namespace
+
+double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b) {
+  const int64_t nx = model.nx, nxy = static_cast<int64_t>(model.nx) * model.ny;
+  const int64_t ia = a % nx, ja = (a / nx) % model.ny, ka = a / nxy;
+  const int64_t ib = b % nx, jb = (b / nx) % model.ny, kb = b / nxy;
+  const int axis = ia != ib ? 0 : ja != jb ? 1 : 2;
+  const bool plus = axis == 0 ? ib > ia : axis == 1 ? jb > ja : kb > ka;
+  const int dir = 2 * axis + (plus ? 0 : 1), opposite = 2 * axis + (plus ? 1 : 0);
+  return multiplier(model, dir, a) * multiplier(model, opposite, b);
+}
+
+FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& model, const CornerPointCellFaces* cells,
+                                 const std::vector<char>& active, const std::vector<Vec3>& coords) {
+  FaceMultipliers out;
+  if (!has_transmissibility_multipliers(model)) return out;
+  auto model_cell = [&](int32_t c) -> int64_t {
+    if (mesh.cell_region[c] != kReservoir) return -1;
+    const auto& ijk = mesh.cell_ijk[c];
+    return ijk[0] + static_cast<int64_t>(model.nx) * (ijk[1] + static_cast<int64_t>(model.ny) * ijk[2]);
+  };
+  // Per model cell beside a cavity: its cavity triangles and the cavity cell each faces.
+  std::map<TriangleKey, int32_t> toward;
+  std::vector<char> walled(model.actnum.size(), 0);
+  if (cells != nullptr)
+    for (int32_t f = 0; f < mesh.n_faces(); ++f) {
+      const int32_t o = mesh.face_owner[f], n = mesh.face_neighbour[f];
+      if (n < 0 || (mesh.cell_region[o] == kReservoir) == (mesh.cell_region[n] == kReservoir)) continue;
+      const int64_t a = model_cell(mesh.cell_region[o] == kReservoir ? o : n);
+      if (walled[a]) continue;
+      walled[a] = 1;
+      for (const CavityTriangle& t : cavity_triangles(*cells, static_cast<int>(a), active, coords))
+        toward[triangle_key(coords, t.nodes.data())] = t.inside;
+    }
+  out.face.assign(static_cast<size_t>(mesh.n_faces()), 1.0);
+  for (int32_t f = 0; f < mesh.n_faces(); ++f) {
+    const int32_t n = mesh.face_neighbour[f];
+    if (n < 0) continue;
+    const int64_t a = model_cell(mesh.face_owner[f]), b = model_cell(n);
+    if (a >= 0 && b >= 0) {
+      out.face[f] = connection_multiplier(model, a, b);
+      out.model_faces += out.face[f] != 1.0;
+    } else if (a >= 0 || b >= 0) {
+      const auto it = mesh.face_size(f) == 3 ? toward.find(triangle_key(mesh.nodes, mesh.face_begin(f))) : toward.end();
+      if (it == toward.end()) {
+        ++out.unmatched_walls;
+        continue;
+      }
+      out.face[f] = connection_multiplier(model, std::max(a, b), it->second);
+      out.wall_faces += out.face[f] != 1.0;
+    }
+  }
+  if (cells != nullptr)
+    for (size_t c = 0; c < cells->faces.size(); ++c) {
+      if (!cells->meshed[c] || active[c]) continue;
+      for (int32_t b : cells->neighbour[c]) {
+        if (b <= static_cast<int32_t>(c) || !cells->meshed[b] || active[b]) continue;
+        const double m = connection_multiplier(model, static_cast<int64_t>(c), b);
+        if (m == 1.0) continue;
+        ++out.inside_cavities;
+        out.inside_min = std::min(out.inside_min, m);
+        out.inside_max = std::max(out.inside_max, m);
+      }
+    }
+  return out;
+}
+
+}  // namespace hm
