@@ -5,6 +5,8 @@
 #include <iomanip>
 #include <sstream>
 
+#include "meshgen/core/geometry.hpp"
+
 namespace hm {
 
 namespace {
@@ -13,15 +15,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 // The 6 faces of a cell as corner quads, all oriented alike (corner bit 0 +i, bit 1 +j, bit 2 +k).
 constexpr int kFaces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-
-// Solid angle of triangle (a, b, c) seen from the origin, signed by its orientation
-// (Van Oosterom and Strackee).
-double solid_angle(Vec3 a, Vec3 b, Vec3 c) {
-  const double la = norm(a), lb = norm(b), lc = norm(c);
-  const double num = dot(a, cross(b, c));
-  const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
-  return 2.0 * std::atan2(num, den);
-}
 
 std::string metres(double x) {
   std::ostringstream os;
@@ -91,7 +84,7 @@ bool CornerPointInterior::contains(Vec3 q) const {
     double w = 0;
     for (const auto& f : kFaces) {
       const Vec3 a = c.corners[f[0]] - p, b = c.corners[f[1]] - p, q = c.corners[f[2]] - p, d = c.corners[f[3]] - p;
-      w += solid_angle(a, b, q) + solid_angle(a, q, d);
+      w += triangle_solid_angle(a, b, q) + triangle_solid_angle(a, q, d);
     }
     if (std::abs(w) > 2.0 * kPi) return true;  // winding number 1 (4 pi), not 0
   }

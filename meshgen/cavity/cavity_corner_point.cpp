@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "meshgen/core/geometry.hpp"
 #include "meshgen/grids/gabriel.hpp"
 
 namespace hm {
@@ -29,14 +30,8 @@ std::string cell_name(const CornerPointModel& m, int c) {
          std::to_string(c / (m.nx * m.ny) + 1) + ")";
 }
 
-// Solid angle of triangle abc seen from x (Van Oosterom and Strackee), signed by orientation.
-double solid_angle(Vec3 x, const std::array<Vec3, 3>& t) {
-  const Vec3 a = t[0] - x, b = t[1] - x, c = t[2] - x;
-  const double la = norm(a), lb = norm(b), lc = norm(c);
-  const double num = dot(a, cross(b, c));
-  const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
-  return 2.0 * std::atan2(num, den);
-}
+// Solid angle of triangle t seen from x, signed by orientation.
+double solid_angle(Vec3 x, const std::array<Vec3, 3>& t) { return triangle_solid_angle(t[0] - x, t[1] - x, t[2] - x); }
 
 // One reservoir polygon of the current cavity boundary: a constrained triangle of the face of
 // active cell `outside` toward deactivated cell `inside`; or (outside = -1) a triangle of a face

@@ -1,6 +1,7 @@
 #include "geometry.hpp"
 
 #include <array>
+#include <cmath>
 
 #include "parallel.hpp"
 
@@ -90,6 +91,13 @@ double total_volume(const MeshGeometry& geo) {
   double v = 0;
   for (double x : geo.cell_volume) v += x;
   return v;
+}
+
+double triangle_solid_angle(Vec3 a, Vec3 b, Vec3 c) {
+  const double la = norm(a), lb = norm(b), lc = norm(c);
+  const double num = dot(a, cross(b, c));
+  const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  return 2.0 * std::atan2(num, den);
 }
 
 }  // namespace hm

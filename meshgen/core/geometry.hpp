@@ -27,4 +27,8 @@ Vec3 cell_area_sum(const PolyMesh& mesh, const MeshGeometry& geo, int c);
 /// Total signed volume of all cells.
 double total_volume(const MeshGeometry& geo);
 
+/// Solid angle of triangle (a, b, c) seen from the origin, signed by its orientation (Van Oosterom
+/// and Strackee): summed over a closed surface, 4 pi times its winding number about the origin.
+double triangle_solid_angle(Vec3 a, Vec3 b, Vec3 c);
+
 }  // namespace hm

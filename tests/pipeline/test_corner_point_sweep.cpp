@@ -71,12 +71,6 @@ CornerPointSweepCase make_corner_point_case(uint32_t seed) {
   return c;
 }
 
-double volume_of(const HybridMesh& h) {
-  double v = 0;
-  for (int c = 0; c < h.mesh.n_cells(); ++c) v += h.geometry.cell_volume[c];
-  return v;
-}
-
 // Meshes the case (in the local frame, as meshgen does) and checks what the module promises.
 CaseResult mesh_corner_point_case(const CornerPointSweepCase& c) {
   return run_classified([&](CaseResult& res) {
@@ -87,8 +81,8 @@ CaseResult mesh_corner_point_case(const CornerPointSweepCase& c) {
     const HybridMesh h = build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));  // throws if the self-check fails
     CaseSpec bare = cs;
     bare.wells.clear();
-    const double expected = volume_of(build_hybrid_mesh(bare)) - exact_wellbore_hole_volume(cs, 0, h.blocks[0].sectors);
-    const double got = volume_of(h);
+    const double expected = total_volume(build_hybrid_mesh(bare).geometry) - exact_wellbore_hole_volume(cs, 0, h.blocks[0].sectors);
+    const double got = total_volume(h.geometry);
     std::string bad;
     if (!h.build_report.ok) bad += "builder; ";
     if (!(std::abs(got - expected) <= 1e-9 * expected)) bad += "volume " + std::to_string(got / expected - 1) + "; ";

@@ -47,12 +47,6 @@ CaseSpec case_of(const TempDir& tmp, const TiltedModel& m, const std::string& we
 
 std::string vertical_well(double x, double y, double z0, double z1) { return hmtest::vertical_well_yaml(x, y, z0, z1); }
 
-double total_volume(const HybridMesh& out) {
-  double v = 0;
-  for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
-  return v;
-}
-
 // The properties of a meshed case with wells (see the file's comment).
 void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
   ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
@@ -69,7 +63,7 @@ void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
   const HybridMesh bare = build_hybrid_mesh(no_wells);
   double hole = 0;
   for (size_t w = 0; w < cs.wells.size(); ++w) hole += exact_wellbore_hole_volume(cs, static_cast<int>(w), out.blocks[w].sectors);
-  const double v = total_volume(out), v0 = total_volume(bare);
+  const double v = total_volume(out.geometry), v0 = total_volume(bare.geometry);
   std::printf("[ figures  ] corner-point with wells: %d cells (%d transition), volume %.9f vs model - wellbore %.9f "
               "(rel %.2e)\n",
               out.mesh.n_cells(), transition, v, v0 - hole, v / (v0 - hole) - 1);
