@@ -122,6 +122,43 @@ TEST(Grdecl, CartesianModelMeshesToTheMeshOfItsBoxForm) {
   }
 }
 
+// The same box with MULTZ 0.5 on every cell: its multipliers need faces to act on, so it is meshed as a
+// corner-point model (its own cells), and the transmissibility of every vertical pair is half the box
+// form's, every horizontal pair's the same (docs/corner-point.md, "Transmissibility multipliers").
+TEST(Grdecl, CartesianModelWithMultipliersIsMeshedAsItsCellsAndTheyAct) {
+  TempDir tmp;
+  const size_t n = (kX.size() - 1) * (kY.size() - 1) * (kZ.size() - 1);
+  write(tmp.path / "BOX.GRDECL", grdecl_of_box(kX, kY, kZ, false));
+  write(tmp.path / "BOXM.GRDECL", grdecl_of_box(kX, kY, kZ, false) + "MULTZ\n" + std::to_string(n) + "*0.5 /\n");
+  const CaseSpec plain = load_case(write(tmp.path / "a.yaml", "name: g\nreservoir: {grdecl: BOX.GRDECL}\n"));
+  const CaseSpec mult = load_case(write(tmp.path / "b.yaml", "name: g\nreservoir: {grdecl: BOXM.GRDECL}\n"));
+  EXPECT_FALSE(plain.reservoir.corner_point);
+  ASSERT_TRUE(mult.reservoir.corner_point);
+  using Pair = std::pair<std::array<int32_t, 3>, std::array<int32_t, 3>>;
+  auto pair_values = [](const HybridMesh& h) {
+    const Transmissibilities t = compute_transmissibilities(h.mesh, h.geometry, deck_transmissibility_options());
+    std::map<Pair, double> out;
+    for (int f = 0; f < h.mesh.n_faces(); ++f) {
+      const int32_t o = h.mesh.face_owner[f], nb = h.mesh.face_neighbour[f];
+      if (nb < 0) continue;
+      Pair p{h.mesh.cell_ijk[o], h.mesh.cell_ijk[nb]};
+      if (p.second < p.first) std::swap(p.first, p.second);
+      out[p] += t.face[f];
+    }
+    return out;
+  };
+  const std::map<Pair, double> a = pair_values(build_hybrid_mesh(plain)), b = pair_values(build_hybrid_mesh(mult));
+  ASSERT_EQ(a.size(), b.size());
+  int vertical = 0;
+  for (const auto& [p, t] : a) {
+    ASSERT_EQ(b.count(p), 1u);
+    const bool z_pair = p.first[2] != p.second[2];
+    vertical += z_pair;
+    EXPECT_NEAR(b.at(p) / t, z_pair ? 0.5 : 1.0, 1e-12) << p.first[0] << "," << p.first[1] << "," << p.first[2];
+  }
+  EXPECT_GT(vertical, 100);
+}
+
 // MAPAXES (rotated 30 degrees, origin at UTM values): the wells are given in map coordinates and
 // land where they are in the grid frame, where the mesh is built (OPM's convention: COORD is in the
 // grid frame, MAPAXES places it on the map).
