@@ -169,6 +169,16 @@ PYBIND11_MODULE(hybridmesh, mod) {
       .def_property_readonly("face_owner", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.face_owner, s); })
       .def_property_readonly("face_neighbour", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.face_neighbour, s); })
       .def_property_readonly("face_patch", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.face_patch, s); })
+      .def_property_readonly(
+          "face_trans_mult",
+          [](py::object s) -> py::array {
+            const hm::PolyMesh& m = s.cast<Mesh&>().result.mesh;
+            if (!m.face_trans_mult.empty()) return view(m.face_trans_mult, s);
+            py::array_t<double> ones(static_cast<py::ssize_t>(m.n_faces()));
+            std::fill(ones.mutable_data(), ones.mutable_data() + m.n_faces(), 1.0);
+            return std::move(ones);
+          },
+          "n_faces: the corner-point model's transmissibility multiplier of each face (1 where it has none)")
       .def_property_readonly("cell_face_ptr", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.cell_face_ptr, s); })
       .def_property_readonly("cell_faces", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.cell_faces, s); })
       .def_property_readonly("cell_region", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.cell_region, s); })

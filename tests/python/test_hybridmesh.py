@@ -49,6 +49,7 @@ class BuiltMesh(unittest.TestCase):
         listed = np.bincount(cf, minlength=m.n_faces)
         np.testing.assert_array_equal(listed, 1 + interior.astype(np.int64))
         np.testing.assert_array_equal(m.face_patch == -1, interior)
+        np.testing.assert_array_equal(m.face_trans_mult, np.ones(m.n_faces))  # a box case: no multipliers
         cell_of_entry = np.repeat(np.arange(m.n_cells), np.diff(cp))
         is_owner = m.face_owner[cf] == cell_of_entry
         is_neighbour = m.face_neighbour[cf] == cell_of_entry
@@ -172,6 +173,47 @@ class BadInput(unittest.TestCase):
     def test_good_text_parses(self):
         cs = hybridmesh.parse_case(read_text(README_CASE))
         self.assertEqual(cs.name, "my_case")
+
+
+class ModelMultipliers(unittest.TestCase):
+    """A 4 x 3 x 5 box of 10 m cells given as GRDECL with MULTZ 0.5: meshed as its corner-point cells,
+    every face between two layers carries 0.5, every other face 1, and the transmissibilities include it."""
+
+    def test_multz_on_the_faces_between_layers(self):
+        nx, ny, nz = 4, 3, 5
+        n = nx * ny * nz
+        coord = "".join(f"{10 * i} {10 * j} 1000 {10 * i} {10 * j} 1050\n" for j in range(ny + 1) for i in range(nx + 1))
+        zcorn = "".join(f"{4 * nx * ny}*{1000 + 10 * (k + s)}\n" for k in range(nz) for s in (0, 1))
+        text = (f"SPECGRID\n {nx} {ny} {nz} 1 F /\nCOORD\n{coord}/\nZCORN\n{zcorn}/\n"
+                f"PERMX\n{n}*100 /\nPERMY\n{n}*100 /\nPERMZ\n{n}*10 /\nPORO\n{n}*0.2 /\n")
+        with tempfile.TemporaryDirectory() as d:
+            for name, extra in (("plain", ""), ("mult", f"MULTZ\n{n}*0.5 /\n")):
+                with open(os.path.join(d, name + ".GRDECL"), "w", encoding="utf-8") as f:
+                    f.write(text + extra)
+            plain = hybridmesh.build(hybridmesh.parse_case("name: p\nreservoir: {grdecl: plain.GRDECL}\n", d))
+            mult = hybridmesh.build(hybridmesh.parse_case("name: m\nreservoir: {grdecl: mult.GRDECL}\n", d))
+        m = mult.face_trans_mult
+        self.assertEqual(m.shape, (mult.n_faces,))
+        interior = mult.face_neighbour >= 0
+        ijk = mult.cell_ijk
+        between_layers = interior & (ijk[mult.face_owner, 2] != ijk[np.where(interior, mult.face_neighbour, 0), 2])
+        self.assertGreater(between_layers.sum(), 30)
+        np.testing.assert_array_equal(m[between_layers], 0.5)
+        np.testing.assert_array_equal(m[~between_layers], 1.0)
+        np.testing.assert_array_equal(plain.face_trans_mult, np.ones(plain.n_faces))
+        # Same cells either way (sorted by ijk): the vertical pairs' transmissibilities are halved.
+        def by_pair(mesh):
+            t, ijk = mesh.transmissibilities, mesh.cell_ijk
+            out = {}
+            for f in np.nonzero(mesh.face_neighbour >= 0)[0]:
+                a, b = tuple(ijk[mesh.face_owner[f]]), tuple(ijk[mesh.face_neighbour[f]])
+                out[tuple(sorted((a, b)))] = out.get(tuple(sorted((a, b))), 0.0) + t[f]
+            return out
+        p, q = by_pair(plain), by_pair(mult)
+        self.assertEqual(p.keys(), q.keys())
+        for pair, t in p.items():
+            expected = 0.5 if pair[0][2] != pair[1][2] else 1.0
+            self.assertAlmostEqual(q[pair] / t, expected, places=12)
 
 
 if __name__ == "__main__":
