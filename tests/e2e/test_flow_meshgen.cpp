@@ -218,6 +218,26 @@ TEST(FlowMeshgen, ReekWellDeckMatchesSolverDemo) {
                 "--linear-solver-max-iter=2000");
 }
 
+// The same with an injector 360 m north-east of SW1 (a vertical path from z 1650, above the model, cut
+// to it), so that the two wells flow at steady state (1131 m3/day) and the comparison is not of a state at
+// rest: 160,658 cells. flow with --linear-solver-max-iter=2000 as above.
+TEST(FlowMeshgen, ReekProducerAndInjectorDeckMatchesSolverDemo) {
+  REQUIRE_FLOW_E2E();
+  if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: ~160k cells in flow)";
+  const fs::path reek = fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek";
+  if (!fs::exists(reek / "REEK_GRID.DATA")) GTEST_SKIP() << "no " << reek;
+  const fs::path d = fresh_dir("flow_reek2");
+  const RemoveAtExit cleanup{d};
+  std::string text = slurp(std::string(HM_SOURCE_DIR) + "/examples/reek_steep_well.yaml");
+  const std::string from = "../../shared/data/reek/REEK_GRID.DATA";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), fs::absolute(reek / "REEK_GRID.DATA").string());
+  text += "  - name: I1\n    type: injector\n    trajectory: [[461955.576, 5929407.846, 1650], [461955.576, 5929407.846, "
+          "1760]]\n    radius: 0.1\n    drainage_radius: 5\n    end_caps: flat\n    bhp: 250\n";
+  std::ofstream(d / "reek2.yaml") << text;
+  run_case_file(d / "reek2.yaml", "reek, producer and injector", d, false, 1e-6, "--linear-solver-max-iter=2000");
+}
+
 TEST(FlowMeshgen, UnwritableExportDirectoryExitsTwoAndLeavesNoDeck) {
   const fs::path d = fresh_dir("flow_unwritable");
   const RemoveAtExit cleanup{d};
