@@ -11,11 +11,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
 
 #include "../exporters/exporter_test_support.hpp"
 #include "corner_point_test_models.hpp"
 #include "meshgen/case/corner_point_refine.hpp"
 #include "meshgen/case/grdecl.hpp"
+#include "meshgen/cavity/cavity_corner_point.hpp"
+#include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/local_frame.hpp"
@@ -366,4 +371,80 @@ TEST(NearWellRefinement, ReekWellMeshesWhereverItsEndIsRounded) {
     well.bottom.z = std::nextafter(well.bottom.z, 2e3);
   }
   EXPECT_EQ(cells[0], cells[1]);
+}
+
+// examples/reek_wells.yaml in Reek as read: OP_3's vertical path crosses exactly the cells Reek's
+// COMPDAT lists for it (reek_history.sch: (28, 46) for K 1-12 and (28, 45) for K 12-14, 1-based),
+// in order, and HZ1 runs 600 m through layer 8's cells (17..21, 54) (1-based), the one layer the
+// issue asks for. Cells located as the mesh has them (CornerPointLocator: winding number of the
+// faces' triangles; Reek's faces are twisted by metres) every 0.25 m along the paths.
+namespace {
+
+std::vector<Vec3> example_trajectory(const std::string& text, const std::string& well) {
+  const size_t at = text.find("name: " + well);
+  const size_t open = text.find("trajectory: [", at), close = text.find("]]", open);
+  std::vector<Vec3> points;
+  std::string numbers = text.substr(open + 13, close - open - 13);
+  for (char& ch : numbers)
+    if (ch == '[' || ch == ']' || ch == ',' || ch == '\n') ch = ' ';
+  std::istringstream in(numbers);
+  for (Vec3 p; in >> p.x >> p.y >> p.z;) points.push_back(p);
+  return points;
+}
+
+}  // namespace
+
+TEST(NearWellRefinement, ReekWellsExampleFollowsTheCompdatCells) {
+  const fs::path deck = reek_deck();
+  if (!fs::exists(deck)) GTEST_SKIP() << "no " << deck;
+  const CornerPointModel m = read_corner_point_model(deck.string(), "reservoir.grdecl");
+  std::ifstream file(fs::path(HM_SOURCE_DIR) / "examples" / "reek_wells.yaml");
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  MeshBuilder scratch;
+  const CornerPointCellFaces faces = corner_point_cell_faces(m, std::vector<char>(m.actnum.size(), 1), scratch);
+  std::vector<Vec3> coords(scratch.n_nodes());
+  for (int32_t i = 0; i < scratch.n_nodes(); ++i) coords[i] = scratch.node(i);
+  std::vector<int32_t> active;
+  for (int32_t c = 0; c < static_cast<int32_t>(m.actnum.size()); ++c)
+    if (m.actnum[c]) active.push_back(c);
+  const CornerPointLocator locate(m, faces, active, coords);
+  const double det = m.map_unit_x[0] * m.map_unit_y[1] - m.map_unit_x[1] * m.map_unit_y[0];
+  auto to_grid = [&](Vec3 p) {  // MAPAXES inverted
+    const double dx = p.x - m.map_origin[0], dy = p.y - m.map_origin[1];
+    return Vec3{(dx * m.map_unit_y[1] - dy * m.map_unit_y[0]) / det, (m.map_unit_x[0] * dy - m.map_unit_x[1] * dx) / det,
+                p.z};
+  };
+  // The (i, j, k) (1-based) of the cells along a path, consecutive repeats merged; outside: none.
+  auto cells_along = [&](const std::vector<Vec3>& path, double* length) {
+    std::vector<std::array<int, 3>> seq;
+    *length = 0;
+    for (size_t s = 0; s + 1 < path.size(); ++s) {
+      const Vec3 a = to_grid(path[s]), b = to_grid(path[s + 1]);
+      const int n = static_cast<int>(std::ceil(norm(b - a) / 0.25));
+      *length += norm(b - a);
+      for (int q = 0; q <= n; ++q) {
+        const int c = locate.cell_at(a + (static_cast<double>(q) / n) * (b - a));
+        if (c < 0) continue;
+        const std::array<int, 3> ijk{c % m.nx + 1, c / m.nx % m.ny + 1, c / (m.nx * m.ny) + 1};
+        if (seq.empty() || seq.back() != ijk) seq.push_back(ijk);
+      }
+    }
+    return seq;
+  };
+  double length = 0;
+  std::vector<std::array<int, 3>> compdat;
+  for (int k = 1; k <= 12; ++k) compdat.push_back({28, 46, k});
+  for (int k = 12; k <= 14; ++k) compdat.push_back({28, 45, k});
+  EXPECT_EQ(cells_along(example_trajectory(text, "OP_3"), &length), compdat);
+
+  const auto hz = cells_along(example_trajectory(text, "HZ1"), &length);
+  EXPECT_NEAR(length, 600.0, 1e-3);
+  ASSERT_FALSE(hz.empty());
+  std::set<int> columns;
+  for (const auto& ijk : hz) {
+    EXPECT_EQ(ijk[1], 54);
+    EXPECT_EQ(ijk[2], 8) << "cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2] << ")";
+    columns.insert(ijk[0]);
+  }
+  EXPECT_EQ(columns, (std::set<int>{17, 18, 19, 20, 21}));
 }
