@@ -398,6 +398,7 @@ struct Parsed {
   std::vector<int32_t> face_patch;
   bool has_face_patch = false;
   std::vector<double> face_mult;  ///< field data face_trans_mult, in face_patch's order (empty: none)
+  bool reservoir_cells_are_model = false;  ///< field data reservoir_cells_are_model (1)
   std::vector<std::string> warnings;
 };
 
@@ -593,6 +594,13 @@ Parsed parse_document(Source& src) {
       if (!(std::isfinite(v) && v >= 0)) fail("face_trans_mult: " + std::to_string(v) + " is not a finite value >= 0");
       out.face_mult[q] = v;
     }
+  }
+  if (vtkXMLDataElement* rm = data_array(child(grid, "FieldData"), "reservoir_cells_are_model")) {
+    if (count_attr(rm, "NumberOfTuples", kMaxIds) != 1) fail("field data reservoir_cells_are_model must be one value");
+    const Array a = read_array(src, rm, 1);
+    const double v = a.is_int ? static_cast<double>(a.i[0]) : a.d[0];
+    if (a.components != 1 || !(v == 0 || v == 1)) fail("field data reservoir_cells_are_model must be one value, 0 or 1");
+    out.reservoir_cells_are_model = v == 1;
   }
   return out;
 }
@@ -868,6 +876,7 @@ ReadResult convert(const Source& src, Parsed&& in, VtuAssembly assembly) {
     build_with_mesh_builder(in, res);
   }
   if (!in.face_mult.empty()) place_face_multipliers(in.face_mult, res.mesh);
+  res.mesh.reservoir_cells_are_model = in.reservoir_cells_are_model;
   read_cell_data(src, in);  // now: the file's cells no longer take memory
   res.warnings = std::move(in.warnings);
   PolyMesh& m = res.mesh;

@@ -217,6 +217,10 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   field.tuples = static_cast<int64_t>(face_patch.size());
   Block mult_field = make_block("Float64", "face_trans_mult", 1, face_mult);
   mult_field.tuples = static_cast<int64_t>(face_mult.size());
+  // The mesh's reservoir cells are a corner-point model's (PolyMesh::reservoir_cells_are_model).
+  const std::vector<int32_t> one{1};
+  Block model_field = make_block("Int32", "reservoir_cells_are_model", 1, one);
+  model_field.tuples = 1;
   std::vector<Block> point_blocks{make_block("Float64", "Points", 3, points)};
   std::vector<Block> cell_blocks{make_block("Int64", "connectivity", 1, connectivity),
                                  make_block("Int64", "offsets", 1, offsets), make_block("UInt8", "types", 1, types)};
@@ -245,6 +249,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   xml << "  <UnstructuredGrid>\n    <FieldData>\n";
   place(field, "      ");
   if (has_mult) place(mult_field, "      ");
+  if (m.reservoir_cells_are_model) place(model_field, "      ");
   xml << "    </FieldData>\n    <Piece NumberOfPoints=\"" << m.nodes.size() << "\" NumberOfCells=\"" << nc << "\">\n";
   xml << "      <Points>\n";
   for (const Block& b : point_blocks) place(b, "        ");
@@ -266,6 +271,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   };
   emit(field);
   if (has_mult) emit(mult_field);
+  if (m.reservoir_cells_are_model) emit(model_field);
   for (const Block& b : point_blocks) emit(b);
   for (const Block& b : cell_blocks) emit(b);
   for (const Block& b : data_blocks) emit(b);

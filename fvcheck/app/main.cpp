@@ -164,7 +164,12 @@ int main(int argc, char** argv) {
       report.notes.push_back("no permeability array: transmissibilities computed with k = 1 mD (geometric part)");
     }
     const hm::Progress progress("transmissibilities");
-    const hm::Transmissibilities t = hm::compute_transmissibilities(in.mesh, geo);
+    // A corner-point model's mesh: the transmissibilities flow and solver_demo use (OPM's form on the
+    // model's side, never negative; docs/transmissibility.md).
+    const hm::Transmissibilities t = hm::compute_transmissibilities(
+        in.mesh, geo, in.mesh.reservoir_cells_are_model ? hm::deck_transmissibility_options() : hm::TransmissibilityOptions{});
+    if (in.mesh.reservoir_cells_are_model)
+      report.notes.push_back("a corner-point model's mesh: transmissibilities in the deck's form (OPM's on the model's side)");
     report.transmissibility = hm::summarize_transmissibilities(t.face);
     report.transmissibility.negative_halves = t.negative;
     if (report.transmissibility.negative_faces.empty()) report.transmissibility.negative_faces = t.negative_faces;

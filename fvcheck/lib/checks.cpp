@@ -796,4 +796,35 @@ CheckResult check_planarity(const PolyMesh& m, const MeshGeometry& geo, const Ch
   return r;
 }
 
+
+std::vector<CheckResult> check_shapes(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt,
+                                      const CellScales* scales, int64_t* exempt_cells) {
+  std::vector<char> ours(mesh.n_cells(), 1);
+  if (mesh.reservoir_cells_are_model)
+    for (int c = 0; c < mesh.n_cells(); ++c) ours[c] = mesh.cell_region[c] != kReservoir;
+  const int64_t exempt = std::count(ours.begin(), ours.end(), 0);
+  if (exempt_cells) *exempt_cells = exempt;
+  auto run = [&](const PolyMesh& m, const MeshGeometry& g, const CellScales& sc) {
+    return std::vector<CheckResult>{check_convexity(m, g, opt), check_orthogonality(m, g, opt),
+                                    check_auto_centering(m, g, opt, sc), check_planarity(m, g, opt)};
+  };
+  if (exempt == 0) return run(mesh, geo, scales ? *scales : compute_cell_scales(mesh, opt.rel_tol));
+  if (exempt == mesh.n_cells()) {  // only the model's cells: nothing of ours to judge
+    std::vector<CheckResult> out(4);
+    const char* names[] = {"convexity", "orthogonality", "auto_centering", "planarity"};
+    for (int i = 0; i < 4; ++i) out[i].name = names[i];
+    return out;
+  }
+  std::vector<int32_t> cell_of;
+  const PolyMesh sub = cells_as_mesh(mesh, ours, &cell_of);
+  const MeshGeometry sub_geo = compute_geometry(sub);
+  std::vector<CheckResult> out = run(sub, sub_geo, compute_cell_scales(sub, opt.rel_tol));
+  for (CheckResult& r : out) {  // ids of the kept cells' mesh -> cells of the whole mesh
+    for (int32_t& id : r.worst_ids) id = cell_of[r.id_kind == IdKind::Face ? sub.face_owner[id] : id];
+    r.id_kind = IdKind::Cell;
+    r.values.clear();
+  }
+  return out;
+}
+
 }  // namespace hm

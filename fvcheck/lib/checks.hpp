@@ -105,6 +105,15 @@ CheckResult check_auto_centering(const PolyMesh& mesh, const MeshGeometry& geo, 
 /// > max_planarity_deg. worst = max Q_P.
 CheckResult check_planarity(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt = {});
 
+/// The shape checks: convexity, orthogonality, auto-centering, planarity, in that order. On a mesh
+/// whose reservoir cells are a corner-point model's (PolyMesh::reservoir_cells_are_model: the user's
+/// cells, in general neither convex nor orthogonal) they judge only the other cells, as a mesh of
+/// their own (cells_as_mesh: their faces toward model cells are boundary faces, measured to their
+/// flux points); ids are then cells of `mesh` (id_kind Cell; a face's owner) and values are empty.
+/// scales: compute_cell_scales(mesh, opt.rel_tol), or null to compute. *exempt_cells (if given)
+/// receives the number of cells not judged.
+std::vector<CheckResult> check_shapes(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt,
+                                      const CellScales* scales = nullptr, int64_t* exempt_cells = nullptr);
 /// Simple-polygon test of one face (projected on its own plane): returns 0 if simple and
 /// without reflex vertex, 1 if it has a reflex vertex, 2 if edges intersect, 3 if degenerate.
 int face_polygon_defect(const std::vector<Vec3>& nodes, const int32_t* begin, const int32_t* end,

@@ -51,16 +51,18 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   Progress progress("checks", 9);
   MeshGeometry geo = compute_geometry(mesh);
   progress.advance();
-  r.checks.push_back(check_convexity(mesh, geo, opt)), progress.advance();
+  const CellScales scales = compute_cell_scales(mesh, opt.rel_tol);  // volume and auto-centering
+  std::vector<CheckResult> shapes = check_shapes(mesh, geo, opt, &scales, &r.model_cells_not_judged);
+  progress.advance(4);
+  r.checks.push_back(std::move(shapes[0]));
   r.checks.push_back(check_conformity(mesh, geo, opt, build)), progress.advance();
   r.checks.push_back(check_closure(mesh, geo, opt)), progress.advance();
-  const CellScales scales = compute_cell_scales(mesh, opt.rel_tol);  // volume and auto-centering
   r.checks.push_back(check_volume(mesh, geo, opt, scales)), progress.advance();
-  r.checks.push_back(check_orthogonality(mesh, geo, opt)), progress.advance();
-  r.checks.push_back(check_auto_centering(mesh, geo, opt, scales)), progress.advance();
-  r.checks.push_back(check_planarity(mesh, geo, opt)), progress.advance();
+  for (int i = 1; i < 4; ++i) r.checks.push_back(std::move(shapes[i]));
   r.q_s = cell_shape_quality(mesh, h_ref);
-  r.q_o_cell = cell_min_of_faces(mesh, r.k_metric ? face_orthogonality(mesh, geo) : r.find("orthogonality")->values);
+  // Q_O and Q_P of every cell, the model's too (the checks' values cover only the judged cells).
+  const bool whole = r.model_cells_not_judged == 0;
+  r.q_o_cell = cell_min_of_faces(mesh, r.k_metric || !whole ? face_orthogonality(mesh, geo) : r.find("orthogonality")->values);
   bool has_perm = true;
   for (const Vec3& k : mesh.cell_perm)
     has_perm = has_perm && k.x > 0 && k.y > 0 && k.z > 0 && std::isfinite(k.x + k.y + k.z);
@@ -73,7 +75,7 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
     r.k_angle_all = stats_of(r.k_angle_cell);
     r.k_angle_interior_all = stats_of(r.k_angle_interior_cell);
   }
-  r.q_p_cell = cell_max_of_faces(mesh, r.find("planarity")->values);
+  r.q_p_cell = cell_max_of_faces(mesh, whole ? r.find("planarity")->values : face_planarity(mesh, geo));
   r.q_s_all = stats_of(r.q_s);
   r.q_o_all = stats_of(r.q_o_cell);
   r.q_p_all = stats_of(r.q_p_cell);
@@ -106,6 +108,9 @@ std::string report_summary_text(const FvReport& r) {
   os << "fvcheck: " << (r.source.empty() ? "mesh" : r.source) << ": " << r.cells << " cells, " << r.faces
      << " faces, " << r.nodes << " nodes\n";
   for (const std::string& n : r.notes) os << "  note: " << n << "\n";
+  if (r.model_cells_not_judged > 0)
+    os << "  convexity, orthogonality, auto-centering and planarity judge the " << r.cells - r.model_cells_not_judged
+       << " near-well cells; the " << r.model_cells_not_judged << " cells of the corner-point model are the user's\n";
   if (!r.structure.ok) {
     os << "  structure       FAILED (checks skipped)\n";
     for (const std::string& p : r.structure.problems) os << "    " << p << "\n";

@@ -37,6 +37,8 @@ struct FvReport {
   int64_t cells = 0, faces = 0, nodes = 0, boundary_faces = 0;
   CheckOptions options;
   CsrReport structure;                       ///< CSR invariants; when not ok the checks are skipped
+  /// Cells the shape checks do not judge: a corner-point model's cells (PolyMesh::reservoir_cells_are_model).
+  int64_t model_cells_not_judged = 0;
   std::vector<CheckResult> checks;           ///< fixed order: convexity, conformity, closure, volume,
                                              ///< orthogonality, auto_centering, planarity
   std::vector<double> q_s, q_o_cell, q_p_cell;  ///< per cell (empty if skipped); Q_O Euclidean

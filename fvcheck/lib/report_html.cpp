@@ -101,6 +101,10 @@ std::string report_html(const FvReport& r) {
     h << "<tr><td class='l'>" << xml_escape(rq.name) << " cells</td><td>" << rq.cells << "</td></tr>";
   h << "</table>\n";
   for (const std::string& n : r.notes) h << "<p class='small'>Note: " << xml_escape(n) << "</p>\n";
+  if (r.model_cells_not_judged > 0)
+    h << "<p class='small'>Convexity, orthogonality, auto-centering and planarity judge the "
+      << r.cells - r.model_cells_not_judged << " near-well cells; the " << r.model_cells_not_judged
+      << " cells of the corner-point model are the user's.</p>\n";
 
   // Checks.
   if (!r.pictures.empty()) {

@@ -272,4 +272,39 @@ CsrReport check_csr_invariants(const PolyMesh& m) {
   return r;
 }
 
+
+PolyMesh cells_as_mesh(const PolyMesh& mesh, const std::vector<char>& keep, std::vector<int32_t>* cell_of) {
+  MeshBuilder b;
+  std::vector<int32_t> node(mesh.n_nodes(), -1);
+  std::vector<CellFace> faces;
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    if (!keep[c]) continue;
+    faces.clear();
+    for (const int32_t* fp = mesh.cell_begin(c); fp != mesh.cell_end(c); ++fp) {
+      CellFace f;
+      for (const int32_t* v = mesh.face_begin(*fp); v != mesh.face_end(*fp); ++v) {
+        if (node[*v] < 0) node[*v] = b.add_node(mesh.nodes[*v]);
+        f.nodes.push_back(node[*v]);
+      }
+      if (mesh.face_owner[*fp] != c) std::reverse(f.nodes.begin(), f.nodes.end());
+      const int32_t other = mesh.face_owner[*fp] == c ? mesh.face_neighbour[*fp] : mesh.face_owner[*fp];
+      f.patch = other < 0 ? mesh.face_patch[*fp] : (keep[other] ? kInteriorFace : kOuterBoundary);
+      faces.push_back(std::move(f));
+    }
+    CellAttributes at;
+    at.region = mesh.cell_region[c];
+    at.fv_center = mesh.cell_fv_center[c];
+    at.ijk = mesh.cell_ijk[c];
+    at.perm = mesh.cell_perm[c];
+    at.porosity = mesh.cell_porosity[c];
+    at.radial = mesh.cell_radial[c];
+    b.add_cell(faces, at);
+    cell_of->push_back(c);
+  }
+  BuildReport report;
+  PolyMesh sub = b.finish(&report);
+  sub.metric_scale = mesh.metric_scale;
+  return sub;
+}
+
 }  // namespace hm

@@ -50,6 +50,7 @@ class MeshBuilder {
     int32_t patch = kInteriorFace;
     int uses = 0;
   };
+
   std::vector<Vec3> nodes_;
   std::vector<int32_t> face_ptr_{0};
   std::vector<int32_t> face_nodes_;
@@ -67,6 +68,11 @@ class MeshBuilder {
   std::vector<CellAttributes> cells_;
   BuildReport report_;
 };
+
+/// The cells with keep[c] as a mesh of their own: faces toward the other cells become boundary
+/// faces (kOuterBoundary), the other attributes and metric_scale are kept; (*cell_of)[k] is the
+/// whole mesh's cell of cell k. `mesh` must pass check_csr_invariants.
+PolyMesh cells_as_mesh(const PolyMesh& mesh, const std::vector<char>& keep, std::vector<int32_t>* cell_of);
 
 /// The canonical key of a face cycle: rotated to start at its smallest id, oriented so
 /// that the second entry is the smaller neighbour. `reversed` tells whether the

@@ -77,6 +77,11 @@ struct PolyMesh {
   /// docs/anisotropy.md), product 1; (1, 1, 1) for a Euclidean mesh. cell_radial's radii and
   /// lengths are those of the scaled frame x' = S^-1 x, where the transmissibilities are computed.
   Vec3 metric_scale{1, 1, 1};
+  /// The reservoir cells (region kReservoir) are a user's corner-point model's cells as given: not
+  /// ours, so the shape checks (convexity, orthogonality, auto-centering, planarity) judge only the
+  /// other cells (fvcheck/lib/checks.hpp, check_shapes); fvcheck then checks the transmissibilities
+  /// of deck_transmissibility_options, the ones solver_demo and the Eclipse deck use.
+  bool reservoir_cells_are_model = false;
 
   int n_nodes() const { return static_cast<int>(nodes.size()); }
   int n_faces() const { return static_cast<int>(face_owner.size()); }

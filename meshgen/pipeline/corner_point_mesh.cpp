@@ -200,6 +200,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   summarize_transitions(out, transitions, coords);
   std::vector<std::vector<int>> cavity_wells;
   for (const Cavity& c : out.cavities.cavities) cavity_wells.push_back(c.wells);
+  out.mesh.reservoir_cells_are_model = cs.reservoir.corner_point != nullptr;
   out.self_check = self_check(out.mesh, out.geometry, out.build_report, out.cell_cavity, cavity_wells, cs);
   stage.mark("self_check");
   if (!out.self_check.ok()) throw MeshingError("self-check", out.self_check.wells, out.self_check.message);
@@ -234,6 +235,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
                        "assembly: the corner-point cells do not conform: " +
                            (out.build_report.problems.empty() ? std::string("?") : out.build_report.problems[0]));
   if (!opts.build_transition) return out;
+  out.mesh.reservoir_cells_are_model = cs.reservoir.corner_point != nullptr;
   out.self_check = self_check(out.mesh, out.geometry, out.build_report, out.cell_cavity, {}, cs);
   stage.mark("self_check");
   if (!out.self_check.ok()) throw MeshingError("self-check", {}, out.self_check.message);

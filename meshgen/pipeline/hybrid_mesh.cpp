@@ -387,6 +387,7 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
   timer.mark("transition_quality");
   std::vector<std::vector<int>> cavity_wells;
   for (const Cavity& c : out.cavities.cavities) cavity_wells.push_back(c.wells);
+  out.mesh.reservoir_cells_are_model = cs.reservoir.corner_point != nullptr;
   out.self_check = self_check(out.mesh, out.geometry, out.build_report, out.cell_cavity, cavity_wells, cs);
   timer.mark("self_check");
   if (!out.self_check.ok())

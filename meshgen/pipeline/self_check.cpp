@@ -59,51 +59,6 @@ std::string cell_text(const PolyMesh& mesh, int32_t c, const std::vector<int32_t
   return os.str();
 }
 
-// The cells of a corner-point model (reservoir cells when the case has one): the user's cells, whose
-// faces are in general neither planar nor orthogonal to the centre-to-centre segments.
-std::vector<char> model_cells(const PolyMesh& mesh, const CaseSpec& cs) {
-  std::vector<char> model(mesh.n_cells(), 0);
-  if (cs.reservoir.corner_point)
-    for (int c = 0; c < mesh.n_cells(); ++c) model[c] = mesh.cell_region[c] == kReservoir;
-  return model;
-}
-
-// The cells with keep[c] as a mesh of their own (faces toward the others become boundary faces);
-// `cell_of` maps its cells back.
-PolyMesh kept_cells(const PolyMesh& mesh, const std::vector<char>& keep, std::vector<int32_t>* cell_of) {
-  MeshBuilder b;
-  std::vector<int32_t> node(mesh.n_nodes(), -1);
-  std::vector<CellFace> faces;
-  for (int c = 0; c < mesh.n_cells(); ++c) {
-    if (!keep[c]) continue;
-    faces.clear();
-    for (const int32_t* fp = mesh.cell_begin(c); fp != mesh.cell_end(c); ++fp) {
-      CellFace f;
-      for (const int32_t* v = mesh.face_begin(*fp); v != mesh.face_end(*fp); ++v) {
-        if (node[*v] < 0) node[*v] = b.add_node(mesh.nodes[*v]);
-        f.nodes.push_back(node[*v]);
-      }
-      if (mesh.face_owner[*fp] != c) std::reverse(f.nodes.begin(), f.nodes.end());
-      const int32_t other = mesh.face_owner[*fp] == c ? mesh.face_neighbour[*fp] : mesh.face_owner[*fp];
-      f.patch = other < 0 ? mesh.face_patch[*fp] : (keep[other] ? kInteriorFace : kOuterBoundary);
-      faces.push_back(std::move(f));
-    }
-    CellAttributes at;
-    at.region = mesh.cell_region[c];
-    at.fv_center = mesh.cell_fv_center[c];
-    at.ijk = mesh.cell_ijk[c];
-    at.perm = mesh.cell_perm[c];
-    at.porosity = mesh.cell_porosity[c];
-    at.radial = mesh.cell_radial[c];
-    b.add_cell(faces, at);
-    cell_of->push_back(c);
-  }
-  BuildReport report;
-  PolyMesh sub = b.finish(&report);
-  sub.metric_scale = mesh.metric_scale;
-  return sub;
-}
-
 }  // namespace
 
 SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildReport& build,
@@ -122,34 +77,10 @@ SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildR
   checks.push_back(check_conformity(mesh, geo, opt, &build)), progress.advance();
   checks.push_back(check_closure(mesh, geo, opt)), progress.advance();
   checks.push_back(check_volume(mesh, geo, opt)), progress.advance();
-  // The shape checks (convexity, orthogonality, auto-centring, planarity) hold for every cell we
-  // make; the cells of a corner-point model are the user's and are exempt (docs/mesh-layout.md).
-  const std::vector<char> model = model_cells(mesh, cs);
-  const bool has_model = std::find(model.begin(), model.end(), 1) != model.end();
-  std::vector<int32_t> cell_of;
-  PolyMesh sub;
-  if (has_model) {
-    std::vector<char> ours(model.size());
-    for (size_t c = 0; c < model.size(); ++c) ours[c] = !model[c];
-    sub = kept_cells(mesh, ours, &cell_of);
-  }
-  const PolyMesh& shaped = has_model ? sub : mesh;
-  const MeshGeometry sub_geo = has_model ? compute_geometry(sub) : MeshGeometry{};
-  const MeshGeometry& shaped_geo = has_model ? sub_geo : geo;
-  std::vector<CheckResult> shape;
-  if (shaped.n_cells() > 0) {
-    shape.push_back(check_convexity(shaped, shaped_geo, opt)), progress.advance();
-    shape.push_back(check_orthogonality(shaped, shaped_geo, opt)), progress.advance();
-    shape.push_back(check_auto_centering(shaped, shaped_geo, opt)), progress.advance();
-    shape.push_back(check_planarity(shaped, shaped_geo, opt)), progress.advance();
-  }
-  for (CheckResult& r : shape) {
-    if (has_model) {  // ids of the kept cells' mesh -> cells of the whole mesh
-      for (int32_t& id : r.worst_ids) id = cell_of[r.id_kind == IdKind::Face ? sub.face_owner[id] : id];
-      r.id_kind = IdKind::Cell;
-    }
-    checks.push_back(std::move(r));
-  }
+  // The shape checks hold for every cell we make; a corner-point model's cells are the user's and
+  // are exempt (PolyMesh::reservoir_cells_are_model, docs/mesh-layout.md).
+  for (CheckResult& r : check_shapes(mesh, geo, opt)) checks.push_back(std::move(r));
+  progress.advance(4);
   for (const CheckResult& r : checks) {
     if (r.ok()) continue;
     SelfCheckFailure f;

@@ -27,6 +27,7 @@
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "../exporters/exporter_test_support.hpp"
 #include "corner_point_test_models.hpp"
+#include "fvcheck/lib/report.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 
 using namespace hm;
@@ -650,4 +651,44 @@ TEST(CornerPointWells, ModelMultipliersAreOnTheModelFacesAndTheCavityWalls) {
     ASSERT_EQ(by_nodes.count(key), 1u) << f;
     ASSERT_EQ(back.mesh.face_trans_mult[f], by_nodes[key]) << f;
   }
+}
+
+// A model's mesh says so (PolyMesh::reservoir_cells_are_model), mesh.vtu carries it, and fvcheck then
+// judges the shapes (convexity, orthogonality, auto-centering, planarity) of the near-well cells only,
+// as the self-check does: the model's cells are the user's. The same mesh with the flag cleared is
+// judged whole.
+TEST(CornerPointWells, FvcheckJudgesTheNearWellCellsOfAModelsMeshReadFromItsVtu) {
+  TempDir tmp("cpfvcheck");
+  TiltedModel g;
+  const CaseSpec cs = case_of(tmp, g, vertical_well(90, 90, 1034, 1046));
+  const HybridMesh out = build_hybrid_mesh(cs);
+  expect_sound_mesh(cs, out);
+  ASSERT_TRUE(out.mesh.reservoir_cells_are_model);
+  const std::string path = (tmp.path / "mesh.vtu").string();
+  ASSERT_TRUE(write_vtu(path, out.mesh).ok);
+  const ReadResult back = read_vtu(path);
+  ASSERT_TRUE(back.ok) << back.error;
+  EXPECT_TRUE(back.mesh.reservoir_cells_are_model);
+  int64_t model = 0;
+  for (int c = 0; c < back.mesh.n_cells(); ++c) model += back.mesh.cell_region[c] == kReservoir;
+  const FvReport judged = run_fvcheck(back.mesh, CheckOptions{});
+  EXPECT_EQ(judged.model_cells_not_judged, model);
+  EXPECT_TRUE(judged.ok()) << report_summary_text(judged);
+
+  PolyMesh whole = back.mesh;
+  whole.reservoir_cells_are_model = false;
+  const FvReport all = run_fvcheck(whole, CheckOptions{});
+  EXPECT_EQ(all.model_cells_not_judged, 0);
+  // Judged whole, the model's twisted cells are measured too: the worst convexity value is theirs.
+  EXPECT_GT(all.find("convexity")->worst, judged.find("convexity")->worst);
+  std::printf("[ figures  ] tilted model with a well: %lld model cells not judged; judged whole: convexity worst %.3g "
+              "(near-well cells %.3g), %lld violations\n",
+              static_cast<long long>(model), all.find("convexity")->worst, judged.find("convexity")->worst,
+              static_cast<long long>(all.find("convexity")->violations));
+
+  // A mesh without a model (the flag unset) writes no such field: read back, it stays unset.
+  PolyMesh plain = out.mesh;
+  plain.reservoir_cells_are_model = false;
+  ASSERT_TRUE(write_vtu(path, plain).ok);
+  EXPECT_FALSE(read_vtu(path).mesh.reservoir_cells_are_model);
 }
