@@ -1,4 +1,4 @@
-// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--quiet] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]
+// meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--quiet] [--export vtu,eclipse,openfoam] [--eclipse-steady] [--png] [--png-size WxH]
 // Exit codes: 0 success, 1 meshing failure (a stage, wells named; a mesh that fails the
 // self-check is never written), 2 bad input or arguments.
 #include <chrono>
@@ -30,11 +30,13 @@ namespace {
 
 int usage(const std::string& why) {
   std::cerr << "meshgen: " << why << "\n"
-            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--quiet] [--export vtu,eclipse,openfoam] [--png] [--png-size WxH]\n"
+            << "usage: meshgen CASE.yaml -o OUTDIR [--no-optimize] [--no-transition] [-j N] [--quiet] [--export vtu,eclipse,openfoam] [--eclipse-steady] [--png] [--png-size WxH]\n"
             << "  -j N: at most N threads (cavities meshed and optimised at once, parallel checks; default: every core)\n"
             << "  --quiet: no progress lines on stderr (shown only on a terminal, for stages over 2 s)\n"
             << "  mesh.vtu, summary.json and cavity_K.obj are always written; --export adds\n"
             << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n"
+            << "  --eclipse-steady: the deck is one long step, a steady-state solve for flow with the options its first\n"
+            << "  line names (default: a transient that flow runs as typed; docs/export-eclipse.md).\n"
             << "  --png: pictures beside mesh.vtu (VTK, off-screen; re-runs under xvfb-run without an X display):\n"
             << "  well_K_region.png and well_K_qs.png (a cut along well K's trajectory), overview.png;\n"
             << "  --png-size WxH: their size in pixels (default 1200x900; implies --png).\n";
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
   hm::PipelineOptions opts;
   bool export_eclipse = false, export_openfoam = false, pictures = false, quiet = false;
   hm::PictureOptions picture_opts;
+  hm::EclipseDeckOptions deck_opts;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-o" || a == "--output") {
@@ -77,6 +80,8 @@ int main(int argc, char** argv) {
         else if (item != "vtu") return usage("--export: unknown format '" + item + "' (expected vtu, eclipse or openfoam)");
         start = comma + 1;
       }
+    } else if (a == "--eclipse-steady") {
+      deck_opts.schedule = hm::EclipseSchedule::SingleStep;
     } else if (a == "--png") {
       pictures = true;
     } else if (a == "--png-size") {
@@ -166,7 +171,7 @@ int main(int argc, char** argv) {
   if (export_eclipse) {
     hm::EclipseDeckInfo info;
     const hm::WriteStatus st =
-        hm::write_eclipse_deck((out / "eclipse").string(), cs, result.mesh, result.geometry, *trans, {}, &info);
+        hm::write_eclipse_deck((out / "eclipse").string(), cs, result.mesh, result.geometry, *trans, deck_opts, &info);
     if (!st.ok) {
       std::cerr << "meshgen: " << st.message << "\n";
       return 2;

@@ -92,9 +92,12 @@ bool flow_installed() { return have("flow") && fs::exists("/usr/bin/python3"); }
 // meshgen CASE --export eclipse, flow NAME.DATA as typed, solver_demo CASE: the same steady state.
 // `d` is the test's folder (the fail half's incompressible copy of the case is written there).
 // `flow_options`: flow's command-line options where as typed is not enough (said in the figures).
+// meshgen_options: e.g. --eclipse-steady; flow then runs with the options the deck's first line
+// names (none for the default deck), plus flow_options.
 void run_case_file(const fs::path& yaml, const std::string& example, const fs::path& d,
-                   bool expect_compressibility_visible, double gate, const std::string& flow_options = "") {
-  const auto mg = run_command(kMeshgen + " " + q(yaml) + " -o " + q(d / "mesh") + " --export eclipse", 900);
+                   bool expect_compressibility_visible, double gate, const std::string& flow_options = "",
+                   const std::string& meshgen_options = "") {
+  const auto mg = run_command(kMeshgen + " " + q(yaml) + " -o " + q(d / "mesh") + " --export eclipse " + meshgen_options, 900);
   if (mg.exit_code == 2 && mg.err.find("--export") != std::string::npos)
     GTEST_SKIP() << "meshgen does not accept --export eclipse yet: " << mg.err;
   ASSERT_EQ(mg.exit_code, 0) << mg.out << mg.err;
@@ -105,14 +108,23 @@ void run_case_file(const fs::path& yaml, const std::string& example, const fs::p
     if (e.path().extension() == ".DATA") name = e.path().stem().string();
   ASSERT_FALSE(name.empty()) << mg.out;
 
-  // flow as a user types it: `flow NAME.DATA`, no options (the deck says so in its first lines;
-  // --output-dir only chooses where flow writes).
+  // flow as the deck's first line says (the default deck: `flow NAME.DATA`, no options; --output-dir
+  // only chooses where flow writes).
   const std::string data = slurp(deck_dir / (name + ".DATA"));
-  ASSERT_NE(data.find("-- Run: flow " + name + ".DATA"), std::string::npos) << data.substr(0, 400);
+  const std::string run = "\n-- Run: flow ";
+  const size_t at = data.find(run);
+  ASSERT_NE(at, std::string::npos) << data.substr(0, 400);
+  const std::string line = data.substr(at + run.size(), data.find('\n', at + 1) - at - run.size());
+  const size_t deck_at = line.find(name + ".DATA");
+  ASSERT_NE(deck_at, std::string::npos) << line;
+  const std::string deck_options = line.substr(0, deck_at);
+  if (meshgen_options.empty()) {
+    EXPECT_EQ(deck_options, "") << line;
+  }
   const auto t0 = std::chrono::steady_clock::now();
-  const auto fl = run_command("sh -c 'cd " + q(deck_dir) + " && flow --output-dir=out " + flow_options + " " + name +
-                                  ".DATA'",
-                              900);
+  const auto fl = run_command("sh -c 'cd " + q(deck_dir) + " && flow --output-dir=out " + deck_options + flow_options +
+                                  " " + name + ".DATA'",
+                              1800);
   const double flow_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(fl.exit_code, 0) << fl.out.substr(fl.out.size() > 4000 ? fl.out.size() - 4000 : 0) << fl.err;
   const auto rd = run_command("/usr/bin/python3 " + q(std::string(HM_SOURCE_DIR) + "/scripts/validate_flow.py") + " " +
@@ -122,7 +134,7 @@ void run_case_file(const fs::path& yaml, const std::string& example, const fs::p
   const nlohmann::json res = nlohmann::json::parse(rd.out);
 
   // Our solve of the same case.
-  const auto sd = run_command(kSolver + " " + q(yaml) + " -o " + q(d / "solve"), 900);
+  const auto sd = run_command(kSolver + " " + q(yaml) + " -o " + q(d / "solve"), 1800);
   ASSERT_EQ(sd.exit_code, 0) << sd.out << sd.err;
   const nlohmann::json ours = nlohmann::json::parse(slurp(d / "solve" / "solution.json"));
 
@@ -133,10 +145,10 @@ void run_case_file(const fs::path& yaml, const std::string& example, const fs::p
   EXPECT_LT(diff.pmax, gate);
   EXPECT_LT(diff.pmean, gate);
   EXPECT_LT(diff.rate, gate);
+  const std::string how = deck_options + flow_options;
   std::printf("[ figures  ] %s: flow %s (%.2f s) vs solver_demo: pressure min %.3g, max %.3g, mean %.3g "
               "(relative); rates %.3g\n",
-              example.c_str(), flow_options.empty() ? "as typed" : flow_options.c_str(), flow_s, diff.pmin, diff.pmax,
-              diff.pmean, diff.rate);
+              example.c_str(), how.empty() ? "as typed" : how.c_str(), flow_s, diff.pmin, diff.pmax, diff.pmean, diff.rate);
 
   // Fail half, where the case's compressibility matters: solver_demo of the case made nearly
   // incompressible misses flow's run of the shipped case by more than the gate.
@@ -236,6 +248,22 @@ TEST(FlowMeshgen, ReekProducerAndInjectorDeckMatchesSolverDemo) {
           "1760]]\n    radius: 0.1\n    drainage_radius: 5\n    end_caps: flat\n    bhp: 250\n";
   std::ofstream(d / "reek2.yaml") << text;
   run_case_file(d / "reek2.yaml", "reek, producer and injector", d, false, 1e-6, "--linear-solver-max-iter=2000");
+}
+
+// examples/reek_wells.yaml: Reek's well OP_3 (from its COMPDAT cells), a 600 m horizontal producer in
+// layer 8 and an injector, the model refined near all three (794,930 cells). The default deck's transient
+// takes flow ~30 steps of ~2 min here (docs/corner-point.md, "Reek's own wells"); the steady-state deck
+// (meshgen --eclipse-steady: one long step, flow with the options its first line names) plus
+// --linear-solver-max-iter=2000 is one step (~7 min of flow, ~8 min of solver_demo).
+TEST(FlowMeshgen, ReekWellsExampleSteadyDeckMatchesSolverDemo) {
+  REQUIRE_FLOW_E2E();
+  if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: ~0.8M cells in flow)";
+  const fs::path reek = fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek";
+  if (!fs::exists(reek / "REEK_GRID.DATA")) GTEST_SKIP() << "no " << reek;
+  const fs::path d = fresh_dir("flow_reek_wells");
+  const RemoveAtExit cleanup{d};
+  run_case_file(fs::path(HM_SOURCE_DIR) / "examples" / "reek_wells.yaml", "reek_wells", d, false, 1e-6,
+                "--linear-solver-max-iter=2000", "--eclipse-steady");
 }
 
 TEST(FlowMeshgen, UnwritableExportDirectoryExitsTwoAndLeavesNoDeck) {
