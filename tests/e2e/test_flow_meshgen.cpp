@@ -120,6 +120,8 @@ void run_case_file(const fs::path& yaml, const std::string& example, const fs::p
   const std::string deck_options = line.substr(0, deck_at);
   if (meshgen_options.empty()) {
     EXPECT_EQ(deck_options, "") << line;
+  } else {
+    EXPECT_NE(deck_options, "") << line;
   }
   const auto t0 = std::chrono::steady_clock::now();
   const auto fl = run_command("sh -c 'cd " + q(deck_dir) + " && flow --output-dir=out " + deck_options + flow_options +
@@ -177,6 +179,15 @@ TEST(FlowMeshgen, ThreeWellsAsShippedDeckMatchesSolverDemo) { run_example("three
 // Wells through the reservoir boundary (issue 12): a producer and an injector each, so that the
 // solution is not hydrostatic; flow matches solver_demo to 1e-6.
 TEST(FlowMeshgen, VerticalThroughDeckMatchesSolverDemo) { run_example("vertical_through", false, 1e-6); }
+// The same case as the steady-state deck (meshgen --eclipse-steady): one long step, flow with the
+// options the deck's first line names.
+TEST(FlowMeshgen, VerticalThroughSteadyDeckMatchesSolverDemo) {
+  REQUIRE_FLOW_E2E();
+  const fs::path d = fresh_dir("flow_vertical_through_steady");
+  const RemoveAtExit cleanup{d};
+  run_case_file(std::string(HM_SOURCE_DIR) + "/examples/vertical_through.yaml", "vertical_through (steady deck)", d,
+                false, 1e-6, "", "--eclipse-steady");
+}
 TEST(FlowMeshgen, DeviatedThroughTopDeckMatchesSolverDemo) { run_example("deviated_through_top", false, 1e-6); }
 TEST(FlowMeshgen, HorizontalThroughSidesDeckMatchesSolverDemo) {
   run_example("horizontal_through_sides", false, 1e-6);
