@@ -319,30 +319,37 @@ double read_near_well_cell_size(const YAML::Node& n, const std::string& path) {
 }
 
 // Wells in a corner-point model: the part of each path inside the model's active cells is meshed
-// (meshgen/case/corner_point_path.hpp); the case says so in its notes.
-void clip_paths_to_model(CaseSpec& cs) {
+// (meshgen/case/corner_point_path.hpp), clipped from the path as the user gave it (`as_given`, grid
+// frame); with `note` the case says so in its notes.
+void clip_paths_to_model(CaseSpec& cs, const std::vector<WellSpec>& as_given, SurfaceGapRule rule, bool note) {
   if (!cs.reservoir.corner_point) return;
   for (size_t i = 0; i < cs.wells.size(); ++i) {
     WellSpec& w = cs.wells[i];
     const std::string key = index_path("wells", i);
-    const ClippedPath path = clip_path_to_model(*cs.reservoir.corner_point, w, key);
+    const ClippedPath path = clip_path_to_model(*cs.reservoir.corner_point, as_given[i], key, rule);
     if (!path.clipped()) continue;
     if (w.end_caps == EndCaps::Hemisphere && !w.end_caps_fallback)
       fail(key + ".end_caps", "hemisphere caps need both ends of the path inside the corner-point model; this well "
                               "crosses the model's surface (use flat or auto)");
     w.end_caps = EndCaps::Flat;
     w.end_caps_fallback = false;
-    std::string note = key + " (" + w.name + "): its path crosses the corner-point model's surface; the radial block is "
-                       "built from measured depth " + fmt6(path.md.front()) + " to " + fmt6(path.md.back()) +
-                       " m (flat ends " + fmt(kSurfaceGap) + " x drainage_radius from the surface) and the transition "
-                       "fills the rest to the surface";
-    bool open_outside = false;
-    for (const auto& iv : w.perforations) open_outside = open_outside || iv[0] < path.md.front() || iv[1] > path.md.back();
-    if (w.perforations.empty()) note += "; the path between the surface and the block has no wellbore connection";
-    if (open_outside) note += "; perforated depths outside that range have no wellbore connection";
-    cs.notes.push_back(note);
     w.trajectory = path.points;
     w.trajectory_md = path.md;
+    if (!note) continue;
+    std::string gaps;
+    for (int e = 0; e < 2; ++e)
+      if (path.cut[e] > 0)
+        gaps += std::string(gaps.empty() ? "" : ", ") + (e == 0 ? "start " : "end ") + fmt6(path.gap[e]) + " m (" +
+                fmt6(path.gap[e] / w.drainage_radius) + " x drainage_radius)";
+    std::string text = key + " (" + w.name + "): its path crosses the corner-point model's surface; the radial block is "
+                       "built from measured depth " + fmt6(path.md.front()) + " to " + fmt6(path.md.back()) +
+                       " m (flat ends that keep " + gaps + " from the surface) and the transition fills the rest to "
+                       "the surface";
+    bool open_outside = false;
+    for (const auto& iv : w.perforations) open_outside = open_outside || iv[0] < path.md.front() || iv[1] > path.md.back();
+    if (w.perforations.empty()) text += "; the path between the surface and the block has no wellbore connection";
+    if (open_outside) text += "; perforated depths outside that range have no wellbore connection";
+    cs.notes.push_back(text);
   }
 }
 
@@ -642,9 +649,15 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   }
   for (WellSpec& w : cs.wells)
     for (Vec3& p : w.trajectory) p = map_to_grid(cs.reservoir, p);
-  clip_paths_to_model(cs);
+  // The path's part inside the model, ended kSurfaceGapMin x R inside the surface: the refinement
+  // follows it. Then, in the refined model, ended where the surface's faces near each end allow
+  // (surface_gap, at least that much).
+  const std::vector<WellSpec> as_given = cs.wells;
+  clip_paths_to_model(cs, as_given, SurfaceGapRule::Least, false);
   check_wells(cs);
   refine_near_wells(cs);
+  clip_paths_to_model(cs, as_given, SurfaceGapRule::SurfaceFaces, true);
+  check_wells(cs);
   return cs;
 }
 
@@ -681,6 +694,15 @@ std::vector<double> well_measured_depths(const WellSpec& ws) {
   std::vector<double> md(ws.trajectory.size(), 0.0);
   for (size_t i = 1; i < md.size(); ++i) md[i] = md[i - 1] + norm(ws.trajectory[i] - ws.trajectory[i - 1]);
   return md;
+}
+
+std::vector<double> ring_radii(const WellSpec& ws) {
+  std::vector<double> radii(ws.rings + 1);
+  const double ratio = ws.drainage_radius / ws.radius;
+  for (int i = 0; i <= ws.rings; ++i) radii[i] = ws.radius * std::pow(ratio, static_cast<double>(i) / ws.rings);
+  radii[0] = ws.radius;
+  radii[ws.rings] = ws.drainage_radius;
+  return radii;
 }
 
 std::vector<double> hemisphere_end_grading(const WellSpec& ws) {

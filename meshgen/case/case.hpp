@@ -96,6 +96,10 @@ std::vector<double> well_measured_depths(const WellSpec& ws);
 /// from orthogonal).
 inline int hemisphere_cap_bands(int sectors) { return (sectors + 2) / 4 + 1; }
 
+/// The radii of a well's rings, r_w = radii[0] < ... < radii[rings] = drainage radius, in geometric
+/// progression (the radial block's, meshgen/grids/well_block.hpp).
+std::vector<double> ring_radii(const WellSpec& ws);
+
 /// Distances from a trajectory end of the extra stations of a block with hemispherical caps
 /// (empty with flat ends): r_k - r_w, k = 1, 2, ... (r_k = r_w q^k, q the ring ratio), while the
 /// layer they close (r_k - r_{k-1} thick) is thinner than a segment, within 3 segments of the

@@ -91,7 +91,36 @@ bool CornerPointInterior::contains(Vec3 q) const {
   return false;
 }
 
-ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, const std::string& key) {
+double surface_gap(const CornerPointModel& m, Vec3 at, const WellSpec& ws) {
+  const double R = ws.drainage_radius, reach = R + kSurfaceGap * R;
+  // The block's outer end-face polygon: from the last ring's inner radius to R over one sector.
+  const double r_in = ring_radii(ws)[ws.rings - 1], arc = 2 * kPi / std::max(3, ws.sectors);
+  const Vec3 outer_far{R * std::cos(arc), R * std::sin(arc), 0}, inner_near{r_in, 0, 0};
+  auto active = [&](int i, int j, int k) {
+    return i >= 0 && j >= 0 && k >= 0 && i < m.nx && j < m.ny && k < m.nz && m.actnum[i + m.nx * (j + m.ny * k)];
+  };
+  // kFaces in the order -i, +i, -j, +j, -k, +k: the logical neighbour across each.
+  constexpr int kStep[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+  double longest = 0;
+  for (int c = 0; c < static_cast<int>(m.corners.size()); ++c) {
+    if (!m.actnum[c]) continue;
+    const int i = c % m.nx, j = c / m.nx % m.ny, k = c / (m.nx * m.ny);
+    for (int f = 0; f < 6; ++f) {
+      if (active(i + kStep[f][0], j + kStep[f][1], k + kStep[f][2])) continue;
+      std::array<Vec3, 4> q;
+      bool near = false;
+      for (int v = 0; v < 4; ++v) q[v] = m.corners[c][kFaces[f][v]], near = near || norm(q[v] - at) <= reach;
+      if (!near) continue;
+      for (int v = 0; v < 4; ++v) longest = std::max(longest, norm(q[(v + 1) % 4] - q[v]));
+      longest = std::max({longest, norm(q[2] - q[0]), norm(q[3] - q[1])});
+    }
+  }
+  longest = std::max(longest, norm(outer_far - inner_near));
+  return std::clamp(kSurfaceGapMargin * 0.5 * longest, kSurfaceGapMin * R, kSurfaceGap * R);
+}
+
+ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, const std::string& key,
+                               SurfaceGapRule rule) {
   const std::string tkey = key + ".trajectory";
   const Polyline path(ws.trajectory);
   const std::vector<double> md = well_measured_depths(ws);
@@ -138,15 +167,15 @@ ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, co
   for (int i = -1; i <= 1; ++i)
     for (int j = -1; j <= 1; ++j)
       for (int k = -1; k <= 1; ++k)
-        if (i || j || k) around.push_back(gap * normalized(Vec3{double(i), double(j), double(k)}));
-  auto end_clear = [&](double s) {
+        if (i || j || k) around.push_back(normalized(Vec3{double(i), double(j), double(k)}));
+  auto end_clear = [&](double s, double g) {
     const Vec3 p = path.at(s), d = path.direction(s);
     const Vec3 helper = std::abs(d.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
     const Vec3 u = normalized(cross(d, helper)), v = cross(d, u);
     for (int k = -1; k < 16; ++k) {
       const Vec3 q = k < 0 ? p : p + R * (std::cos(2 * kPi * k / 16) * u + std::sin(2 * kPi * k / 16) * v);
-      for (const Vec3& g : around)
-        if (!interior.contains(q + g)) return false;
+      for (const Vec3& e : around)
+        if (!interior.contains(q + g * e)) return false;
     }
     return true;
   };
@@ -154,14 +183,23 @@ ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, co
   double b = last < n - 1 ? crossing(s_of(last + 1), s_of(last)) : L;
   const double step = R / 16.0;
   const double a0 = a, b0 = b;
-  if (first > 0)
-    while (a < b && !end_clear(a)) a += step;
-  if (last < n - 1)
-    while (b > a && !end_clear(b)) b -= step;
+  auto gap_at = [&](double s) {
+    return rule == SurfaceGapRule::SurfaceFaces ? surface_gap(m, path.at(s), ws)
+           : rule == SurfaceGapRule::Least      ? kSurfaceGapMin * R
+                                                : gap;
+  };
+  if (first > 0) {
+    out.gap[0] = gap_at(a);
+    while (a < b && !end_clear(a, out.gap[0])) a += step;
+  }
+  if (last < n - 1) {
+    out.gap[1] = gap_at(b);
+    while (b > a && !end_clear(b, out.gap[1])) b -= step;
+  }
   if (!(b - a > std::min(ws.segment_length, R)))
     throw InputError(tkey + ": only " + metres(std::max(0.0, b - a)) + " of its " + metres(b0 - a0) +
-                     " inside the corner-point model's active cells keep " + metres(gap) + " (" +
-                     std::to_string(kSurfaceGap).substr(0, 3) +
+                     " inside the corner-point model's active cells keep " + metres(std::max(out.gap[0], out.gap[1])) +
+                     " (" + std::to_string(std::max(out.gap[0], out.gap[1]) / R).substr(0, 4) +
                      " x drainage_radius) from the model's surface with the whole end cross-section of the radial "
                      "block; a well must run farther into the model, or take a smaller drainage_radius "
                      "(docs/corner-point.md)");

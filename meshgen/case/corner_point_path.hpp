@@ -18,6 +18,13 @@ namespace hm {
 /// block (no cell behind them to deactivate), so their diametral spheres must not reach it: a face
 /// of a near-well cell about R wide (the refinement's target) has a circumradius of ~0.7 R.
 constexpr double kSurfaceGap = 1.0;
+/// Once the model is refined near the wells its surface faces there are smaller than R, and the gap
+/// can follow them (surface_gap): at least this many drainage radii (the end cross-section's rim is
+/// sampled at 16 points; the block's faces between them must keep clear too).
+constexpr double kSurfaceGapMin = 0.25;
+/// surface_gap keeps the end cross-section this many times half the longest edge of the surface's
+/// triangles near it away from the surface: outside their diametral spheres with a margin.
+constexpr double kSurfaceGapMargin = 1.25;
 
 /// Relative size (of the coordinates) of the shift that moves a point off the faces it lies on before
 /// the inside test: far above rounding, far below any cell.
@@ -40,20 +47,36 @@ class CornerPointInterior {
   Vec3 nudge_;
 };
 
+/// The gap (m) the end cross-section of well ws's block (drainage radius R) needs from the model's
+/// surface near `at` (a crossing of the surface, grid frame): kSurfaceGapMargin x the larger of half
+/// the longest edge (sides and diagonals) of the surface faces of active cells within R +
+/// kSurfaceGap R of `at` and half the diagonal of the block's outer end-face polygon (outer ring,
+/// ws.sectors: the diametral spheres of both kinds must stay clear of the other's nodes), clamped to
+/// [kSurfaceGapMin R, kSurfaceGap R]. A surface face is a face whose logical neighbour is outside
+/// the grid or inactive.
+double surface_gap(const CornerPointModel& m, Vec3 at, const WellSpec& ws);
+
+/// How clip_path_to_model sizes the gap: kSurfaceGap x R; kSurfaceGapMin x R (before the model is
+/// refined near the wells: the refinement follows the path so clipped, the longest a block can get);
+/// or surface_gap at each crossing (in the model the wells are meshed in).
+enum class SurfaceGapRule { DrainageRadius, Least, SurfaceFaces };
+
 /// A path clipped to a model: its points and measured depths, and per end (0 start, 1 end) how far
 /// (m, along the path) the meshed end lies from the user's (0: the user's end, inside the model).
 struct ClippedPath {
   std::vector<Vec3> points;
   std::vector<double> md;
   std::array<double, 2> cut{0, 0};
+  std::array<double, 2> gap{0, 0};  ///< per clipped end, the gap (m) its end cross-section keeps
   bool clipped() const { return cut[0] > 0 || cut[1] > 0; }
 };
 
 /// The part of `ws`'s path (grid frame) inside the model's active cells, each end that crosses the
 /// model's surface moved inward (by drainage_radius / 16 steps) until the block's end cross-section
-/// (radius drainage_radius) keeps kSurfaceGap x drainage_radius from the surface (sampled: its centre
-/// and 16 rim points, each in 26 directions). Throws InputError naming `key` when no part is
-/// inside, when the path leaves the model and comes back, or when too little of it is left.
-ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, const std::string& key);
+/// (radius drainage_radius) keeps the gap of `rule` from the surface (sampled: its centre and 16 rim
+/// points, each in 26 directions). Throws InputError naming `key` when no part is inside, when the
+/// path leaves the model and comes back, or when too little of it is left.
+ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, const std::string& key,
+                               SurfaceGapRule rule = SurfaceGapRule::DrainageRadius);
 
 }  // namespace hm

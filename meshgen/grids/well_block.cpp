@@ -112,15 +112,6 @@ std::vector<Leg> make_legs(const WellSpec& ws, int w) {
   return legs;
 }
 
-std::vector<double> ring_radii(const WellSpec& ws) {
-  std::vector<double> radii(ws.rings + 1);
-  const double ratio = ws.drainage_radius / ws.radius;
-  for (int i = 0; i <= ws.rings; ++i) radii[i] = ws.radius * std::pow(ratio, static_cast<double>(i) / ws.rings);
-  radii[0] = ws.radius;
-  radii[ws.rings] = ws.drainage_radius;
-  return radii;
-}
-
 
 std::string bend_phrase(const Leg& g) {
   if (g.bend_start >= 0 && g.bend_end >= 0) return "its bends of " + num(g.bend_start) + " and " + num(g.bend_end) + " degrees";

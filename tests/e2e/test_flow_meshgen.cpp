@@ -262,7 +262,7 @@ TEST(FlowMeshgen, ReekProducerAndInjectorDeckMatchesSolverDemo) {
 }
 
 // examples/reek_wells.yaml: Reek's well OP_3 (from its COMPDAT cells), a 600 m horizontal producer in
-// layer 8 and an injector, the model refined near all three (794,930 cells). The default deck's transient
+// layer 8 and an injector, the model refined near all three (805,822 cells). The default deck's transient
 // takes flow ~30 steps of ~2 min here (docs/corner-point.md, "Reek's own wells"); the steady-state deck
 // (meshgen --eclipse-steady: one long step, flow with the options its first line names) plus
 // --linear-solver-max-iter=2000 is one step (~7 min of flow, ~8 min of solver_demo).

@@ -692,3 +692,35 @@ TEST(CornerPointWells, FvcheckJudgesTheNearWellCellsOfAModelsMeshReadFromItsVtu)
   ASSERT_TRUE(write_vtu(path, plain).ok);
   EXPECT_FALSE(read_vtu(path).mesh.reservoir_cells_are_model);
 }
+
+// A vertical well from above through a model whose wide columns (60 m, R = 5 m) are refined near it:
+// each block end keeps the gap the refined surface's faces and the block's end polygons ask
+// (surface_gap), less than the kSurfaceGap x R kept where the surface's faces are as wide as the well
+// (above), so the block is longer than the 1 R rule gives on the same model; the mesh is sound.
+TEST(CornerPointSurface, RefinedSurfaceLetsTheBlockEndNearerToIt) {
+  TiltedModel g;
+  g.nx = g.ny = 5, g.nz = 10, g.dx = g.dy = 60, g.dz = 3;
+  const double x = 150, y = 150, z_head = 980, z_end = 1070, R = 5;
+  TempDir tmp("cpsurfacegap");
+  const CaseSpec cs = case_of(tmp, g, vertical_well(x, y, z_head, z_end));
+  const CornerPointModel& model = *cs.reservoir.corner_point;
+  ASSERT_FALSE(model.parent_cell.empty()) << "the model is refined near the well";
+  const WellSpec& w = cs.wells[0];
+  WellSpec given = w;
+  given.trajectory = {{x, y, z_head}, {x, y, z_end}};
+  given.trajectory_md = {0, z_end - z_head};
+  const ClippedPath by_surface = clip_path_to_model(model, given, "wells[0]", SurfaceGapRule::SurfaceFaces);
+  const ClippedPath by_radius = clip_path_to_model(model, given, "wells[0]", SurfaceGapRule::DrainageRadius);
+  EXPECT_EQ(w.trajectory, by_surface.points);
+  for (int e = 0; e < 2; ++e) {
+    EXPECT_GE(by_surface.gap[e], kSurfaceGapMin * R);
+    EXPECT_LT(by_surface.gap[e], kSurfaceGap * R);
+  }
+  const double meshed = by_surface.md.back() - by_surface.md.front(), one_r = by_radius.md.back() - by_radius.md.front();
+  std::printf("[ figures  ] refined surface: gaps %.3f and %.3f m (R = %g m); block %.3f m long, %.3f m with 1 R gaps\n",
+              by_surface.gap[0], by_surface.gap[1], R, meshed, one_r);
+  EXPECT_GT(meshed, one_r + R / 4);
+  HybridMesh out;
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  expect_sound_mesh(cs, out);
+}
