@@ -73,82 +73,127 @@ int32_t MeshBuilder::find_face(const std::vector<int32_t>& key, uint64_t hash) c
   }
 }
 
-void MeshBuilder::insert_face(int32_t f, uint64_t hash) {
-  if (2 * (faces_.size() + 1) > table_.size()) {  // load factor <= 1/2
-    std::vector<int32_t> bigger(std::max<size_t>(1024, 2 * table_.size()), -1);
-    const size_t mask = bigger.size() - 1;
-    for (int32_t g : table_) {
-      if (g < 0) continue;
-      size_t i = face_hash_[g] & mask;
-      while (bigger[i] >= 0) i = (i + 1) & mask;
-      bigger[i] = g;
-    }
-    table_.swap(bigger);
+void MeshBuilder::reserve(size_t more_cells, size_t more_faces, size_t more_face_nodes) {
+  const size_t cells = cells_.size() + more_cells, faces = faces_.size() + more_faces;
+  cells_.reserve(cells);
+  cell_ptr_.reserve(cells + 1);
+  cell_faces_.reserve(cell_faces_.size() + 2 * more_faces);
+  faces_.reserve(faces);
+  face_hash_.reserve(faces);
+  face_ptr_.reserve(faces + 1);
+  face_nodes_.reserve(face_nodes_.size() + more_face_nodes);
+  grow_table(faces);
+}
+
+void MeshBuilder::grow_table(size_t faces) {
+  if (2 * faces <= table_.size()) return;  // load factor <= 1/2
+  size_t size = std::max<size_t>(1024, table_.size());
+  while (2 * faces > size) size *= 2;
+  std::vector<int32_t> bigger(size, -1);
+  const size_t mask = bigger.size() - 1;
+  for (int32_t g : table_) {
+    if (g < 0) continue;
+    size_t i = face_hash_[g] & mask;
+    while (bigger[i] >= 0) i = (i + 1) & mask;
+    bigger[i] = g;
   }
+  table_.swap(bigger);
+}
+
+void MeshBuilder::insert_face(int32_t f, uint64_t hash) {
+  grow_table(faces_.size() + 1);
   const size_t mask = table_.size() - 1;
   size_t i = hash & mask;
   while (table_[i] >= 0) i = (i + 1) & mask;
   table_[i] = f;
 }
 
-int32_t MeshBuilder::add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs) {
+bool MeshBuilder::clean_cycle(const CellFace& cf, int32_t cell) {
+  // Drop repeated consecutive nodes (a conformity snap can merge two vertices).
+  std::vector<int32_t>& cyc = cyc_;
+  cyc.clear();
+  for (int32_t v : cf.nodes)
+    if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
+  while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
+  sorted_.assign(cyc.begin(), cyc.end());
+  std::sort(sorted_.begin(), sorted_.end());
+  if (cyc.size() >= 3 && std::adjacent_find(sorted_.begin(), sorted_.end()) == sorted_.end()) return true;
+  ++report_.degenerate_faces;
+  std::ostringstream os;
+  os << "cell " << cell << ": degenerate face with " << cyc.size() << " nodes";
+  note(report_, os.str());
+  return false;
+}
+
+int32_t MeshBuilder::new_face(int32_t cell, int32_t patch, const uint64_t* hash) {
+  const int32_t f = static_cast<int32_t>(faces_.size());
+  if (hash) insert_face(f, *hash);
+  face_hash_.push_back(hash ? *hash : 0);
+  face_nodes_.insert(face_nodes_.end(), cyc_.begin(), cyc_.end());
+  face_ptr_.push_back(static_cast<int32_t>(face_nodes_.size()));
+  FaceRecord rec;
+  rec.owner = cell;
+  rec.patch = patch;
+  rec.uses = 1;
+  faces_.push_back(rec);
+  return f;
+}
+
+bool MeshBuilder::second_use(int32_t f, int32_t cell, bool reversed) {
+  FaceRecord& rec = faces_[f];
+  ++rec.uses;
+  if (rec.uses > 2) {
+    ++report_.overused_faces;
+    std::ostringstream os;
+    os << "face " << f << " named by a third cell " << cell;
+    note(report_, os.str());
+    return false;
+  }
+  // The stored cycle is the owner's orientation: the neighbour must name it reversed.
+  bool stored_reversed = false;
+  stored_.assign(face_nodes_.begin() + face_ptr_[f], face_nodes_.begin() + face_ptr_[f + 1]);
+  canonical_cycle_into(stored_, &sorted_, &stored_reversed);
+  if (sorted_ != key_) {
+    ++report_.unmatched_faces;
+    std::ostringstream os;
+    os << "cell " << cell << " names face " << f << " by its id with other nodes";
+    note(report_, os.str());
+    --rec.uses;
+    return false;
+  }
+  if (stored_reversed == reversed) {
+    ++report_.misoriented_faces;
+    std::ostringstream os;
+    os << "face " << f << " named with the same orientation by cells " << rec.owner << " and " << cell;
+    note(report_, os.str());
+  }
+  rec.neighbour = cell;
+  return true;
+}
+
+int32_t MeshBuilder::add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs,
+                              std::vector<int32_t>* face_ids) {
   const int32_t cell = static_cast<int32_t>(cells_.size());
-  for (const CellFace& cf : faces) {
-    // Drop repeated consecutive nodes (a conformity snap can merge two vertices).
-    std::vector<int32_t>& cyc = cyc_;
-    cyc.clear();
-    for (int32_t v : cf.nodes)
-      if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
-    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    sorted_.assign(cyc.begin(), cyc.end());
-    std::sort(sorted_.begin(), sorted_.end());
-    if (cyc.size() < 3 || std::adjacent_find(sorted_.begin(), sorted_.end()) != sorted_.end()) {
-      ++report_.degenerate_faces;
-      std::ostringstream os;
-      os << "cell " << cell << ": degenerate face with " << cyc.size() << " nodes";
-      note(report_, os.str());
-      continue;
-    }
+  if (face_ids) face_ids->assign(faces.size(), -1);
+  for (size_t i = 0; i < faces.size(); ++i) {
+    const CellFace& cf = faces[i];
+    if (!clean_cycle(cf, cell)) continue;
     bool reversed = false;
-    canonical_cycle_into(cyc, &key_, &reversed);
-    const uint64_t hash = cycle_hash(key_);
-    const int32_t found = find_face(key_, hash);
-    if (found < 0) {
-      const int32_t f = static_cast<int32_t>(faces_.size());
-      insert_face(f, hash);
-      face_hash_.push_back(hash);
-      face_nodes_.insert(face_nodes_.end(), cyc.begin(), cyc.end());
-      face_ptr_.push_back(static_cast<int32_t>(face_nodes_.size()));
-      FaceRecord rec;
-      rec.owner = cell;
-      rec.patch = cf.patch;
-      rec.uses = 1;
-      faces_.push_back(rec);
-      cell_faces_.push_back(f);
-      continue;
+    canonical_cycle_into(cyc_, &key_, &reversed);
+    int32_t f = -1;
+    if (cf.known_face >= 0) {
+      if (cf.known_face >= static_cast<int32_t>(faces_.size()) || !second_use(cf.known_face, cell, reversed)) continue;
+      f = cf.known_face;
+    } else if (cf.by_id_only) {
+      f = new_face(cell, cf.patch, nullptr);
+    } else {
+      const uint64_t hash = cycle_hash(key_);
+      f = find_face(key_, hash);
+      if (f < 0) f = new_face(cell, cf.patch, &hash);
+      else if (!second_use(f, cell, reversed)) continue;
     }
-    const int32_t f = found;
-    FaceRecord& rec = faces_[f];
-    ++rec.uses;
-    if (rec.uses > 2) {
-      ++report_.overused_faces;
-      std::ostringstream os;
-      os << "face " << f << " named by a third cell " << cell;
-      note(report_, os.str());
-      continue;
-    }
-    // The stored cycle is the owner's orientation: the neighbour must name it reversed.
-    bool stored_reversed = false;
-    stored_.assign(face_nodes_.begin() + face_ptr_[f], face_nodes_.begin() + face_ptr_[f + 1]);
-    canonical_cycle_into(stored_, &sorted_, &stored_reversed);
-    if (stored_reversed == reversed) {
-      ++report_.misoriented_faces;
-      std::ostringstream os;
-      os << "face " << f << " named with the same orientation by cells " << rec.owner << " and " << cell;
-      note(report_, os.str());
-    }
-    rec.neighbour = cell;
     cell_faces_.push_back(f);
+    if (face_ids) (*face_ids)[i] = f;
   }
   cell_ptr_.push_back(static_cast<int32_t>(cell_faces_.size()));
   cells_.push_back(attrs);

@@ -19,6 +19,12 @@ namespace hm {
 struct CellFace {
   std::vector<int32_t> nodes;
   int32_t patch = kInteriorFace;
+  /// A face added earlier by another cell, by its id (add_cell's face_ids): this cell is its
+  /// second cell and names it reversed; no lookup by nodes. -1: looked up by its nodes.
+  int32_t known_face = -1;
+  /// A new face that no later cell looks up by its nodes (a boundary face, or one a later
+  /// cell names by id): kept out of the lookup table.
+  bool by_id_only = false;
 };
 
 struct BuildReport {
@@ -36,8 +42,13 @@ class MeshBuilder {
   int32_t add_node(Vec3 p);
   Vec3 node(int32_t id) const { return nodes_[id]; }
   int32_t n_nodes() const { return static_cast<int32_t>(nodes_.size()); }
-  /// Adds a cell; returns its id. Faces must be closed and outward oriented.
-  int32_t add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs);
+  /// Capacity for this many more cells, faces (each new face's nodes counted once) and face
+  /// nodes: a large grid added in one go is then stored without regrowing its arrays.
+  void reserve(size_t more_cells, size_t more_faces, size_t more_face_nodes);
+  /// Adds a cell; returns its id. Faces must be closed and outward oriented. face_ids (if
+  /// given): the id of each face, -1 where the face was refused (degenerate, overused).
+  int32_t add_cell(const std::vector<CellFace>& faces, const CellAttributes& attrs,
+                   std::vector<int32_t>* face_ids = nullptr);
   /// Finishes: compacts unused nodes, fixes patches, returns the mesh. The report says
   /// whether every face was used consistently; the mesh is returned either way so
   /// that a caller can inspect it. The builder's arrays move into the mesh: the builder
@@ -60,6 +71,10 @@ class MeshBuilder {
   // compared in place. face_hash_[f] keeps each face's hash for growing the table.
   int32_t find_face(const std::vector<int32_t>& key, uint64_t hash) const;
   void insert_face(int32_t f, uint64_t hash);
+  void grow_table(size_t faces);
+  bool clean_cycle(const CellFace& cf, int32_t cell);  // the face's cycle into cyc_; false if degenerate
+  int32_t new_face(int32_t cell, int32_t patch, const uint64_t* hash);  // cyc_ as a new face; hashed if hash
+  bool second_use(int32_t f, int32_t cell, bool reversed);  // cell as f's neighbour (key_: its canonical cycle)  // the table for this many faces at load factor <= 1/2
   std::vector<int32_t> table_;
   std::vector<uint64_t> face_hash_;
   std::vector<int32_t> cyc_, sorted_, key_, stored_;  // scratch of add_cell

@@ -1,5 +1,8 @@
 #include "reservoir_grid.hpp"
 
+#include <algorithm>
+#include <array>
+
 namespace hm {
 
 ReservoirGrid make_reservoir_grid(const ReservoirSpec& spec) {
@@ -60,12 +63,27 @@ std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const Reserv
                                          MeshBuilder& builder) {
   std::vector<int32_t> cell_id(grid.n_cells(), -1);
   std::vector<CellFace> faces(6);  // reused: no allocation per cell
+  std::vector<int32_t> face_ids;
+  const size_t n_active = static_cast<size_t>(std::count(active.begin(), active.end(), 1));
+  const size_t n_outer = 2 * (static_cast<size_t>(grid.nx()) * grid.ny() + static_cast<size_t>(grid.ny()) * grid.nz() +
+                              static_cast<size_t>(grid.nx()) * grid.nz());
+  const size_t n_faces = 3 * n_active + n_outer;  // each cell's three low faces, and the far sides
+  builder.reserve(n_active, n_faces, 4 * n_faces);
+  // A face between two active cells is named by id by the second (the structure pairs them);
+  // only faces toward inactive (cavity) cells are looked up by their nodes, by the transition.
+  std::array<std::vector<int32_t>, 3> high_face;  // per axis: the face id of each cell's + side
+  for (auto& h : high_face) h.assign(grid.n_cells(), -1);
   for (int c = 0; c < grid.n_cells(); ++c) {
     if (!active[c]) continue;
     for (int side = 0; side < 6; ++side) {
       const auto fn = grid.cell_face_nodes(c, side);
-      faces[side].nodes.assign({node_ids[fn[0]], node_ids[fn[1]], node_ids[fn[2]], node_ids[fn[3]]});
-      faces[side].patch = grid.neighbour(c, side) < 0 ? kOuterBoundary : kInteriorFace;
+      CellFace& face = faces[side];
+      face.nodes.assign({node_ids[fn[0]], node_ids[fn[1]], node_ids[fn[2]], node_ids[fn[3]]});
+      const int nb = grid.neighbour(c, side);
+      face.patch = nb < 0 ? kOuterBoundary : kInteriorFace;
+      const bool paired = nb >= 0 && active[nb];
+      face.known_face = paired && side % 2 == 0 ? high_face[side / 2][nb] : -1;
+      face.by_id_only = nb < 0 || (paired && side % 2 == 1);
     }
     CellAttributes at;
     at.region = kReservoir;
@@ -74,7 +92,8 @@ std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const Reserv
     at.ijk = {ijk[0], ijk[1], ijk[2]};
     at.perm = reservoir_permeability(spec, c);
     at.porosity = reservoir_porosity(spec, c);
-    cell_id[c] = builder.add_cell(faces, at);
+    cell_id[c] = builder.add_cell(faces, at, &face_ids);
+    for (int axis = 0; axis < 3; ++axis) high_face[axis][c] = face_ids[2 * axis + 1];
   }
   return cell_id;
 }

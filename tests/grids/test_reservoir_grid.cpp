@@ -82,3 +82,96 @@ TEST(ReservoirGrid, NeighboursAndFaceOrientation) {
     EXPECT_GT(dot(n, node(f[0]) - g.cell_center(c)), 0) << "side " << side;
   }
 }
+
+namespace {
+// The grid's active cells added with every face looked up by its nodes (the builder's general
+// path), for comparison with add_reservoir_cells, which pairs faces by the structure.
+PolyMesh by_lookup(const ReservoirGrid& g, const ReservoirSpec& s, const std::vector<char>& active) {
+  MeshBuilder b;
+  const auto nodes = add_reservoir_nodes(g, b);
+  for (int c = 0; c < g.n_cells(); ++c) {
+    if (!active[c]) continue;
+    std::vector<CellFace> faces(6);
+    for (int side = 0; side < 6; ++side) {
+      const auto fn = g.cell_face_nodes(c, side);
+      faces[side].nodes = {nodes[fn[0]], nodes[fn[1]], nodes[fn[2]], nodes[fn[3]]};
+      faces[side].patch = g.neighbour(c, side) < 0 ? kOuterBoundary : kInteriorFace;
+    }
+    CellAttributes at;
+    at.fv_center = g.cell_center(c);
+    at.perm = reservoir_permeability(s, c);
+    b.add_cell(faces, at);
+  }
+  BuildReport rep;
+  return b.finish(&rep);
+}
+}  // namespace
+
+TEST(ReservoirGrid, FacesPairedByTheStructureAreTheFacesFoundByTheirNodes) {
+  const ReservoirSpec s = spec();
+  const ReservoirGrid g = make_reservoir_grid(s);
+  std::vector<char> active(g.n_cells(), 1);
+  active[g.cell_index(2, 1, 1)] = 0;
+  active[g.cell_index(0, 0, 0)] = 0;
+  active[g.cell_index(4, 2, 2)] = 0;
+  MeshBuilder b;
+  const auto nodes = add_reservoir_nodes(g, b);
+  add_reservoir_cells(g, s, nodes, active, b);
+  // The inactive interior cell's six faces are still found by their nodes (as the transition
+  // finds them): a cell naming them reversed closes them.
+  const int hole = g.cell_index(2, 1, 1);
+  std::vector<CellFace> filler(6);
+  for (int side = 0; side < 6; ++side) {
+    const auto fn = g.cell_face_nodes(hole, side);
+    filler[side].nodes = {nodes[fn[0]], nodes[fn[1]], nodes[fn[2]], nodes[fn[3]]};
+  }
+  b.add_cell(filler, CellAttributes{});
+  BuildReport rep;
+  const PolyMesh m = b.finish(&rep);
+  EXPECT_EQ(rep.unmatched_faces, 6);  // the two corner cells' neighbours' faces, unclaimed
+  EXPECT_EQ(rep.misoriented_faces + rep.overused_faces + rep.degenerate_faces, 0);
+  int filler_neighbours = 0;
+  for (int f = 0; f < m.n_faces(); ++f) filler_neighbours += m.face_neighbour[f] == m.n_cells() - 1;
+  EXPECT_EQ(filler_neighbours, 6);
+
+  // Without the filler: the same faces, owners, neighbours and patches as the lookup path.
+  MeshBuilder b2;
+  const auto nodes2 = add_reservoir_nodes(g, b2);
+  add_reservoir_cells(g, s, nodes2, active, b2);
+  BuildReport rep2;
+  const PolyMesh paired = b2.finish(&rep2);
+  const PolyMesh looked_up = by_lookup(g, s, active);
+  EXPECT_EQ(rep2.unmatched_faces, 6 + 3 + 3);  // the hole's six, and three of each corner cell's neighbours
+  EXPECT_EQ(paired.face_node_ptr, looked_up.face_node_ptr);
+  EXPECT_EQ(paired.face_nodes, looked_up.face_nodes);
+  EXPECT_EQ(paired.face_owner, looked_up.face_owner);
+  EXPECT_EQ(paired.face_neighbour, looked_up.face_neighbour);
+  EXPECT_EQ(paired.face_patch, looked_up.face_patch);
+  EXPECT_EQ(paired.cell_faces, looked_up.cell_faces);
+}
+
+TEST(MeshBuilderById, AFaceNamedByIdWithOtherNodesOrTheSameOrientationIsReported) {
+  MeshBuilder b;
+  for (int i = 0; i < 5; ++i) b.add_node({double(i), 0, 0});
+  std::vector<int32_t> ids;
+  std::vector<CellFace> first(1);
+  first[0].nodes = {0, 1, 2};
+  first[0].by_id_only = true;
+  b.add_cell(first, CellAttributes{}, &ids);
+  ASSERT_EQ(ids.size(), 1u);
+  std::vector<CellFace> wrong(1);
+  wrong[0].nodes = {3, 2, 1};  // not face ids[0]'s nodes
+  wrong[0].known_face = ids[0];
+  b.add_cell(wrong, CellAttributes{});
+  std::vector<CellFace> same(1);
+  same[0].nodes = {1, 2, 0};  // face ids[0] in its owner's orientation
+  same[0].known_face = ids[0];
+  b.add_cell(same, CellAttributes{});
+  BuildReport rep;
+  b.finish(&rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.misoriented_faces, 1);
+  EXPECT_GE(rep.unmatched_faces, 1);
+  ASSERT_FALSE(rep.problems.empty());
+  EXPECT_NE(rep.problems[0].find("by its id with other nodes"), std::string::npos);
+}
