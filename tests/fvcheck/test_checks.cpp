@@ -155,6 +155,26 @@ TEST(Conformity, HangingNodesAreFoundAndTheConformingSplitPasses) {
   EXPECT_TRUE(check_convexity(bad, g).ok());
 }
 
+TEST(Conformity, AHangingNodeOnATwistedFaceIsFoundOffItsMeanPlane) {
+  // Cell A: a unit box whose top corner (1, 1, 1) is lifted to z = 1.4 (a twisted top face);
+  // B's corner lies on that face's fan, 0.9 of the way from its node mean to the lifted corner:
+  // off the face's mean plane by most of the face's own spread (a search that took the face
+  // as planar would miss it).
+  MeshBuilder b;
+  int32_t n[8];
+  for (int c = 0; c < 8; ++c) n[c] = b.add_node({double(c & 1), double((c >> 1) & 1), (c & 4) ? (c == 7 ? 1.4 : 1.0) : 0.0});
+  CellAttributes at;
+  at.fv_center = {0.5, 0.5, 0.55};
+  b.add_cell(fvtest::box_faces(n), at);
+  const Vec3 g{0.5, 0.5, 1.1}, lifted{1, 1, 1.4};
+  const Vec3 p = 0.9 * lifted + 0.1 * g;
+  add_box(b, p, p + Vec3{0.2, 0.2, 0.5});
+  const PolyMesh m = finish_ok(b);
+  const CheckResult r = check_conformity(m, compute_geometry(m));
+  EXPECT_EQ(count_of(r, "hanging_nodes"), 1);
+  EXPECT_EQ(count_of(r, "hanging_node_face_pairs"), 1);
+}
+
 TEST(Conformity, DuplicatedNodesAtAnInterfaceAreHanging) {
   MeshBuilder b;
   add_box(b, {0, 0, 0}, {1, 1, 1});
