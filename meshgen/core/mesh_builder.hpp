@@ -42,8 +42,8 @@ class MeshBuilder {
   int32_t add_node(Vec3 p);
   Vec3 node(int32_t id) const { return nodes_[id]; }
   int32_t n_nodes() const { return static_cast<int32_t>(nodes_.size()); }
-  /// Capacity for this many more cells, faces (each new face's nodes counted once) and face
-  /// nodes: a large grid added in one go is then stored without regrowing its arrays.
+  /// Capacity for this many more cells, distinct faces and nodes over those faces' cycles: a
+  /// large grid added in one go is then stored without regrowing its arrays.
   void reserve(size_t more_cells, size_t more_faces, size_t more_face_nodes);
   /// Adds a cell; returns its id. Faces must be closed and outward oriented. face_ids (if
   /// given): the id of each face, -1 where the face was refused (degenerate, overused).
@@ -71,10 +71,10 @@ class MeshBuilder {
   // compared in place. face_hash_[f] keeps each face's hash for growing the table.
   int32_t find_face(const std::vector<int32_t>& key, uint64_t hash) const;
   void insert_face(int32_t f, uint64_t hash);
-  void grow_table(size_t faces);
+  void grow_table(size_t faces);  // the table for this many faces at load factor <= 1/2
   bool clean_cycle(const CellFace& cf, int32_t cell);  // the face's cycle into cyc_; false if degenerate
   int32_t new_face(int32_t cell, int32_t patch, const uint64_t* hash);  // cyc_ as a new face; hashed if hash
-  bool second_use(int32_t f, int32_t cell, bool reversed);  // cell as f's neighbour (key_: its canonical cycle)  // the table for this many faces at load factor <= 1/2
+  bool second_use(int32_t f, int32_t cell, bool reversed);  // cell as f's neighbour (key_: its canonical cycle)
   std::vector<int32_t> table_;
   std::vector<uint64_t> face_hash_;
   std::vector<int32_t> cyc_, sorted_, key_, stored_;  // scratch of add_cell
