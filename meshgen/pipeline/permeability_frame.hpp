@@ -7,28 +7,10 @@
 // all get the same mesh.
 #pragma once
 #include "meshgen/case/case.hpp"
+#include "meshgen/case/permeability_metric.hpp"
 #include "meshgen/core/polymesh.hpp"
 
 namespace hm {
-
-struct PermeabilityFrame {
-  Vec3 scale{1, 1, 1};  ///< diagonal of S; product 1
-  Vec3 origin;          ///< fixed point of the map: the reservoir's min corner
-  Vec3 k{0, 0, 0};      ///< the K the frame is built for (geometric means, mD)
-  bool identity() const { return scale == Vec3{1, 1, 1}; }
-};
-
-/// diag(S) for a diagonal K: (sqrt(kx/k0), sqrt(ky/k0), sqrt(kz/k0)), k0 = cbrt(kx ky kz);
-/// exactly (1, 1, 1) when kx == ky == kz.
-Vec3 frame_scale(Vec3 k);
-
-/// The case's frame: identity for `metric: euclidean` or isotropic rock; else one frame per case
-/// from the geometric mean of kx, ky, kz over the reservoir cells the wells' trajectories pass
-/// through (sampled every segment_length / 4), the whole grid when there are no wells.
-PermeabilityFrame permeability_frame(const CaseSpec& cs);
-
-Vec3 to_scaled(const PermeabilityFrame& f, Vec3 x);
-Vec3 to_physical(const PermeabilityFrame& f, Vec3 x_scaled);
 
 /// Equivalent radius (a + b) / 2 of the scaled cross-section (normal to the scaled axis) of a
 /// circular cylinder of radius r about the physical unit axis; for a vertical axis and
