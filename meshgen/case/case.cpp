@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/near_well_layers.hpp"
 #include "meshgen/case/corner_point_path.hpp"
 #include "meshgen/case/corner_point_refine.hpp"
 #include "meshgen/case/grdecl.hpp"
@@ -384,7 +385,8 @@ void refine_near_wells(CaseSpec& cs) {
 
 ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir) {
   const Fields f(n, "reservoir",
-                 {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size"});
+                 {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size",
+                  "near_well_layer_aspect"});
   ReservoirSpec r;
   if (f.get("grdecl")) {
     r = read_grdecl_reservoir(f, base_dir);
@@ -411,6 +413,9 @@ ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir) {
   require(r.porosity > 0 && r.porosity <= 1, f.path("porosity"), "must be in (0, 1]");
   f.number("initial_pressure", r.initial_pressure);
   require_range(r.initial_pressure, 0, kMaxPressure, true, f.path("initial_pressure"), "bar");
+  f.number("near_well_layer_aspect", r.near_well_layer_aspect);
+  require(r.near_well_layer_aspect == 0 || (r.near_well_layer_aspect >= 0.5 && r.near_well_layer_aspect <= 100),
+          f.path("near_well_layer_aspect"), "must be 0 (off) or in [0.5, 100]");
   return r;
 }
 
@@ -658,6 +663,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   refine_near_wells(cs);
   clip_paths_to_model(cs, as_given, SurfaceGapRule::SurfaceFaces, true);
   check_wells(cs);
+  split_layers_near_wells(cs);
   return cs;
 }
 

@@ -42,6 +42,10 @@ struct ReservoirSpec {
   /// near a well are split to (meshgen/case/corner_point_refine.hpp); 0 = auto (each well's
   /// drainage radius), < 0 = off. After load_case, `corner_point` is the refined model.
   double near_well_cell_size = 0;
+  /// `reservoir.near_well_layer_aspect` (metric: permeability): layers near the wells are split so
+  /// that their cells there are, in the permeability frame, at most this many times taller than
+  /// wide (meshgen/case/near_well_layers.hpp); 0 = off. After load_case, `z` is the split grid's.
+  double near_well_layer_aspect = 1.5;
 };
 
 /// The grid-frame point of map point p (MAPAXES inverse; the identity without MAPAXES); z unchanged.

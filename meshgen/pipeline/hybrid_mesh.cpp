@@ -172,6 +172,7 @@ std::string caps_hint(const CaseSpec& cs, const std::vector<int>& wells) {
 // built again. The other cavities keep their transitions.
 HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOptions& opts) {
   HybridMesh out;
+  out.notes = input.notes;  // what reading the case changed
   StageTimer timer(&out.timings_s, opts);
   CaseSpec cs = input;  // end caps as meshed
   const int nw = static_cast<int>(cs.wells.size());

@@ -308,7 +308,8 @@ TEST(CaseErrors, UnknownKeyAtEveryLevel) {
   EXPECT_EQ(error_of(kBase + "wellz: []\n"),
             "wellz: unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
   EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  poro: 0.2\n")),
-            "reservoir.poro: unknown key (expected one of: x, y, z, grdecl, permeability, porosity, initial_pressure, near_well_cell_size)");
+            "reservoir.poro: unknown key (expected one of: x, y, z, grdecl, permeability, porosity, initial_pressure, near_well_cell_size, "
+            "near_well_layer_aspect)");
   EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "    bhp: 250\n    skin: 0\n")),
             "wells[1].skin: unknown key (expected one of: name, type, trajectory, survey, radius, drainage_radius, rings, "
             "sectors, segment_length, bhp, end_caps, perforations)");
@@ -449,6 +450,10 @@ TEST(CaseErrors, PermeabilityPorosityPressure) {
             "reservoir.permeability: expected a list of 3 numbers [kx, ky, kz], got 100");
   EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 0")), "reservoir.porosity: must be in (0, 1]");
   EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 1.01")), "reservoir.porosity: must be in (0, 1]");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 0.2\n  near_well_layer_aspect: 0.2")),
+            "reservoir.near_well_layer_aspect: must be 0 (off) or in [0.5, 100]");
+  EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 0.2\n  near_well_layer_aspect: -1")),
+            "reservoir.near_well_layer_aspect: must be 0 (off) or in [0.5, 100]");
   EXPECT_EQ(error_of(with(kBase, "porosity: 0.2", "porosity: 1")), "");
   EXPECT_EQ(error_of(with(kBase, "initial_pressure: 200", "initial_pressure: -1")),
             "reservoir.initial_pressure: must be > 0");
