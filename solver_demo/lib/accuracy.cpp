@@ -9,6 +9,7 @@
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/case/near_well_layers.hpp"
 #include "meshgen/pipeline/permeability_frame.hpp"
 #include "peaceman.hpp"
 
@@ -39,15 +40,17 @@ AccuracySetup make_accuracy_setup(const CaseSpec& cs, const AccuracyOptions& opt
   const PermeabilityFrame frame = permeability_frame(cs);  // identity unless metric: permeability
   s.p_w = ws.bhp;
   s.drawdown = std::fabs(cs.reservoir.initial_pressure - ws.bhp);
-  s.source_inset = opt.source_to_tips ? 0.0 : ws.radius;
   // The well as meshed: the block cuts each bend's corner along its fillet wedges, so the
   // exact solution's source follows that axis (the trajectory itself for straight wells).
   // A K-orthogonal block is planned in the scaled frame (its fillet too): its axis mapped back.
   const CaseSpec meshed = scaled_case(cs, frame);
   std::vector<Vec3> axis = meshed_axis(make_well_block(meshed, 0, ws.sectors));  // independent of sectors
   for (Vec3& p : axis) p = to_physical(frame, p);
+  // The source stops the wellbore's radius short of the ends in the frame the wellbore is a
+  // circle in (r_w for a Euclidean mesh; the scaled equivalent radius for a K-orthogonal one).
+  s.source_inset = opt.source_to_tips ? 0.0 : meshed.wells[0].radius;
   s.field = make_line_source_field(axis, ws.radius, ws.bhp, cs.reservoir.initial_pressure, s.near_radius,
-                                   s.source_inset, scale);
+                                   s.source_inset, scale, frame.scale);
   s.field.wellbore_scale = frame.scale;
   s.field.wellbore_radius = meshed.wells[0].radius;  // r_w, or the mean equivalent radius of the scaled block
   s.reference = field_reference(axis);
@@ -203,9 +206,16 @@ AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyO
     lv.factor = f;
     // Each level's exact solution follows that level's meshed axis (the bend wedges are
     // re-planned with the finer segments).
-    const AccuracySetup setup = f == 1 ? st.setup : make_accuracy_setup(level_case, opt);
+    // The level's case as load_case would give it: in a permeability frame its layers near the
+    // well split (near_well_layers.hpp). The hybrid mesh and Cartesian + Peaceman share that grid.
+    CaseSpec split_case = level_case;
+    split_layers_near_wells(split_case);
+    const bool split = split_case.reservoir.z != level_case.reservoir.z;
+    const AccuracySetup setup =
+        f == 1 && !split ? st.setup : make_accuracy_setup(split ? split_case : level_case, opt);
+    if (f == 1) st.setup = setup;
     {
-      const HybridMesh hm = build_hybrid_mesh(level_case);
+      const HybridMesh hm = build_hybrid_mesh(split_case);
       if (f == 1) st.notes = hm.notes;
       lv.hybrid_cells = hm.mesh.n_cells();
       lv.hybrid = measure_accuracy(hm.mesh, hm.geometry, {}, setup, nullptr, f == 1 ? &st.hybrid_samples : nullptr);
@@ -219,10 +229,10 @@ AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyO
       lv.hybrid_euclidean = measure_accuracy(hm.mesh, hm.geometry, {}, e_setup);
     }
     {
-      const CartesianMesh cm = make_cartesian_mesh(level_case.reservoir);
+      const CartesianMesh cm = make_cartesian_mesh(split_case.reservoir);
       lv.cartesian_cells = cm.mesh.n_cells();
       const std::vector<WellConnection> wells =
-          peaceman_connections(cm, setup.field.polyline, level_case.wells[0].radius, 0);
+          peaceman_connections(cm, setup.field.polyline, split_case.wells[0].radius, 0);
       lv.peaceman = measure_accuracy(cm.mesh, cm.geo, wells, setup, nullptr, f == 1 ? &st.peaceman_samples : nullptr);
     }
     if (f == 1) st.hybrid = lv.hybrid, st.peaceman = lv.peaceman;

@@ -38,7 +38,9 @@ struct AccuracySetup {
   double equivalent_radius = 0;  ///< m, scaled frame: the wellbore's equivalent radius at the reference point (r_w if isotropic)
   double exact_rate = 0;      ///< rm3/day, q' x scaled source length (> 0 produced)
   double slab_half_width = 0; ///< plot: cells projecting within this of the reference midpoint
-  double source_inset = 0;    ///< m removed from each end of the trajectory to get the source
+  /// removed from each end of the trajectory to get the source, in the mesh's wellbore frame
+  /// (the permeability frame's scaled metres for a K-orthogonal mesh; physical metres otherwise)
+  double source_inset = 0;
 };
 
 /// Throws InputError when the study does not apply: not exactly one well, per-cell permeability.

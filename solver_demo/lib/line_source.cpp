@@ -157,13 +157,17 @@ FieldReference field_reference(const std::vector<Vec3>& poly) {
 }
 
 LineSourceField make_line_source_field(const std::vector<Vec3>& poly, double r_w, double p_w, double p_outer,
-                                       double outer_distance, double inset, Vec3 scale) {
+                                       double outer_distance, double inset, Vec3 scale, Vec3 inset_frame) {
   LineSourceField f;
   f.polyline = poly;
   f.source = poly;
   const size_t n = poly.size();
-  f.source[0] = poly[0] + inset * normalized(poly[1] - poly[0]);
-  f.source[n - 1] = poly[n - 1] - inset * normalized(poly[n - 1] - poly[n - 2]);
+  // The end moved by `inset` along its leg, both measured in the inset's frame.
+  auto inset_end = [&](Vec3 end, Vec3 inward) {
+    return from_scaled(to_scaled(end, inset_frame) + inset * normalized(to_scaled(inward, inset_frame)), inset_frame);
+  };
+  f.source[0] = inset_end(poly[0], poly[1] - poly[0]);
+  f.source[n - 1] = inset_end(poly[n - 1], poly[n - 2] - poly[n - 1]);
   f.r_w = r_w;
   f.scale = scale;
   for (Vec3 p : f.source) f.scaled_source.push_back(to_scaled(p, scale));

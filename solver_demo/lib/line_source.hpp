@@ -89,15 +89,18 @@ struct LineSourceField {
 
 /// Builds the field whose pressure is p_w at distance r_w and p_outer at distance `outer_distance`
 /// from the midpoint of the longest leg (both along perpendicular_unit of that leg). The source is
-/// the trajectory with `inset` (m) removed at both ends (0: the whole trajectory; inset = r_w keeps
-/// the source strictly inside the wellbore, so that p is smooth up to the end caps).
+/// the trajectory with `inset` removed at both ends, measured in the frame of scale `inset_frame`
+/// (the frame the mesh's wellbore is a circle in: its end caps are half-balls of that radius there;
+/// 0: the whole trajectory; inset = the wellbore's radius in its frame keeps the source inside the
+/// wellbore and as far from the caps as the caps are from the ends, so that p is smooth up to them).
 /// Anisotropic (scale != 1): the field is a line source in x' = x / scale; p = p_w at the
 /// equivalent wellbore (the equivalent radius from the scaled midpoint, perpendicular to the
 /// scaled leg) and p = p_outer at the physical point outer_distance from the midpoint along the
 /// physical perpendicular. The wellbore frame is left Euclidean (set wellbore_scale /
 /// wellbore_radius for a mesh built in another frame).
 LineSourceField make_line_source_field(const std::vector<Vec3>& polyline, double r_w, double p_w, double p_outer,
-                                       double outer_distance, double inset = 0, Vec3 scale = {1, 1, 1});
+                                       double outer_distance, double inset = 0, Vec3 scale = {1, 1, 1},
+                                       Vec3 inset_frame = {1, 1, 1});
 
 /// Reference points of such a field: the longest leg's midpoint and its perpendicular.
 struct FieldReference {
