@@ -254,22 +254,32 @@ TEST(FlowExamples, HorizontalThroughSidesMatchesTheCompressibleSolve) {
   EXPECT_GT(std::abs(r.ours.well_rate[0]), 1.0);
 }
 
+// Meshes `cs` (anisotropic rock, permeability metric), runs flow on its deck and compares with our
+// compressible solve on every cell and well.
+void expect_anisotropic_deck_matches(const hm::CaseSpec& cs) {
+  ExampleRun r;
+  run_example(cs, cs.name, &r);
+  if (::testing::Test::HasFatalFailure()) return;
+  EXPECT_FALSE(r.hybrid.frame.identity());
+  expect_match(r.c);
+  EXPECT_GT(std::abs(r.ours.well_rate[0]), 1.0);
+}
+
+hm::CaseSpec anisotropic_example(const std::string& example, const std::string& name, hm::Vec3 k) {
+  hm::CaseSpec cs = load_example(example);
+  cs.name = name;
+  cs.reservoir.permeability = k;
+  cs.metric = hm::MeshMetric::Permeability;
+  return cs;
+}
+
 // Anisotropic rock with the permeability metric (issue 15, docs/anisotropy.md): kv/kh 0.01 and
 // kx/ky 3 around the producer and the injector of vertical_through, meshed K-orthogonal (elliptic
 // blocks); flow reading the exported deck (transmissibilities of the scaled frame) agrees with our
 // solve on every cell and well.
 TEST(FlowExamples, AnisotropicKvKh001PermeabilityMetricMatchesTheCompressibleSolve) {
   REQUIRE_FLOW();
-  hm::CaseSpec cs = load_example("vertical_through");
-  cs.name = "vertical_kvkh001";
-  cs.reservoir.permeability = {300, 100, 1};
-  cs.metric = hm::MeshMetric::Permeability;
-  ExampleRun r;
-  run_example(cs, "vertical_kvkh001", &r);
-  if (HasFatalFailure()) return;
-  EXPECT_FALSE(r.hybrid.frame.identity());
-  expect_match(r.c);
-  EXPECT_GT(std::abs(r.ours.well_rate[0]), 1.0);
+  expect_anisotropic_deck_matches(anisotropic_example("vertical_through", "vertical_kvkh001", {300, 100, 1}));
 }
 
 // The same for horizontal_through_sides at kv/kh 0.01 with its layers split near the well as
@@ -278,19 +288,11 @@ TEST(FlowExamples, AnisotropicKvKh001PermeabilityMetricMatchesTheCompressibleSol
 // reading it agrees with our solve.
 TEST(FlowExamples, AnisotropicKvKh001OnLayersSplitNearTheWellMatchesTheCompressibleSolve) {
   REQUIRE_FLOW();
-  hm::CaseSpec cs = load_example("horizontal_through_sides");
-  cs.name = "horizontal_kvkh001";
-  cs.reservoir.permeability = {100, 100, 1};
-  cs.metric = hm::MeshMetric::Permeability;
+  hm::CaseSpec cs = anisotropic_example("horizontal_through_sides", "horizontal_kvkh001", {100, 100, 1});
   const size_t user_layers = cs.reservoir.z.size() - 1;
   hm::split_layers_near_wells(cs);
   ASSERT_GT(cs.reservoir.z.size() - 1, user_layers);
-  ExampleRun r;
-  run_example(cs, "horizontal_kvkh001", &r);
-  if (HasFatalFailure()) return;
-  EXPECT_FALSE(r.hybrid.frame.identity());
-  expect_match(r.c);
-  EXPECT_GT(std::abs(r.ours.well_rate[0]), 1.0);
+  expect_anisotropic_deck_matches(cs);
 }
 
 }  // namespace
