@@ -38,6 +38,10 @@ struct RealisticOptions {
   /// 0: no bound.
   double max_cavity_layers = 60;
   double min_dx = 5, max_dx = 100, min_dz = 0.25, max_dz = 10;
+  /// > 0: `metric: permeability` with K = (100, 100, 100 kv_kh) mD (the layers near the wells then
+  /// split as load_case splits them); 0: the Euclidean metric with K = (100, 100, 10).
+  double kv_kh = 0;
+  double layer_aspect = -1;  ///< >= 0: written as reservoir.near_well_layer_aspect (else the default)
 };
 
 struct RealisticCase {
@@ -177,7 +181,7 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
   }
 
   std::ostringstream os;
-  os << "name: realistic_" << seed << "\nreservoir:\n";
+  os << "name: realistic_" << seed << "\n" << (opt.kv_kh > 0 ? "metric: permeability\n" : "") << "reservoir:\n";
   auto shifted = [](std::vector<double> v, double o) {
     for (double& a : v) a += o;
     return v;
@@ -185,7 +189,9 @@ inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& 
   detail::yaml_axis(os, "x", shifted(x, origin.x));
   detail::yaml_axis(os, "y", shifted(y, origin.y));
   detail::yaml_axis(os, "z", shifted(z, origin.z));
-  os << "  permeability: [100, 100, 10]\ntransition: {dilation: " << num(dilation)
+  os << "  permeability: [100, 100, " << (opt.kv_kh > 0 ? num(100 * opt.kv_kh) : std::string("10")) << "]\n";
+  if (opt.layer_aspect >= 0) os << "  near_well_layer_aspect: " << num(opt.layer_aspect) << "\n";
+  os << "transition: {dilation: " << num(dilation)
      << ", optimize: " << (opt.optimize ? "true" : "false") << "}\nwells:\n";
   const char* caps = opt.caps == RealisticOptions::Caps::Flat || crossing ? "flat"
                      : opt.caps == RealisticOptions::Caps::Hemisphere ? "hemisphere" : "auto";

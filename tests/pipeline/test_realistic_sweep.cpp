@@ -36,12 +36,15 @@ RealisticOptions sweep_options(uint32_t seed) {
   o.field_origin = d(m) % 4 == 3;
   o.cross_top_bottom = d(m) % 4 == 2;  // wells through the top (half of them also the bottom), flat ends
   o.max_cavity_layers = 40;
+  if (const char* v = std::getenv("HM_SWEEP_KVKH")) o.kv_kh = std::atof(v);  // the permeability metric
+  if (const char* v = std::getenv("HM_SWEEP_LAYER_ASPECT")) o.layer_aspect = std::atof(v);
   return o;
 }
 
 std::string mode_label(const RealisticOptions& o) {
   return std::string(o.caps == RealisticOptions::Caps::Flat || o.cross_top_bottom ? "flat" : "caps") +
-         (o.optimize ? " opt" : "") + (o.field_origin ? " utm" : "") + (o.cross_top_bottom ? " cross" : "");
+         (o.optimize ? " opt" : "") + (o.field_origin ? " utm" : "") + (o.cross_top_bottom ? " cross" : "") +
+         (o.kv_kh > 0 ? " kv/kh " + std::to_string(o.kv_kh).substr(0, 4) : "");
 }
 
 // The seed's case must mesh and pass every check; one line per case on stdout.
@@ -180,6 +183,32 @@ TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
                 r.seconds);
   }
   for (const auto& [k, v] : shapes) std::printf("[ ci sweep  ] %s: %d cases\n", k.c_str(), v);
+}
+
+// The CI subset in the permeability metric (docs/anisotropy.md, "Layers near the wells"): ten small
+// cases at kv/kh 0.1 and 0.01 alternately (one or two straight wells, caps or flat ends, cells at most
+// 20 m wide), their layers near the wells split as load_case splits them. Each must mesh and pass
+// mesh_and_check (fvcheck judges a permeability-frame mesh in the K metric); some must have been split.
+TEST(RealisticSweep, CiSubsetInThePermeabilityMetricMeshesAndPassesFvcheck) {
+  int split = 0;
+  for (uint32_t seed = 1; seed <= 10; ++seed) {
+    RealisticOptions o;
+    o.caps = seed % 3 ? RealisticOptions::Caps::Hemisphere : RealisticOptions::Caps::Flat;
+    o.max_wells = 2;
+    o.bends = false;
+    o.max_cavity_layers = 48;
+    o.max_dx = 20;
+    o.kv_kh = seed % 2 ? 0.1 : 0.01;
+    const RealisticCase rc = make_realistic_case(seed, o);
+    ASSERT_EQ(rc.spec.metric, MeshMetric::Permeability);
+    const bool was_split = !rc.spec.notes.empty() && rc.spec.notes.back().find("layers near the wells split") != std::string::npos;
+    split += was_split;
+    const CaseResult r = mesh_and_check(rc);
+    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+    std::printf("[ ci sweep  ] %s [%s]%s %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(),
+                was_split ? " split" : "", outcome_name(r.outcome), r.seconds);
+  }
+  EXPECT_GE(split, 3);
 }
 
 // The CI subset's wells through the reservoir boundary (flat ends, local coordinates, no
