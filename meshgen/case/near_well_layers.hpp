@@ -1,6 +1,6 @@
 // Layers split near the wells for the permeability frame (docs/anisotropy.md, "Layers near the
-// wells"). With kv/kh < 1 the frame stretches the reservoir's layers (by 2.15 at kv/kh 0.1, 4.64 at
-// 0.01): next to the well the scaled cells are several times taller than wide, the one row of
+// wells"). With kv/kh < 1 the frame stretches the reservoir's layers by (kh/kv)^1/3: next to the
+// well the scaled cells are several times taller than wide, the one row of
 // transition cells between the block and such a wall cannot follow the well's logarithmic field,
 // and the near-well error is set there. Splitting the layers within reach of the wells (whole
 // layers: a cell split only beside the cavity would meet its unsplit neighbour along a face that

@@ -230,8 +230,8 @@ AccuracyStudy run_accuracy_study(const CaseSpec& cs, int levels, const AccuracyO
       lv.hybrid_euclidean = measure_accuracy(hm.mesh, hm.geometry, {}, e_setup);
     }
     {
-      // Peaceman's well index needs cells wider than about 7 r_w across the well: where the split
-      // layers are thinner, the reference runs on the level's own grid (and says so).
+      // Peaceman's well index needs cells several r_w wide across the well (r_o > r_w): where the
+      // split layers are thinner, the reference runs on the level's own grid (and says so).
       CartesianMesh cm = make_cartesian_mesh(split_case.reservoir);
       std::vector<WellConnection> wells;
       try {
