@@ -11,6 +11,10 @@ namespace hm {
 
 namespace {
 
+// A height ratio within this relative amount of an integer n gives n children, not n + 1 (the
+// ratio of two rounded lengths: an exact 3 may come out as 3 + 1e-16).
+constexpr double kRatioRounding = 1e-12;
+
 // The cells [first, last) of `planes` that the interval [from, to] meets.
 std::pair<int, int> cells_between(const std::vector<double>& planes, double from, double to) {
   const int first = static_cast<int>(std::upper_bound(planes.begin(), planes.end(), from) - planes.begin()) - 1;
@@ -70,7 +74,7 @@ std::vector<int> near_well_layer_children(const CaseSpec& cs) {
   for (int k = 0; k < nz; ++k) {
     if (!std::isfinite(narrowest[k])) continue;
     const double height = (r.z[k + 1] - r.z[k]) / s.z;
-    const double n = std::ceil(height / (r.near_well_layer_aspect * narrowest[k]) * (1 - 1e-12));
+    const double n = std::ceil(height / (r.near_well_layer_aspect * narrowest[k]) * (1 - kRatioRounding));
     children[k] = static_cast<int>(std::clamp(n, 1.0, static_cast<double>(kMaxLayerChildren)));
   }
   return children;
