@@ -47,6 +47,18 @@ std::string mode_label(const RealisticOptions& o) {
          (o.kv_kh > 0 ? " kv/kh " + std::to_string(o.kv_kh).substr(0, 4) : "");
 }
 
+// The CI subsets' cases: one or two straight wells, cavities at most 48 layers thick, cells at most
+// 20 m wide (time), local coordinates, no optimisation.
+RealisticOptions ci_subset_options(RealisticOptions::Caps caps) {
+  RealisticOptions o;
+  o.caps = caps;
+  o.max_wells = 2;
+  o.bends = false;
+  o.max_cavity_layers = 48;
+  o.max_dx = 20;
+  return o;
+}
+
 // The seed's case must mesh and pass every check; one line per case on stdout.
 void expect_meshes(const RealisticCase& rc, const RealisticOptions& o) {
   const CaseResult r = mesh_and_check(rc);
@@ -169,12 +181,7 @@ TEST(RealisticSweep, FullSweepTable) {
 TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
   std::map<std::string, int> shapes;
   for (uint32_t seed = 1; seed <= 16; ++seed) {
-    RealisticOptions o;
-    o.caps = seed % 2 ? RealisticOptions::Caps::Hemisphere : RealisticOptions::Caps::Flat;
-    o.max_wells = 2;
-    o.bends = false;
-    o.max_cavity_layers = 48;
-    o.max_dx = 20;
+    const RealisticOptions o = ci_subset_options(seed % 2 ? RealisticOptions::Caps::Hemisphere : RealisticOptions::Caps::Flat);
     const RealisticCase rc = make_realistic_case(seed, o);
     const CaseResult r = mesh_and_check(rc);
     ++shapes[shape_class(rc)];
@@ -192,12 +199,7 @@ TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
 TEST(RealisticSweep, CiSubsetInThePermeabilityMetricMeshesAndPassesFvcheck) {
   int split = 0;
   for (uint32_t seed = 1; seed <= 10; ++seed) {
-    RealisticOptions o;
-    o.caps = seed % 3 ? RealisticOptions::Caps::Hemisphere : RealisticOptions::Caps::Flat;
-    o.max_wells = 2;
-    o.bends = false;
-    o.max_cavity_layers = 48;
-    o.max_dx = 20;
+    RealisticOptions o = ci_subset_options(seed % 3 ? RealisticOptions::Caps::Hemisphere : RealisticOptions::Caps::Flat);
     o.kv_kh = seed % 2 ? 0.1 : 0.01;
     const RealisticCase rc = make_realistic_case(seed, o);
     ASSERT_EQ(rc.spec.metric, MeshMetric::Permeability);
