@@ -87,6 +87,15 @@ void write_model_geometry(TextOut& o, const CornerPointModel& m, const EclipseLa
   o.eclipse_array("ZCORN", z);
 }
 
+// The model's PINCH, item by item, so that flow connects its cells across layers of zero thickness as it
+// would in the model's own deck (a deck with near-well cells carries those connections as NNC instead).
+void write_pinch(TextOut& o, const CornerPointModel::Pinch& p) {
+  if (!p.active) return;
+  o << "-- The model's PINCH: flow connects cells across layers of zero thickness with it only.\n"
+    << "PINCH\n " << p.threshold << (p.nogap ? " NOGAP " : " GAP ") << p.max_empty_gap
+    << (p.pinchout_all ? " ALL" : " TOPBOT") << (p.multz_all ? " ALL" : " TOP") << " /\n\n";
+}
+
 std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::string* error) {
   const int nx = static_cast<int>(res.x.size()) - 1, ny = static_cast<int>(res.y.size()) - 1,
             nz = static_cast<int>(res.z.size()) - 1;
@@ -303,6 +312,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
         const std::vector<double>& v = cs.reservoir.corner_point->trans_mult[d];
         if (std::any_of(v.begin(), v.end(), [](double x) { return x != 1.0; })) o.eclipse_array(kMult[d], v);
       }
+      write_pinch(o, cs.reservoir.corner_point->pinch);
     } else if (L.corner_point) {
       o << "-- Columns 1.." << L.nx << ": the model's own corner-point geometry (COORD/ZCORN as OPM read them),\n"
         << "-- widened by the separator and extra columns (vertical pillars beyond the model's +x side).\n"

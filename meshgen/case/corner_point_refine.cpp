@@ -146,6 +146,7 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   r.nz = m.nz;
   r.parent_nx = m.parent_cell.empty() ? m.nx : m.parent_nx;
   r.parent_ny = m.parent_cell.empty() ? m.ny : m.parent_ny;
+  r.pinch = m.pinch;
   r.has_mapaxes = m.has_mapaxes;
   r.map_origin = m.map_origin;
   r.map_unit_x = m.map_unit_x;

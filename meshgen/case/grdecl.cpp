@@ -111,6 +111,15 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
     m.permz = fp.has_double("PERMZ") ? global(fp.get_double("PERMZ"), md, 0.0) : m.permx;
     m.poro = global(fp.get_double("PORO"), 1.0, 0.0);
     m.ntg = fp.has_double("NTG") ? global(fp.get_double("NTG"), 1.0, 1.0) : std::vector<double>(n, 1.0);
+    if (grid.isPinchActive()) {
+      m.pinch.active = true;
+      m.pinch.threshold = grid.getPinchThresholdThickness();
+      m.pinch.nogap = grid.getPinchGapMode() == Opm::PinchMode::ModeEnum::NOGAP;
+      m.pinch.pinchout_all = grid.getPinchOption() == Opm::PinchMode::ModeEnum::ALL;
+      m.pinch.multz_all = grid.getMultzOption() == Opm::PinchMode::ModeEnum::ALL;
+      // Not in EclipseGrid (OPM Flow 2022.10 does not use it): from the keyword, for writing it back.
+      m.pinch.max_empty_gap = deck["PINCH"].back().getRecord(0).getItem("MAX_EMPTY_GAP").getSIDouble(0);
+    }
     if (deck.hasKeyword("MAPAXES")) {
       const Opm::MapAxes axes(deck);
       m.has_mapaxes = true;

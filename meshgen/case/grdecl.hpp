@@ -36,6 +36,18 @@ struct CornerPointModel {
   /// cell lies in (natural order of that model). Empty for a model as read.
   std::vector<int32_t> parent_cell;
   int parent_nx = 0, parent_ny = 0;  ///< refined model: nx, ny of the model as read
+  /// PINCH as OPM read it (EclipseGrid::isPinchActive and the keyword's items). OPM Flow connects two
+  /// cells of a column that touch across layers of zero thickness only with PINCH (opm-grid's
+  /// process_grdecl); the other items are kept to write the keyword back (docs/corner-point.md,
+  /// "Pinched-out layers").
+  struct Pinch {
+    bool active = false;
+    double threshold = 0.001;     ///< THRESHOLD_THICKNESS (m)
+    bool nogap = false;           ///< CONTROL_OPTION NOGAP (else GAP)
+    double max_empty_gap = 1e20;  ///< MAX_EMPTY_GAP (m)
+    bool pinchout_all = false;    ///< PINCHOUT_OPTION ALL (else TOPBOT)
+    bool multz_all = false;       ///< MULTZ_OPTION ALL: the smallest MULTZ down the pinched column (else TOP)
+  } pinch;
   bool has_mapaxes = false;
   /// MAPAXES as OPM applies it: the map (world) position of grid point (0, 0) and of the
   /// unit grid x and y directions (origin, unit_x, unit_y), for has_mapaxes.

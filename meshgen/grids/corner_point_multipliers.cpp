@@ -1,6 +1,7 @@
 #include "corner_point_multipliers.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <map>
 
@@ -26,7 +27,23 @@ TriangleKey triangle_key(const std::vector<Vec3>& xyz, const int32_t* v) {
 
 }  // namespace
 
+bool across_pinched_layers(const CornerPointModel& model, int64_t a, int64_t b) {
+  const int64_t nxy = static_cast<int64_t>(model.nx) * model.ny;
+  return a % nxy == b % nxy && std::abs(a / nxy - b / nxy) > 1;
+}
+
 double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b) {
+  if (across_pinched_layers(model, a, b)) {
+    if (!model.pinch.active) return 0.0;
+    // OPM's applyAllZMultipliers_ (MULTZ option ALL): the smallest MULTZ from the upper cell down to
+    // the last pinched cell; TOP: the upper cell's, as between logical neighbours.
+    const int64_t nxy = static_cast<int64_t>(model.nx) * model.ny;
+    const int64_t top = std::min(a, b), bottom = std::max(a, b);
+    double down = multiplier(model, 4, top);
+    if (model.pinch.multz_all)
+      for (int64_t c = top + nxy; c < bottom; c += nxy) down = std::min(down, multiplier(model, 4, c));
+    return down * multiplier(model, 5, bottom);
+  }
   const int64_t nx = model.nx, nxy = static_cast<int64_t>(model.nx) * model.ny;
   const int64_t ia = a % nx, ja = (a / nx) % model.ny, ka = a / nxy;
   const int64_t ib = b % nx, jb = (b / nx) % model.ny, kb = b / nxy;
@@ -39,12 +56,19 @@ double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b
 FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& model, const CornerPointCellFaces* cells,
                                  const std::vector<char>& active, const std::vector<Vec3>& coords) {
   FaceMultipliers out;
-  if (!has_transmissibility_multipliers(model)) return out;
   auto model_cell = [&](int32_t c) -> int64_t {
     if (mesh.cell_region[c] != kReservoir) return -1;
     const auto& ijk = mesh.cell_ijk[c];
     return ijk[0] + static_cast<int64_t>(model.nx) * (ijk[1] + static_cast<int64_t>(model.ny) * ijk[2]);
   };
+  bool pinched = false;  // a face joins two cells of a column across layers of zero thickness
+  for (int32_t f = 0; f < mesh.n_faces() && !pinched; ++f) {
+    const int32_t n = mesh.face_neighbour[f];
+    if (n < 0) continue;
+    const int64_t a = model_cell(mesh.face_owner[f]), b = model_cell(n);
+    pinched = a >= 0 && b >= 0 && across_pinched_layers(model, a, b);
+  }
+  if (!pinched && !has_transmissibility_multipliers(model)) return out;
   // Per model cell beside a cavity: its cavity triangles and the cavity cell each faces.
   std::map<TriangleKey, int32_t> toward;
   std::vector<char> walled(model.actnum.size(), 0);
@@ -66,6 +90,7 @@ FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& m
     if (a >= 0 && b >= 0) {
       out.face[f] = connection_multiplier(model, a, b);
       out.model_faces += out.face[f] != 1.0;
+      if (across_pinched_layers(model, a, b)) ++(model.pinch.active ? out.pinch_faces : out.unpinched_faces);
     } else if (a >= 0 || b >= 0) {
       const auto it = mesh.face_size(f) == 3 ? toward.find(triangle_key(mesh.nodes, mesh.face_begin(f))) : toward.end();
       if (it == toward.end()) {

@@ -52,6 +52,14 @@ void apply_model_multipliers(HybridMesh& out, const CornerPointModel& model, con
     out.notes.push_back("reservoir: the model's transmissibility multipliers (MULTX..MULTZ-, FAULTS/MULTFLT) act on " +
                         std::to_string(fm.model_faces) + " faces between model cells and " + std::to_string(fm.wall_faces) +
                         " faces between model cells and near-well cells (docs/corner-point.md)");
+  if (fm.unpinched_faces > 0)
+    out.notes.push_back("reservoir: " + std::to_string(fm.unpinched_faces) +
+                        " faces join cells of a column across layers of zero thickness; the model has no PINCH, so "
+                        "they carry no flow (as in OPM Flow: docs/corner-point.md, \"Pinched-out layers\")");
+  if (fm.pinch_faces > 0)
+    out.notes.push_back("reservoir: " + std::to_string(fm.pinch_faces) +
+                        " faces join cells of a column across layers of zero thickness, connected as PINCH asks "
+                        "(MULTZ option " + std::string(model.pinch.multz_all ? "ALL" : "TOP") + ")");
   if (fm.inside_cavities > 0) {
     char range[96];
     std::snprintf(range, sizeof range, "%.6g to %.6g", fm.inside_min, fm.inside_max);

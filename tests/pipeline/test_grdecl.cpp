@@ -15,7 +15,9 @@
 #include "corner_point_test_models.hpp"
 #include "exporters/eclipse/eclipse_deck.hpp"
 #include "meshgen/case/grdecl.hpp"
+#include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
+#include "meshgen/grids/corner_point_multipliers.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 
 using namespace hm;
@@ -634,13 +636,17 @@ namespace {
 
 struct FlowPairs {
   std::set<std::pair<int, int>> mesh, flow;
+  std::map<std::pair<int, int>, double> flow_value, ours;  ///< flow's INIT value, ours (deck options), per pair
 };
 
 // Exports the deck of r, runs flow as typed and collects the cell pairs (natural indices) that share a
-// mesh face and that flow connects (INIT TRANX/Y/Z > 0, TRANNNC > 0).
+// mesh face carrying flow (a multiplier not 0) and that flow connects (INIT TRANX/Y/Z > 0: TRANZ to the
+// next active cell down the column, which PINCH connects across layers of zero thickness; TRANNNC > 0).
 FlowPairs flow_and_mesh_pairs(const CpgRun& r, const fs::path& deck, const std::string& name) {
   FlowPairs out;
   const Transmissibilities trans = compute_transmissibilities(r.out.mesh, r.out.geometry);
+  const Transmissibilities deck_trans =
+      compute_transmissibilities(r.out.mesh, r.out.geometry, deck_transmissibility_options());
   EclipseDeckInfo info;
   const WriteStatus st = write_eclipse_deck(deck.string(), r.cs, r.out.mesh, r.out.geometry, trans, {}, &info);
   EXPECT_TRUE(st.ok) << st.message;
@@ -651,26 +657,48 @@ FlowPairs flow_and_mesh_pairs(const CpgRun& r, const fs::path& deck, const std::
   std::printf("[ figures  ] flow ran %s in %.1f s wall\n", name.c_str(), run.seconds);
   const CornerPointModel& m = *r.cs.reservoir.corner_point;
   const int nx = m.nx, nxy = m.nx * m.ny;
+  const std::vector<double>& mult = r.out.mesh.face_trans_mult;
   for (int f = 0; f < r.out.mesh.n_faces(); ++f)
-    if (r.out.mesh.face_neighbour[f] >= 0) {
+    if (r.out.mesh.face_neighbour[f] >= 0 && (mult.empty() || mult[f] != 0)) {
       const int a = r.out.reservoir_cell_of[r.out.mesh.face_owner[f]], b = r.out.reservoir_cell_of[r.out.mesh.face_neighbour[f]];
       out.mesh.insert({std::min(a, b), std::max(a, b)});
+      out.ours[{std::min(a, b), std::max(a, b)}] += deck_trans.face[f];
     }
   std::vector<int> active;
+  std::vector<char> is_active(info.layout.deck_cell.size(), 0);
   for (size_t c = 0; c < info.layout.deck_cell.size(); ++c)
-    if (info.layout.deck_cell[c] >= 0) active.push_back(static_cast<int>(c));
+    if (info.layout.deck_cell[c] >= 0) active.push_back(static_cast<int>(c)), is_active[c] = 1;
   const auto& init = run.results["init"];
   const char* keys[3] = {"tranx", "trany", "tranz"};
   const int step[3] = {1, nx, nxy};
   for (int d = 0; d < 3; ++d) {
     EXPECT_EQ(init[keys[d]].size(), active.size());
-    for (size_t a = 0; a < active.size() && a < init[keys[d]].size(); ++a)
-      if (init[keys[d]][a].get<double>() > 0) out.flow.insert({active[a], active[a] + step[d]});
+    for (size_t a = 0; a < active.size() && a < init[keys[d]].size(); ++a) {
+      const double v = init[keys[d]][a].get<double>();
+      if (!(v > 0)) continue;
+      int b = active[a] + step[d];
+      while (d == 2 && b < static_cast<int>(is_active.size()) && !is_active[b]) b += step[d];
+      out.flow.insert({active[a], b});
+      out.flow_value[{active[a], b}] += v;
+    }
   }
   for (size_t k = 0; k < init["trannnc"].size(); ++k)
     if (init["trannnc"][k].get<double>() > 0) {
       const int a = init["nnc1"][k].get<int>() - 1, b = init["nnc2"][k].get<int>() - 1;
       out.flow.insert({std::min(a, b), std::max(a, b)});
+      out.flow_value[{std::min(a, b), std::max(a, b)}] += init["trannnc"][k].get<double>();
+    }
+  return out;
+}
+
+// The pairs of one column the mesh joins across layers of zero thickness (natural indices).
+std::set<std::pair<int, int>> pinch_pairs(const CpgRun& r) {
+  std::set<std::pair<int, int>> out;
+  const CornerPointModel& m = *r.cs.reservoir.corner_point;
+  for (int f = 0; f < r.out.mesh.n_faces(); ++f)
+    if (r.out.mesh.face_neighbour[f] >= 0) {
+      const int a = r.out.reservoir_cell_of[r.out.mesh.face_owner[f]], b = r.out.reservoir_cell_of[r.out.mesh.face_neighbour[f]];
+      if (across_pinched_layers(m, a, b)) out.insert({std::min(a, b), std::max(a, b)});
     }
   return out;
 }
@@ -678,26 +706,77 @@ FlowPairs flow_and_mesh_pairs(const CpgRun& r, const fs::path& deck, const std::
 }  // namespace
 
 // The exported deck is the model: OPM Flow reads the model's COORD/ZCORN and computes its own
-// connections (fault NNCs included). Every cell pair flow connects is a pair of mesh cells sharing a
-// face, and every face-sharing pair is connected by flow except across a layer of zero thickness,
-// which OPM connects only with PINCH (the mesh's cells touch there).
+// connections (fault NNCs included). The cell pairs flow connects are exactly the pairs of mesh cells
+// sharing a face that carries flow: across the layer of zero thickness (the mesh's cells touch there)
+// only with PINCH, which the deck then carries; there flow's transmissibility is ours.
 TEST(CornerPoint, FlowConnectsExactlyTheCellsTheMeshJoins) {
   REQUIRE_FLOW();
-  TempDir tmp;
-  const CpgRun r = mesh_of(tmp, SyntheticCpg{}.text());
-  const FlowPairs p = flow_and_mesh_pairs(r, tmp.path / "deck", "CPG");
-  const int nxy = r.cs.reservoir.corner_point->nx * r.cs.reservoir.corner_point->ny;
-  int across_pinch = 0;
-  for (const auto& pair : p.mesh) {
-    if (p.flow.count(pair)) continue;
-    // Not connected by flow: only across the zero-thickness layer 1 (k 0 and 2 of one column).
-    EXPECT_EQ(pair.second - pair.first, 2 * nxy) << pair.first << " " << pair.second;
-    ++across_pinch;
+  for (const bool pinch : {false, true}) {
+    TempDir tmp;
+    const CpgRun r = mesh_of(tmp, (pinch ? "PINCH\n 0.4 NOGAP 1* TOPBOT TOP /\n" : "") + SyntheticCpg{}.text());
+    const FlowPairs p = flow_and_mesh_pairs(r, tmp.path / "deck", "CPG");
+    const std::set<std::pair<int, int>> across = pinch_pairs(r);
+    EXPECT_EQ(across.size(), 10u);
+    for (const auto& pair : across) EXPECT_EQ(p.mesh.count(pair), pinch ? 1u : 0u) << pair.first << " " << pair.second;
+    for (const auto& pair : p.mesh) EXPECT_TRUE(p.flow.count(pair)) << "flow does not connect " << pair.first << " " << pair.second;
+    for (const auto& pair : p.flow) EXPECT_TRUE(p.mesh.count(pair)) << "flow connects " << pair.first << " " << pair.second;
+    double worst = 0;  // flow's float32 INIT and its Darcy constant against ours (docs/export-eclipse.md)
+    for (const auto& pair : across)
+      if (p.flow_value.count(pair)) worst = std::max(worst, std::abs(p.ours.at(pair) / p.flow_value.at(pair) - 1));
+    std::printf("[ figures  ] %s: flow connects %zu cell pairs, the mesh %zu (%zu across the pinched-out layer, %s); "
+                "there ours vs flow's at most %.2e\n",
+                pinch ? "PINCH" : "no PINCH", p.flow.size(), p.mesh.size(), across.size(),
+                pinch ? "connected" : "no flow", worst);
+    EXPECT_LT(worst, 1e-6);
+    EXPECT_GT(p.flow.size(), 200u);
   }
-  for (const auto& pair : p.flow) EXPECT_TRUE(p.mesh.count(pair)) << "flow connects " << pair.first << " " << pair.second;
-  std::printf("[ figures  ] flow connects %zu cell pairs, the mesh %zu (%d across the pinched-out layer)\n",
-              p.flow.size(), p.mesh.size(), across_pinch);
-  EXPECT_GT(p.flow.size(), 200u);
+}
+
+// Two cells of a column touching across a layer of zero thickness are connected as OPM Flow connects
+// them: not without PINCH (multiplier 0), with PINCH by MULTZ of the upper cell (MULTZ option TOP) or
+// the smallest MULTZ down to the last pinched cell (ALL).
+TEST(CornerPoint, PinchedOutLayerCarriesFlowOnlyWithPinch) {
+  const SyntheticCpg g;
+  const int n = g.nx * g.ny * g.nz, nxy = g.nx * g.ny;
+  std::ostringstream multz;  // 0.5 on the pinching layer 1, 0.8 on layer 0
+  multz << "MULTZ\n";
+  for (int c = 0; c < n; ++c) multz << (c / nxy == 1 ? 0.5 : c / nxy == 0 ? 0.8 : 1.0) << "\n";
+  multz << "/\n";
+  struct Variant {
+    std::string pinch;
+    bool multz;
+    double expected;
+    const char* note;
+  };
+  for (const Variant& v : {Variant{"", false, 0.0, "carry no flow"}, Variant{"0.4 NOGAP 1* TOPBOT TOP", false, 1.0, "MULTZ option TOP"},
+                           Variant{"1* GAP 1* TOPBOT TOP", true, 0.8, "MULTZ option TOP"},
+                           Variant{"1* GAP 1* TOPBOT ALL", true, 0.5, "MULTZ option ALL"}}) {
+    TempDir tmp;
+    const std::string text = (v.pinch.empty() ? "" : "PINCH\n " + v.pinch + " /\n") + g.text() + (v.multz ? multz.str() : "");
+    const CpgRun r = mesh_of(tmp, text);
+    ASSERT_TRUE(r.out.self_check.ok()) << r.out.self_check.message;
+    const PolyMesh& m = r.out.mesh;
+    ASSERT_EQ(m.face_trans_mult.size(), static_cast<size_t>(m.n_faces())) << v.pinch;
+    int across = 0;
+    for (int f = 0; f < m.n_faces(); ++f) {
+      if (m.face_neighbour[f] < 0) continue;
+      const int a = r.out.reservoir_cell_of[m.face_owner[f]], b = r.out.reservoir_cell_of[m.face_neighbour[f]];
+      if (!across_pinched_layers(*r.cs.reservoir.corner_point, a, b)) continue;
+      ++across;
+      EXPECT_EQ(std::abs(a - b), 2 * nxy);
+      EXPECT_DOUBLE_EQ(m.face_trans_mult[f], v.expected) << v.pinch << ": cells " << a << ", " << b;
+    }
+    EXPECT_GE(across, 10) << v.pinch;
+    bool noted = false;
+    for (const std::string& note : r.out.notes) noted = noted || note.find(v.note) != std::string::npos;
+    EXPECT_TRUE(noted) << v.pinch;
+    const Transmissibilities t = compute_transmissibilities(m, r.out.geometry, deck_transmissibility_options());
+    for (int f = 0; f < m.n_faces(); ++f) {
+      if (m.face_neighbour[f] >= 0 && m.face_trans_mult[f] == 0) {
+        EXPECT_EQ(t.face[f], 0.0);
+      }
+    }
+  }
 }
 
 // Reek (HM_LONG_TESTS=1: flow takes ~2 min): every connection flow makes is a face of the mesh; the
