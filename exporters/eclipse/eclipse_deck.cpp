@@ -96,6 +96,17 @@ void write_pinch(TextOut& o, const CornerPointModel::Pinch& p) {
     << (p.pinchout_all ? " ALL" : " TOPBOT") << (p.multz_all ? " ALL" : " TOP") << " /\n\n";
 }
 
+// The model's MULTREGT and the region arrays it names, as the deck gave them (a deck with near-well
+// cells carries their effect in its transmissibilities instead).
+void write_region_multipliers(TextOut& o, const CornerPointModel& m) {
+  if (m.multregt_records.empty()) return;
+  o << "-- The model's region multipliers (MULTREGT) and the region arrays they name.\n";
+  for (const auto& [name, values] : m.region_arrays) o.eclipse_array(name.c_str(), values);
+  o << "MULTREGT\n";
+  for (const std::string& r : m.multregt_records) o << " " << r << " /\n";
+  o << "/\n\n";
+}
+
 std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::string* error) {
   const int nx = static_cast<int>(res.x.size()) - 1, ny = static_cast<int>(res.y.size()) - 1,
             nz = static_cast<int>(res.z.size()) - 1;
@@ -313,6 +324,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
         if (std::any_of(v.begin(), v.end(), [](double x) { return x != 1.0; })) o.eclipse_array(kMult[d], v);
       }
       write_pinch(o, cs.reservoir.corner_point->pinch);
+      write_region_multipliers(o, *cs.reservoir.corner_point);
     } else if (L.corner_point) {
       o << "-- Columns 1.." << L.nx << ": the model's own corner-point geometry (COORD/ZCORN as OPM read them),\n"
         << "-- widened by the separator and extra columns (vertical pillars beyond the model's +x side).\n"

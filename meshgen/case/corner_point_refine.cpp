@@ -147,6 +147,9 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   r.parent_nx = m.parent_cell.empty() ? m.nx : m.parent_nx;
   r.parent_ny = m.parent_cell.empty() ? m.ny : m.parent_ny;
   r.pinch = m.pinch;
+  r.region_mult = m.region_mult;
+  r.multregt_records = m.multregt_records;
+  r.region_arrays = m.region_arrays;
   r.has_mapaxes = m.has_mapaxes;
   r.map_origin = m.map_origin;
   r.map_unit_x = m.map_unit_x;

@@ -1,6 +1,9 @@
 #include "meshgen/case/grdecl.hpp"
 
 #include <opm/input/eclipse/Deck/Deck.hpp>
+#include <opm/input/eclipse/Deck/DeckItem.hpp>
+#include <opm/input/eclipse/Deck/DeckKeyword.hpp>
+#include <opm/input/eclipse/Deck/DeckRecord.hpp>
 #include <opm/input/eclipse/EclipseState/EclipseState.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/EclipseGrid.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/FieldPropsManager.hpp>
@@ -13,6 +16,8 @@
 #include <opm/input/eclipse/Units/Units.hpp>
 
 #include <algorithm>
+#include <iomanip>
+#include <set>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -43,6 +48,60 @@ std::string as_deck(const std::string& path, const std::string& text) {
 }
 
 }  // namespace
+
+struct RegionMultipliers {
+  Opm::TransMult mult;
+};
+
+namespace {
+
+// MULTREGT: OPM's TransMult (its region multipliers), the records as the deck gives them and the
+// region arrays they name, per cell (1 on inactive cells, which no connection reaches).
+void read_region_multipliers(const Opm::Deck& deck, const Opm::EclipseState& state, CornerPointModel& m) {
+  m.region_mult = std::make_shared<const RegionMultipliers>(RegionMultipliers{state.getTransMult()});
+  std::set<std::string> arrays;
+  for (const Opm::DeckKeyword& kw : deck["MULTREGT"])
+    for (size_t r = 0; r < kw.size(); ++r) {
+      const Opm::DeckRecord& rec = kw.getRecord(r);
+      std::ostringstream text;
+      for (size_t i = 0; i < rec.size(); ++i) {
+        const Opm::DeckItem& item = rec.getItem(i);
+        text << (i ? " " : "");
+        if (item.defaultApplied(0)) text << "1*";
+        else if (item.getType() == Opm::type_tag::integer) text << item.get<int>(0);
+        else if (item.getType() == Opm::type_tag::fdouble) text << std::setprecision(17) << item.get<double>(0);
+        else text << "'" << item.getTrimmedString(0) << "'";
+      }
+      m.multregt_records.push_back(text.str());
+      const Opm::DeckItem& def = rec.getItem("REGION_DEF");
+      const std::string letter = def.defaultApplied(0) ? "M" : def.getTrimmedString(0).substr(0, 1);
+      arrays.insert(letter == "F" ? "FLUXNUM" : letter == "O" ? "OPERNUM" : "MULTNUM");
+    }
+  const Opm::FieldPropsManager& fp = state.fieldProps();
+  for (const std::string& name : arrays) {
+    if (!fp.has_int(name)) continue;
+    const std::vector<int>& active = fp.get_int(name);
+    std::vector<int>& v = m.region_arrays[name];
+    v.assign(m.actnum.size(), 1);
+    for (size_t c = 0, a = 0; c < v.size() && a < active.size(); ++c)
+      if (m.actnum[c]) v[c] = active[a++];
+  }
+}
+
+}  // namespace
+
+double region_multiplier(const CornerPointModel& m, int64_t a, int64_t b) {
+  if (!m.region_mult) return 1.0;
+  const bool refined = !m.parent_cell.empty();
+  const int64_t pa = refined ? m.parent_cell[a] : a, pb = refined ? m.parent_cell[b] : b;
+  if (pa == pb) return 1.0;
+  const int64_t nx = refined ? m.parent_nx : m.nx, ny = refined ? m.parent_ny : m.ny;
+  // flow's direction of an intersection: its axis, plus side (EclTransmissibility::update).
+  const Opm::FaceDir::DirEnum dir = pa % nx != pb % nx                 ? Opm::FaceDir::XPlus
+                                    : (pa / nx) % ny != (pb / nx) % ny ? Opm::FaceDir::YPlus
+                                                                       : Opm::FaceDir::ZPlus;
+  return m.region_mult->mult.getRegionMultiplier(static_cast<size_t>(pa), static_cast<size_t>(pb), dir);
+}
 
 CornerPointModel read_corner_point_model(const std::string& path, const std::string& key) {
   namespace fs = std::filesystem;
@@ -111,6 +170,7 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
     m.permz = fp.has_double("PERMZ") ? global(fp.get_double("PERMZ"), md, 0.0) : m.permx;
     m.poro = global(fp.get_double("PORO"), 1.0, 0.0);
     m.ntg = fp.has_double("NTG") ? global(fp.get_double("NTG"), 1.0, 1.0) : std::vector<double>(n, 1.0);
+    if (deck.hasKeyword("MULTREGT")) read_region_multipliers(deck, state, m);
     if (grid.isPinchActive()) {
       m.pinch.active = true;
       m.pinch.threshold = grid.getPinchThresholdThickness();
@@ -182,6 +242,7 @@ Vec3 pillar_point(const CornerPointModel& m, int p, double z) {
 }
 
 bool has_transmissibility_multipliers(const CornerPointModel& m) {
+  if (m.region_mult) return true;
   for (const std::vector<double>& v : m.trans_mult)
     if (std::any_of(v.begin(), v.end(), [](double x) { return x != 1.0; })) return true;
   return false;

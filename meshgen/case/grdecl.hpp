@@ -4,6 +4,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,6 +17,9 @@ struct ReservoirSpec;
 
 /// A corner-point model as OPM reads it. Arrays are per cell in natural order
 /// (i fastest, then j, then k; size nx*ny*nz), rock in mD and fractions.
+/// OPM's region multipliers (MULTREGT) of a model, opaque here (grdecl.cpp holds OPM's TransMult).
+struct RegionMultipliers;
+
 struct CornerPointModel {
   int nx = 0, ny = 0, nz = 0;
   /// 8 corners per cell in the grid's input frame (COORD/ZCORN; z depth, positive down);
@@ -48,6 +52,13 @@ struct CornerPointModel {
     bool pinchout_all = false;    ///< PINCHOUT_OPTION ALL (else TOPBOT)
     bool multz_all = false;       ///< MULTZ_OPTION ALL: the smallest MULTZ down the pinched column (else TOP)
   } pinch;
+  /// MULTREGT: OPM's own region multipliers (TransMult::getRegionMultiplier, in the model as read: a
+  /// refined model asks with its cells' parents), null without the keyword; its records and the region
+  /// arrays they name (MULTNUM, FLUXNUM, OPERNUM; per cell of the model as read) as the deck gives them,
+  /// to write them back (docs/corner-point.md, "Region multipliers").
+  std::shared_ptr<const RegionMultipliers> region_mult;
+  std::vector<std::string> multregt_records;              ///< each record's items, defaults as `1*`
+  std::map<std::string, std::vector<int>> region_arrays;  ///< by keyword
   bool has_mapaxes = false;
   /// MAPAXES as OPM applies it: the map (world) position of grid point (0, 0) and of the
   /// unit grid x and y directions (origin, unit_x, unit_y), for has_mapaxes.
@@ -65,7 +76,13 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
 /// InputError naming `key` and the first cell that is not (corner-point geometry is not meshed yet).
 ReservoirSpec rectilinear_reservoir(const CornerPointModel& model, const std::string& key);
 
-/// Whether any of the model's transmissibility multipliers (trans_mult) is not 1.
+/// OPM Flow's MULTREGT multiplier of the connection between model cells a and b (natural indices of
+/// `model`, refined or not): TransMult::getRegionMultiplier of their cells in the model as read, in the
+/// direction of the axis along which those differ (I, else J, else K); 1 without MULTREGT or within
+/// one cell of the model as read.
+double region_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
+
+/// Whether any of the model's transmissibility multipliers (trans_mult) is not 1, or it has MULTREGT.
 bool has_transmissibility_multipliers(const CornerPointModel& model);
 
 /// Whether every cell is an axis-aligned box on common axes and active (exact equality, no tolerance):

@@ -42,7 +42,7 @@ double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b
     double down = multiplier(model, 4, top);
     if (model.pinch.multz_all)
       for (int64_t c = top + nxy; c < bottom; c += nxy) down = std::min(down, multiplier(model, 4, c));
-    return down * multiplier(model, 5, bottom);
+    return down * multiplier(model, 5, bottom) * region_multiplier(model, a, b);
   }
   const int64_t nx = model.nx, nxy = static_cast<int64_t>(model.nx) * model.ny;
   const int64_t ia = a % nx, ja = (a / nx) % model.ny, ka = a / nxy;
@@ -50,7 +50,7 @@ double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b
   const int axis = ia != ib ? 0 : ja != jb ? 1 : 2;
   const bool plus = axis == 0 ? ib > ia : axis == 1 ? jb > ja : kb > ka;
   const int dir = 2 * axis + (plus ? 0 : 1), opposite = 2 * axis + (plus ? 1 : 0);
-  return multiplier(model, dir, a) * multiplier(model, opposite, b);
+  return multiplier(model, dir, a) * multiplier(model, opposite, b) * region_multiplier(model, a, b);
 }
 
 FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& model, const CornerPointCellFaces* cells,

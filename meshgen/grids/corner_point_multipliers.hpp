@@ -20,6 +20,7 @@ bool across_pinched_layers(const CornerPointModel& model, int64_t a, int64_t b);
 /// (I where their i differ, else J where their j differ, else K). Across pinched-out layers of a
 /// column: 0 without PINCH (OPM Flow does not connect them), else MULTZ of the upper cell (MULTZ
 /// option TOP; ALL: the smallest MULTZ from it down to the last pinched cell) x MULTZ- of the lower.
+/// Times MULTREGT's region multiplier (region_multiplier).
 double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
 
 struct FaceMultipliers {

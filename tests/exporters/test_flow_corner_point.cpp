@@ -241,14 +241,15 @@ TEST(FlowCornerPoint, InclinedPillarsWithADeviatedWellMatchesSolverDemo) {
 // The model's transmissibility multipliers (MULTX..MULTZ-, FAULTS/MULTFLT) with near-well cells
 // (docs/corner-point.md, "Transmissibility multipliers"): MULTX, MULTY-, MULTZ on every layer (0.02 on
 // the producer's layer 6, inside its cavity) and a fault of 6 m throw between the wells with MULTFLT
-// 0.05. The mesh carries them on the faces between model cells and on the cavity walls; flow runs the
-// deck and matches solver_demo. Fail half: solver_demo without the multipliers misses flow.
+// 0.05, and MULTREGT between three MULTNUM regions (region_multiplier_keywords). The mesh carries them on
+// the faces between model cells and on the cavity walls; flow runs the deck and matches solver_demo. Fail
+// half: solver_demo without the multipliers misses flow.
 TEST(FlowCornerPoint, ModelWithMultipliersAndWellsMatchesSolverDemo) {
   REQUIRE_FLOW();
   TempDir tmp("flow_cpw_mult");
   TiltedModel g;
   g.fault_i = 8, g.throw_m = 6;
-  g.keywords = multiplier_keywords(g, 6);
+  g.keywords = multiplier_keywords(g, 6) + region_multiplier_keywords(g);
   CornerPointFlowRun r;
   run_case(tmp, g, two_wells_yaml(), &r);
   if (HasFatalFailure()) return;
@@ -386,21 +387,35 @@ void print_own_vs_ours(const char* label, const OwnVsOurs& d, int kind = -1) {
 // models to 1e-6 on every pair; with HM_REEK_DECK the same figures for Reek (measured, not asserted).
 TEST(FlowCornerPoint, OurModelTransmissibilitiesAgainstFlowsOwn) {
   REQUIRE_FLOW();
-  for (int variant : {0, 1, 2}) {
+  for (int variant : {0, 1, 2, 3}) {
     TempDir tmp("cpw_own");
     TiltedModel g;
     g.inclined_pillars = variant == 1;
     g.nz = variant == 1 ? 22 : 16;
-    if (variant == 2) {  // a fault of 6 m throw and multipliers on every face (flow applies them itself)
+    if (variant >= 2) {  // a fault of 6 m throw and multipliers on every face (flow applies them itself)
       g.fault_i = 6, g.throw_m = 6;
       g.keywords = multiplier_keywords(g, 6);
     }
+    if (variant == 3) g.keywords += region_multiplier_keywords(g);  // and MULTREGT between MULTNUM regions
     std::ofstream(tmp.path / "M.GRDECL") << g.text();
     std::ofstream(tmp.path / "cpm.yaml") << "name: cpm\nreservoir: {grdecl: M.GRDECL}\n";
     const hm::CaseSpec cs = hm::load_case((tmp.path / "cpm.yaml").string());
     const OwnVsOurs d = compare_with_flows_own(cs, tmp.path / "deck");
-    print_own_vs_ours(variant == 0 ? "tilted, vertical pillars" : variant == 1 ? "inclined pillars"
-                                                                                : "tilted, fault, multipliers", d);
+    static const char* kLabel[4] = {"tilted, vertical pillars", "inclined pillars", "tilted, fault, multipliers",
+                                    "tilted, fault, multipliers, MULTREGT"};
+    print_own_vs_ours(kLabel[variant], d);
+    if (variant == 3) {  // fail half: ours without MULTREGT (the deck keeps it, flow applies it)
+      hm::CaseSpec plain = cs;
+      auto model = std::make_shared<hm::CornerPointModel>(*cs.reservoir.corner_point);
+      model->region_mult.reset();
+      plain.reservoir.corner_point = model;
+      const OwnVsOurs without = compare_with_flows_own(plain, tmp.path / "deck_without_multregt");
+      size_t off = 0;
+      for (double r : without.rel) off += std::abs(r) > 0.01;
+      std::printf("[ figures  ] fail half: without MULTREGT in ours %zu of %zu pairs differ by more than 1 %%\n", off,
+                  without.rel.size());
+      EXPECT_GT(off, 100u);
+    }
     if (variant == 2) {  // fail half: ours without the multipliers are not flow's
       const OwnVsOurs without = compare_with_flows_own(cs, tmp.path / "deck_without", true);
       size_t off = 0;

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -112,6 +113,41 @@ TEST(NearWellRefinement, ChildrenTileTheirParents) {
     EXPECT_EQ(r.trans_mult[4][c], 0.125);
   }
   EXPECT_EQ(on_model_pillars, 8 * m.nx * m.ny * m.nz);  // each parent's 8 corners, once each
+}
+
+// MULTREGT (OPM's region multipliers) reaches a refined model's connections through the children's
+// parents: between children of two model cells the model's multiplier, within one cell none.
+TEST(NearWellRefinement, ChildrenKeepTheModelsRegionMultipliers) {
+  TempDir tmp("cprefine_multregt");
+  hmtest::TiltedModel g;
+  g.nx = 6, g.ny = 3, g.nz = 10;
+  g.keywords = hmtest::region_multiplier_keywords(g);
+  std::ofstream(tmp.path / "M.GRDECL") << g.text();
+  const CornerPointModel m = read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
+  ASSERT_TRUE(m.region_mult);
+  ASSERT_EQ(m.multregt_records.size(), 2u);
+  ASSERT_EQ(m.region_arrays.count("MULTNUM"), 1u);
+  const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}});
+  std::map<double, int> seen;
+  const int64_t step[3] = {1, r.nx, static_cast<int64_t>(r.nx) * r.ny};
+  for (int64_t a = 0; a < static_cast<int64_t>(r.corners.size()); ++a) {
+    const int64_t i = a % r.nx, j = (a / r.nx) % r.ny, k = a / step[2];
+    for (int d = 0; d < 3; ++d) {
+      if ((d == 0 && i + 1 == r.nx) || (d == 1 && j + 1 == r.ny) || (d == 2 && k + 1 == r.nz)) continue;
+      const int64_t b = a + step[d], pa = r.parent_cell[a], pb = r.parent_cell[b];
+      const double expected = pa == pb ? 1.0 : region_multiplier(m, pa, pb);
+      EXPECT_EQ(region_multiplier(r, a, b), expected) << a << " " << b;
+      ++seen[region_multiplier(r, a, b)];
+    }
+  }
+  // Regions 1 | 2 across i = 4 (x 0.1 in I), 2 | 3 across k = 8 (x 0.02 in K) in the model as read.
+  const int64_t across_i = 3 + m.nx * (1 + m.ny * 2), across_k = 4 + m.nx * (1 + m.ny * 7);
+  EXPECT_DOUBLE_EQ(region_multiplier(m, across_i, across_i + 1), 0.1);
+  EXPECT_DOUBLE_EQ(region_multiplier(m, across_k, across_k + m.nx * m.ny), 0.02);
+  EXPECT_DOUBLE_EQ(region_multiplier(m, across_i + 1, across_i + 2), 1.0);
+  EXPECT_GT(seen[0.1], 0);
+  EXPECT_GT(seen[0.02], 0);
+  std::printf("[ figures  ] refined model: %d connections x 0.1, %d x 0.02, %d x 1\n", seen[0.1], seen[0.02], seen[1.0]);
 }
 
 // The splits: fine near the well, coarser away, none far off or in narrow columns; the same when

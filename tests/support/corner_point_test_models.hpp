@@ -111,6 +111,19 @@ inline std::string multiplier_keywords(const TiltedModel& g, int barrier_k) {
   return o.str();
 }
 
+/// MULTNUM regions 1 (i < 4), 2 (i >= 4, k < 8) and 3 (i >= 4, k >= 8) and MULTREGT records between them:
+/// 1-2 x 0.1 in every direction, 2-3 x 0.02 in Z only (flow applies neither to an X connection of 2-3).
+inline std::string region_multiplier_keywords(const TiltedModel& g) {
+  std::ostringstream o;
+  o << "MULTNUM\n";
+  for (int c = 0; c < g.nx * g.ny * g.nz; ++c) {
+    const int i = c % g.nx, k = c / (g.nx * g.ny);
+    o << (i < 4 ? 1 : k < 8 ? 2 : 3) << "\n";
+  }
+  o << "/\nMULTREGT\n 1 2 0.1 XYZ 1* M /\n 2 3 0.02 Z 1* M /\n/\n";
+  return o.str();
+}
+
 /// Planar layers (depth 1000 + dz k + tan(dip) x + 0.01 y at pillar (x, y) = (dx I, dy J)) on
 /// parallel straight pillars inclined `pillar_deg` from the vertical toward azimuth `pillar_azimuth_deg`
 /// (0: +x, 90: +y), so every cell face is
