@@ -274,13 +274,22 @@ void require_range(double v, double lo, double hi, bool lo_open, const std::stri
 }
 
 // reservoir.grdecl: a model file read by OPM instead of the x/y/z axes and the uniform rock.
-ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir) {
+ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir, std::vector<std::string>& notes) {
   for (const char* k : {"x", "y", "z", "permeability", "porosity"})
     if (f.get(k)) fail(f.path(k), "not with reservoir.grdecl (the model gives the grid and its rock)");
   std::string path = read_string(f.required("grdecl"), f.path("grdecl"));
   if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
   auto shared = std::make_shared<const CornerPointModel>(read_corner_point_model(path, f.path("grdecl")));
   const CornerPointModel& model = *shared;
+  if (model.below_minpv > 0) {
+    char pv[160];
+    std::snprintf(pv, sizeof pv, "%.6g rm3, %.3g %% of the active pore volume", model.below_minpv_pore_volume,
+                  100 * model.below_minpv_pore_volume / model.active_pore_volume);
+    notes.push_back(f.path("grdecl") + ": " + std::to_string(model.below_minpv) +
+                    " active cells have a pore volume below the model's MINPV (" + pv +
+                    "): OPM Flow removes them and connects the cells above and below across them; the mesh keeps "
+                    "them as cells (docs/corner-point.md, \"MINPV\")");
+  }
   // Axis-aligned boxes, all active, no multiplier: the rectilinear grid (the same mesh as the box
   // form); else the model's own cells (meshgen/grids/corner_point_grid.hpp), which carry multipliers.
   ReservoirSpec r = is_rectilinear(model) && !has_transmissibility_multipliers(model) ? rectilinear_reservoir(model, f.path("grdecl"))
@@ -383,13 +392,13 @@ void refine_near_wells(CaseSpec& cs) {
   r.corner_point = grid.corner_point;
 }
 
-ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir) {
+ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, std::vector<std::string>& notes) {
   const Fields f(n, "reservoir",
                  {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size",
                   "near_well_layer_aspect"});
   ReservoirSpec r;
   if (f.get("grdecl")) {
-    r = read_grdecl_reservoir(f, base_dir);
+    r = read_grdecl_reservoir(f, base_dir, notes);
     if (auto s = f.get("near_well_cell_size")) r.near_well_cell_size = read_near_well_cell_size(*s, f.path("near_well_cell_size"));
   } else {
     if (f.get("near_well_cell_size")) fail(f.path("near_well_cell_size"), "only with reservoir.grdecl (a corner-point model)");
@@ -642,7 +651,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
     else if (m->IsScalar() && s == "euclidean") cs.metric = MeshMetric::Euclidean;
     else fail("metric", "expected permeability or euclidean, got " + describe(*m));
   }
-  cs.reservoir = read_reservoir(f.required("reservoir"), base_dir);
+  cs.reservoir = read_reservoir(f.required("reservoir"), base_dir, cs.notes);
   if (auto t = f.get("transition")) cs.transition = read_transition(*t);
   if (auto fl = f.get("fluid")) cs.fluid = read_fluid(*fl);
   if (auto wells = f.get("wells"); wells && !wells->IsNull()) {

@@ -171,6 +171,16 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
     m.poro = global(fp.get_double("PORO"), 1.0, 0.0);
     m.ntg = fp.has_double("NTG") ? global(fp.get_double("NTG"), 1.0, 1.0) : std::vector<double>(n, 1.0);
     if (deck.hasKeyword("MULTREGT")) read_region_multipliers(deck, state, m);
+    {
+      const std::vector<double> porv = fp.porv(true);
+      const bool minpv = grid.getMinpvMode() != Opm::MinpvMode::ModeEnum::Inactive;
+      const std::vector<double>& limit = grid.getMinpvVector();
+      for (size_t c = 0; c < n && c < porv.size(); ++c) {
+        if (!m.actnum[c]) continue;
+        m.active_pore_volume += porv[c];
+        if (minpv && c < limit.size() && porv[c] < limit[c]) ++m.below_minpv, m.below_minpv_pore_volume += porv[c];
+      }
+    }
     if (grid.isPinchActive()) {
       m.pinch.active = true;
       m.pinch.threshold = grid.getPinchThresholdThickness();

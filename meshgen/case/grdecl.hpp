@@ -1,6 +1,7 @@
 // Reservoir models from Eclipse/OPM decks (GRDECL: SPECGRID/COORD/ZCORN/ACTNUM, PERMX/PERMY/PERMZ,
 // PORO, NTG, MAPAXES), read with OPM's own parser and grid (libopm-common), so that every keyword
-// (INCLUDE, MULTIPLY, BOX, EQUALS, MINPV, PINCH, ...) means what it means in OPM Flow.
+// (INCLUDE, MULTIPLY, BOX, EQUALS, PINCH, MULTREGT, ...) means what it means in OPM Flow; MINPV is
+// counted, not applied (docs/corner-point.md, "MINPV").
 #pragma once
 #include <array>
 #include <cstdint>
@@ -25,7 +26,7 @@ struct CornerPointModel {
   /// 8 corners per cell in the grid's input frame (COORD/ZCORN; z depth, positive down);
   /// corner bit 0 = +i, bit 1 = +j, bit 2 = +k (OPM's and Eclipse's order).
   std::vector<std::array<Vec3, 8>> corners;
-  std::vector<int> actnum;                     ///< 1 active, 0 inactive (ACTNUM after MINPV/PINCH)
+  std::vector<int> actnum;                     ///< 1 active, 0 inactive (EclipseGrid: ACTNUM, cells of no volume; not MINPV)
   std::vector<double> permx, permy, permz;     ///< mD
   std::vector<double> poro, ntg;               ///< NTG is 1 where the deck has none
   /// The deck's geometry as OPM holds it (EclipseGrid::getCOORD/getZCORN): 6 numbers per pillar
@@ -52,6 +53,11 @@ struct CornerPointModel {
     bool pinchout_all = false;    ///< PINCHOUT_OPTION ALL (else TOPBOT)
     bool multz_all = false;       ///< MULTZ_OPTION ALL: the smallest MULTZ down the pinched column (else TOP)
   } pinch;
+  /// MINPV (MINPV, MINPORV, MINPVV): active cells whose pore volume (OPM's, PORV with NTG and MULTPV) is
+  /// below it, which OPM Flow removes (opm-grid's MinpvProcessor) and connects across; the mesh keeps
+  /// them as cells (docs/corner-point.md, "MINPV"). Their count and pore volume, and the active total.
+  int64_t below_minpv = 0;
+  double below_minpv_pore_volume = 0, active_pore_volume = 0;
   /// MULTREGT: OPM's own region multipliers (TransMult::getRegionMultiplier, in the model as read: a
   /// refined model asks with its cells' parents), null without the keyword; its records and the region
   /// arrays they name (MULTNUM, FLUXNUM, OPERNUM; per cell of the model as read) as the deck gives them,

@@ -89,8 +89,8 @@ FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& m
     const int64_t a = model_cell(mesh.face_owner[f]), b = model_cell(n);
     if (a >= 0 && b >= 0) {
       out.face[f] = connection_multiplier(model, a, b);
-      out.model_faces += out.face[f] != 1.0;
       if (across_pinched_layers(model, a, b)) ++(model.pinch.active ? out.pinch_faces : out.unpinched_faces);
+      else out.model_faces += out.face[f] != 1.0;
     } else if (a >= 0 || b >= 0) {
       const auto it = mesh.face_size(f) == 3 ? toward.find(triangle_key(mesh.nodes, mesh.face_begin(f))) : toward.end();
       if (it == toward.end()) {

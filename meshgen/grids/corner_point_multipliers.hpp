@@ -25,7 +25,7 @@ double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b
 
 struct FaceMultipliers {
   std::vector<double> face;     ///< per mesh face (PolyMesh::face_trans_mult), empty when the model has none
-  int64_t model_faces = 0;      ///< faces between two model cells with a multiplier not 1
+  int64_t model_faces = 0;      ///< faces between two model cells with a multiplier not 1, pinch faces apart
   int64_t wall_faces = 0;       ///< faces between a model cell and a near-well cell with a multiplier not 1
   int64_t pinch_faces = 0;      ///< faces between two cells of a column across pinched-out layers, with PINCH
   int64_t unpinched_faces = 0;  ///< the same without PINCH: multiplier 0, as OPM Flow does not connect them

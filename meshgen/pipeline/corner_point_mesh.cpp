@@ -221,6 +221,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
   const CornerPointModel& model = *cs.reservoir.corner_point;
   if (!cs.wells.empty()) return build_corner_point_wells(cs, opts);
   HybridMesh out;
+  out.notes = cs.notes;  // what reading the case found
   Stages stage(out, opts);
   out.grid = make_reservoir_grid(cs.reservoir);  // index arithmetic only (nx, ny, nz)
   MeshBuilder builder;

@@ -732,6 +732,29 @@ TEST(CornerPoint, FlowConnectsExactlyTheCellsTheMeshJoins) {
   }
 }
 
+// MINPV: the active cells whose pore volume is below it (OPM Flow removes them) are counted from OPM's
+// pore volumes (here volume x PORO: no NTG, no MULTPV) and named in a note; without MINPV none.
+TEST(CornerPoint, CellsBelowMinpvAreCountedAndNoted) {
+  for (const double minpv : {0.0, 3000.0}) {
+    TempDir tmp;
+    const std::string text = (minpv > 0 ? "MINPV\n " + num(minpv) + " /\n" : std::string()) + SyntheticCpg{}.text();
+    const CpgRun r = mesh_of(tmp, text);
+    const CornerPointModel& m = *r.cs.reservoir.corner_point;
+    int64_t expected = 0;
+    for (size_t c = 0; c < m.actnum.size(); ++c)
+      expected += m.actnum[c] && m.opm_volume[c] * m.poro[c] * m.ntg[c] < minpv;
+    EXPECT_EQ(m.below_minpv, expected) << minpv;
+    bool noted = false;
+    for (const std::string& note : r.out.notes) noted = noted || note.find("below the model's MINPV") != std::string::npos;
+    EXPECT_EQ(noted, expected > 0) << minpv;
+    if (minpv > 0) {
+      EXPECT_GT(expected, 0);
+    }
+    std::printf("[ figures  ] MINPV %g: %lld active cells below it, %.4g rm3 of %.6g\n", minpv,
+                static_cast<long long>(m.below_minpv), m.below_minpv_pore_volume, m.active_pore_volume);
+  }
+}
+
 // Two cells of a column touching across a layer of zero thickness are connected as OPM Flow connects
 // them: not without PINCH (multiplier 0), with PINCH by MULTZ of the upper cell (MULTZ option TOP) or
 // the smallest MULTZ down to the last pinched cell (ALL).
