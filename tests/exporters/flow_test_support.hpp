@@ -157,8 +157,10 @@ inline FlowComparison compare_flow(const hm::CaseSpec& cs, const hm::PolyMesh& m
   }
   // Connections: flow merges an NNC between cells that share a geometric face into that face's
   // TRANX/Y/Z, so compare per cell pair: flow's TRANX/Y/Z (active order, converted to pairs)
-  // plus its TRANNNC list must be exactly our TRANX/Y/Z plus NNC: none dropped, none added.
-  std::map<std::pair<int32_t, int32_t>, double> mine, theirs;
+  // plus its TRANNNC list must be exactly our TRANX/Y/Z plus NNC: none dropped, none added. Flow's
+  // TRANZ of a cell is its connection to the next active cell down the column: an NNC across
+  // inactive cells of zero thickness (a pinched-out layer) is reported there and in TRANNNC.
+  std::map<std::pair<int32_t, int32_t>, double> mine, theirs, across_inactive;
   const int32_t step[3] = {1, L.deck_nx, L.deck_nx * L.ny};
   const std::vector<double>* tran_ours[3] = {&conn.tranx, &conn.trany, &conn.tranz};
   const char* tran_keys[3] = {"tranx", "trany", "tranz"};
@@ -173,7 +175,9 @@ inline FlowComparison compare_flow(const hm::CaseSpec& cs, const hm::PolyMesh& m
       if ((*tran_ours[d])[g] != 0) mine[{g, g + step[d]}] += (*tran_ours[d])[g];
       if (L.deck_cell[g] < 0) continue;
       const double v = arr[a++].get<double>();
-      if (v != 0) theirs[{g, g + step[d]}] += v;
+      int32_t below = g + step[d];
+      while (d == 2 && below < static_cast<int32_t>(L.deck_cell.size()) && L.deck_cell[below] < 0) below += step[d];
+      if (v != 0) (below == g + step[d] ? theirs : across_inactive)[{g, below}] += v;
     }
   }
   for (const auto& r : conn.nnc) mine[{r.a, r.b}] += r.t;
@@ -202,6 +206,9 @@ inline FlowComparison compare_flow(const hm::CaseSpec& cs, const hm::PolyMesh& m
     }
     theirs[{a, b}] += v;
   }
+  // An NNC of the deck across inactive cells is in TRANNNC and again in the upper cell's TRANZ: once.
+  for (const auto& [pair, v] : across_inactive)
+    if (!theirs.count(pair)) theirs[pair] += v;
   c.our_connections = mine.size();
   c.flow_connections = theirs.size();
   for (const auto& [pair, v] : theirs) {

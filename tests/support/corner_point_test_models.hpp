@@ -55,10 +55,13 @@ struct TiltedModel {
   double pillar_twist = 0;        // inclined pillars whose slope also varies along the model's sides (bent sides)
   std::vector<int> inactive;      // cells with ACTNUM 0 (natural index)
   std::string keywords;           // GRDECL text appended (multipliers, FAULTS; multiplier_keywords)
+  int pinch_k = -1;               // a layer that thins from dz to 0 over 2 dx toward pinch_x and is 0 beyond
+  double pinch_x = 100;
 
   double depth(int i_col, int I, int J, int k) const {
     const double x = dx * I, y = dy * J;
     double z = 1000 + std::tan(dip_deg * M_PI / 180) * x + 0.01 * y + 1e-4 * x * y + dz * k;
+    if (pinch_k >= 0 && k > pinch_k) z -= dz * (1 - std::clamp((pinch_x - x) / (2 * dx), 0.0, 1.0));
     if (fault_i > 0 && i_col >= fault_i) z += throw_m;
     return z;
   }
