@@ -290,6 +290,14 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
                     "): OPM Flow removes them and connects the cells above and below across them; the mesh keeps "
                     "them as cells (docs/corner-point.md, \"MINPV\")");
   }
+  if (model.other_pore_volume > 0) {
+    char pv[200];
+    std::snprintf(pv, sizeof pv, "%.6g rm3 in OPM against %.6g", model.other_pore_volume_opm, model.other_pore_volume_ours);
+    notes.push_back(f.path("grdecl") + ": " + std::to_string(model.other_pore_volume) +
+                    " active cells have a pore volume other than volume x PORO x NTG (MULTPV or PORV in the deck; " + pv +
+                    "), which the mesh's porosity is: the model's pore volumes there are not carried "
+                    "(docs/corner-point.md, \"MINPV\")");
+  }
   // Axis-aligned boxes, all active, no multiplier: the rectilinear grid (the same mesh as the box
   // form); else the model's own cells (meshgen/grids/corner_point_grid.hpp), which carry multipliers.
   ReservoirSpec r = is_rectilinear(model) && !has_transmissibility_multipliers(model) ? rectilinear_reservoir(model, f.path("grdecl"))

@@ -16,6 +16,7 @@
 #include <opm/input/eclipse/Units/Units.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <set>
 #include <filesystem>
@@ -54,6 +55,10 @@ struct RegionMultipliers {
 };
 
 namespace {
+
+// Relative difference below which OPM's pore volume and volume x PORO x NTG are the same number (the
+// order of OPM's multiplications).
+constexpr double kPoreVolumeRounding = 1e-12;
 
 // MULTREGT: OPM's TransMult (its region multipliers), the records as the deck gives them and the
 // region arrays they name, per cell (1 on inactive cells, which no connection reaches).
@@ -179,6 +184,10 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
         if (!m.actnum[c]) continue;
         m.active_pore_volume += porv[c];
         if (minpv && c < limit.size() && porv[c] < limit[c]) ++m.below_minpv, m.below_minpv_pore_volume += porv[c];
+        // The same doubles OPM multiplies (EclipseGrid volume, PORO, NTG): a relative 1e-12 is rounding.
+        const double ours = m.opm_volume[c] * m.poro[c] * m.ntg[c];
+        if (std::abs(porv[c] - ours) > kPoreVolumeRounding * std::max(std::abs(ours), std::abs(porv[c])))
+          ++m.other_pore_volume, m.other_pore_volume_opm += porv[c], m.other_pore_volume_ours += ours;
       }
     }
     if (grid.isPinchActive()) {

@@ -58,6 +58,10 @@ struct CornerPointModel {
   /// them as cells (docs/corner-point.md, "MINPV"). Their count and pore volume, and the active total.
   int64_t below_minpv = 0;
   double below_minpv_pore_volume = 0, active_pore_volume = 0;
+  /// Active cells whose OPM pore volume is not volume x PORO x NTG (MULTPV, PORV edits), which the mesh's
+  /// porosity is: their count and OPM's pore volume of them against that product (docs/corner-point.md).
+  int64_t other_pore_volume = 0;
+  double other_pore_volume_opm = 0, other_pore_volume_ours = 0;
   /// MULTREGT: OPM's own region multipliers (TransMult::getRegionMultiplier, in the model as read: a
   /// refined model asks with its cells' parents), null without the keyword; its records and the region
   /// arrays they name (MULTNUM, FLUXNUM, OPERNUM; per cell of the model as read) as the deck gives them,

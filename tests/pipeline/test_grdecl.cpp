@@ -755,6 +755,35 @@ TEST(CornerPoint, CellsBelowMinpvAreCountedAndNoted) {
   }
 }
 
+// MULTPV (OPM's pore volume other than volume x PORO x NTG, which the mesh's porosity is): the cells are
+// counted and named in a note; without it none (the same doubles: no rounding counted).
+TEST(CornerPoint, PoreVolumesOtherThanTheRocksAreNoted) {
+  const SyntheticCpg g;
+  const int n = g.nx * g.ny * g.nz;
+  for (const bool multpv : {false, true}) {
+    TempDir tmp;
+    std::ostringstream text;
+    text << g.text();
+    if (multpv) {
+      text << "MULTPV\n";
+      for (int c = 0; c < n; ++c) text << (c % 10 == 0 ? 2.5 : 1.0) << "\n";
+      text << "/\n";
+    }
+    const CpgRun r = mesh_of(tmp, text.str());
+    const CornerPointModel& m = *r.cs.reservoir.corner_point;
+    int64_t expected = 0;
+    for (int c = 0; c < n; ++c) expected += multpv && c % 10 == 0 && m.actnum[c] && m.opm_volume[c] > 0;
+    EXPECT_EQ(m.other_pore_volume, expected);
+    if (multpv) {
+      EXPECT_GT(expected, 0);
+      EXPECT_NEAR(m.other_pore_volume_opm / m.other_pore_volume_ours, 2.5, 1e-12);
+    }
+    bool noted = false;
+    for (const std::string& note : r.out.notes) noted = noted || note.find("other than volume x PORO x NTG") != std::string::npos;
+    EXPECT_EQ(noted, multpv);
+  }
+}
+
 // Two cells of a column touching across a layer of zero thickness are connected as OPM Flow connects
 // them: not without PINCH (multiplier 0), with PINCH by MULTZ of the upper cell (MULTZ option TOP) or
 // the smallest MULTZ down to the last pinched cell (ALL).
