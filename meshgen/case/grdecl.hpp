@@ -16,11 +16,11 @@ namespace hm {
 
 struct ReservoirSpec;
 
-/// A corner-point model as OPM reads it. Arrays are per cell in natural order
-/// (i fastest, then j, then k; size nx*ny*nz), rock in mD and fractions.
 /// OPM's region multipliers (MULTREGT) of a model, opaque here (grdecl.cpp holds OPM's TransMult).
 struct RegionMultipliers;
 
+/// A corner-point model as OPM reads it. Arrays are per cell in natural order
+/// (i fastest, then j, then k; size nx*ny*nz), rock in mD and fractions.
 struct CornerPointModel {
   int nx = 0, ny = 0, nz = 0;
   /// 8 corners per cell in the grid's input frame (COORD/ZCORN; z depth, positive down);

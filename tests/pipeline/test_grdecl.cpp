@@ -711,9 +711,16 @@ std::set<std::pair<int, int>> pinch_pairs(const CpgRun& r) {
 // only with PINCH, which the deck then carries; there flow's transmissibility is ours.
 TEST(CornerPoint, FlowConnectsExactlyTheCellsTheMeshJoins) {
   REQUIRE_FLOW();
-  for (const bool pinch : {false, true}) {
+  const SyntheticCpg g;
+  std::ostringstream multz;  // 0.8 on layer 0, 0.5 on the pinching layer 1: MULTZ option ALL takes 0.5 across it
+  multz << "MULTZ\n";
+  for (int c = 0; c < g.nx * g.ny * g.nz; ++c) multz << (c / (g.nx * g.ny) == 0 ? 0.8 : c / (g.nx * g.ny) == 1 ? 0.5 : 1.0) << "\n";
+  multz << "/\n";
+  for (const int variant : {0, 1, 2}) {  // no PINCH; PINCH; PINCH with MULTZ option ALL and MULTZ
+    const bool pinch = variant > 0;
     TempDir tmp;
-    const CpgRun r = mesh_of(tmp, (pinch ? "PINCH\n 0.4 NOGAP 1* TOPBOT TOP /\n" : "") + SyntheticCpg{}.text());
+    const std::string pinch_kw = variant == 1 ? "PINCH\n 0.4 NOGAP 1* TOPBOT TOP /\n" : variant == 2 ? "PINCH\n 1* GAP 1* TOPBOT ALL /\n" : "";
+    const CpgRun r = mesh_of(tmp, pinch_kw + g.text() + (variant == 2 ? multz.str() : ""));
     const FlowPairs p = flow_and_mesh_pairs(r, tmp.path / "deck", "CPG");
     const std::set<std::pair<int, int>> across = pinch_pairs(r);
     EXPECT_EQ(across.size(), 10u);
@@ -725,7 +732,7 @@ TEST(CornerPoint, FlowConnectsExactlyTheCellsTheMeshJoins) {
       if (p.flow_value.count(pair)) worst = std::max(worst, std::abs(p.ours.at(pair) / p.flow_value.at(pair) - 1));
     std::printf("[ figures  ] %s: flow connects %zu cell pairs, the mesh %zu (%zu across the pinched-out layer, %s); "
                 "there ours vs flow's at most %.2e\n",
-                pinch ? "PINCH" : "no PINCH", p.flow.size(), p.mesh.size(), across.size(),
+                variant == 0 ? "no PINCH" : variant == 1 ? "PINCH" : "PINCH, MULTZ option ALL", p.flow.size(), p.mesh.size(), across.size(),
                 pinch ? "connected" : "no flow", worst);
     EXPECT_LT(worst, 1e-6);
     EXPECT_GT(p.flow.size(), 200u);
