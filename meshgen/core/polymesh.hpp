@@ -35,12 +35,13 @@ struct RadialCellInfo {
   int32_t sector = -1;   ///< angular index
   int32_t segment = -1;  ///< index along the trajectory
   double r_in = 0, r_out = 0;  ///< radii of the inner and outer ring polygons (circumradii)
-  double r_center = 0;         ///< radius of the FV centre: sqrt(r_in * r_out)
+  double r_center = 0;         ///< radius of the FV centre: sqrt(r_in * r_out) (caps: / cos(beta_0))
   double angle = 0;            ///< sector angle (rad)
   double length = 0;           ///< cell length along the trajectory axis (m); 0 in an end cap
   /// Hemispherical end caps (docs/mesh-layout.md): latitude band 0 (at the end plane) ..
   /// bands-1 (at the pole), -1 for a cell of the cylindrical part. In a cap, r_in / r_out /
-  /// r_center are distances from cap_center (the trajectory's end point), segment is -1 for
+  /// r_center are distances from cap_center (the trajectory's end point; r_center is the
+  /// cylinder's sqrt(r_in * r_out) / cos(beta_0), beta_0 band 0's centre latitude), segment is -1 for
   /// the cap before the first segment and `segments` for the one after the last.
   int32_t band = -1;
   Vec3 cap_center;

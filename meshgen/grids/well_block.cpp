@@ -482,6 +482,12 @@ CapLatitudes cap_latitudes(int bands, double sector_angle) {
   return c;
 }
 
+// Distance from the cap centre E of the FV centres of a ring whose cylinder cells have theirs at
+// `cylinder_r_center` from the axis.
+double cap_centre_distance(double cylinder_r_center, const CapLatitudes& lat) {
+  return cylinder_r_center / std::cos(lat.beta[0]);
+}
+
 // Orients a closed convex cell's faces outward (normal away from the mean of its nodes).
 void orient_outward(const std::vector<Vec3>& x, std::vector<CellFace>& faces) {
   Vec3 inside;
@@ -690,6 +696,10 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
           RadialCellInfo& rad = at.radial;
           rad.band = j;
           rad.cap_center = e;
+          // Every centre of ring i at one distance from E keeps the shell, cone and meridian faces
+          // orthogonal; r_center / cos(beta_0) puts band 0's centre straight above the cylinder's
+          // (at r_center from the axis), so the end plane is orthogonal too.
+          rad.r_center = cap_centre_distance(rad.r_center, lat);
           const double phi_mid = (s + 0.5) * sector_angle;
           const Vec3 m = std::cos(phi_mid) * st.u + std::sin(phi_mid) * st.v;
           at.fv_center = e + rad.r_center * (std::cos(lat.beta[j]) * m + std::sin(lat.beta[j]) * a);

@@ -988,10 +988,10 @@ TEST_P(HemisphereCaps, CellsClosedPositivePlanarCocircularOnSphericalShells) {
               label().c_str(), faces, worst_circle, worst_plane, worst_closure);
 }
 
-// Shell, cone and meridian faces are orthogonal to the centre-to-centre segments; the end
-// plane between the cylinder and band 0 is not (the cylinder's centre lies half a layer
-// before it, the cap's at latitude beta_0 after it), but stays within 10 degrees.
-TEST_P(HemisphereCaps, ShellConeMeridianFacesOrthogonalEndPlaneNearly) {
+// Shell, cone and meridian faces are orthogonal to the centre-to-centre segments, and so is
+// the end plane between the cylinder and band 0: the cap's centres lie at r_center /
+// cos(beta_0) from the end point, band 0's straight above the cylinder's.
+TEST_P(HemisphereCaps, ShellConeMeridianAndEndPlaneFacesOrthogonal) {
   const WellParams p = params();
   const BuiltBlock b = build(make_case(p), p.sectors);
   const int bands = hemisphere_cap_bands(p.sectors);
@@ -1004,9 +1004,9 @@ TEST_P(HemisphereCaps, ShellConeMeridianFacesOrthogonalEndPlaneNearly) {
   EXPECT_LT(a.shell, 1e-9) << label();
   EXPECT_LT(a.cone, 1e-9) << label();
   EXPECT_LT(a.meridian, 1e-9) << label();
-  EXPECT_LT(a.end_plane, 10 * kPi / 180) << label();
-  std::printf("[ cap orth. ] %-32s shell %.1e cone %.1e meridian %.1e rad, end plane %.2f deg\n", label().c_str(),
-              a.shell, a.cone, a.meridian, a.end_plane * 180 / kPi);
+  EXPECT_LT(a.end_plane, 1e-9) << label();
+  std::printf("[ cap orth. ] %-32s shell %.1e cone %.1e meridian %.1e end plane %.1e rad\n", label().c_str(),
+              a.shell, a.cone, a.meridian, a.end_plane);
 }
 
 // Every FV centre (cap and cylinder) strictly on the inner side of each of its cell's faces.
@@ -1146,6 +1146,20 @@ TEST(HemisphereCapChecks, FailOnBrokenCaps) {
   EXPECT_GT(a.shell, 1e-4);
   EXPECT_GT(a.cone, 1e-4);
   EXPECT_LT(a.meridian, 1e-9);  // the node mean stays on the mid-meridian plane: still orthogonal
+
+  // Centres at sqrt(r_in r_out) from the end point (without 1 / cos(beta_0)): shells, cones and
+  // meridians stay orthogonal, the end plane leans by about beta_0 / 2.
+  BuiltBlock inner = b;
+  for (int c = 0; c < inner.mesh.n_cells(); ++c) {
+    const RadialCellInfo& r = inner.mesh.cell_radial[c];
+    if (r.band < 0) continue;
+    const Vec3 x = inner.mesh.cell_fv_center[c];
+    inner.mesh.cell_fv_center[c] = r.cap_center + std::sqrt(r.r_in * r.r_out) * normalized(x - r.cap_center);
+  }
+  const CapFaceAngles ai = cap_face_angles(inner.mesh, inner.geo);
+  EXPECT_LT(ai.shell, 1e-9);
+  EXPECT_LT(ai.cone, 1e-9);
+  EXPECT_GT(ai.end_plane, 1.0 * kPi / 180);
 
   // A centre just beyond the cell's outer shell.
   const Vec3 fv = blk.cell_attrs[polar].fv_center;
