@@ -298,6 +298,12 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
                     "), which the mesh's porosity is: the model's pore volumes there are not carried "
                     "(docs/corner-point.md, \"MINPV\")");
   }
+  if (model.deck_nnc > 0 || model.deck_editnnc > 0)
+    notes.push_back(f.path("grdecl") + ": the deck's NNC adds " + std::to_string(model.deck_nnc) +
+                    " connections between cells and its EDITNNC multiplies " + std::to_string(model.deck_editnnc) +
+                    " cell pairs' transmissibilities; the mesh connects cells through their shared faces only and "
+                    "carries neither (nor its decks), so OPM Flow on the model's own deck has connections the mesh "
+                    "does not (docs/corner-point.md, \"NNC and EDITNNC\")");
   // Axis-aligned boxes, all active, no multiplier: the rectilinear grid (the same mesh as the box
   // form); else the model's own cells (meshgen/grids/corner_point_grid.hpp), which carry multipliers.
   ReservoirSpec r = is_rectilinear(model) && !has_transmissibility_multipliers(model) ? rectilinear_reservoir(model, f.path("grdecl"))

@@ -9,6 +9,7 @@
 #include <opm/input/eclipse/EclipseState/Grid/FieldPropsManager.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/FaceDir.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/MapAxes.hpp>
+#include <opm/input/eclipse/EclipseState/Grid/NNC.hpp>
 #include <opm/input/eclipse/EclipseState/Grid/TransMult.hpp>
 #include <opm/input/eclipse/Parser/ErrorGuard.hpp>
 #include <opm/input/eclipse/Parser/ParseContext.hpp>
@@ -189,6 +190,11 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
         if (std::abs(porv[c] - ours) > kPoreVolumeRounding * std::max(std::abs(ours), std::abs(porv[c])))
           ++m.other_pore_volume, m.other_pore_volume_opm += porv[c], m.other_pore_volume_ours += ours;
       }
+    }
+    {
+      const Opm::NNC& nnc = state.getInputNNC();
+      m.deck_nnc = static_cast<int64_t>(nnc.input().size());
+      m.deck_editnnc = static_cast<int64_t>(nnc.edit().size());
     }
     if (grid.isPinchActive()) {
       m.pinch.active = true;

@@ -62,6 +62,10 @@ struct CornerPointModel {
   /// porosity is: their count and OPM's pore volume of them against that product (docs/corner-point.md).
   int64_t other_pore_volume = 0;
   double other_pore_volume_opm = 0, other_pore_volume_ours = 0;
+  /// NNC and EDITNNC of the deck (OPM's EclipseState::getInputNNC): the connections NNC adds between two
+  /// cells and the EDITNNC records multiplying the transmissibility of given cell pairs. The mesh connects
+  /// cells through shared faces only and carries neither (docs/corner-point.md, "NNC and EDITNNC").
+  int64_t deck_nnc = 0, deck_editnnc = 0;
   /// MULTREGT: OPM's own region multipliers (TransMult::getRegionMultiplier, in the model as read: a
   /// refined model asks with its cells' parents), null without the keyword; its records and the region
   /// arrays they name (MULTNUM, FLUXNUM, OPERNUM; per cell of the model as read) as the deck gives them,

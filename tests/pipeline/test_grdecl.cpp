@@ -791,6 +791,29 @@ TEST(CornerPoint, PoreVolumesOtherThanTheRocksAreNoted) {
   }
 }
 
+// NNC and EDITNNC of the model's deck, which the mesh does not carry: counted (as OPM reads them) and
+// named in a note; without them no note.
+TEST(CornerPoint, DeckNncAndEditnncAreCountedAndNoted) {
+  for (const bool with : {false, true}) {
+    TempDir tmp;
+    std::string text = SyntheticCpg{}.text();
+    // OPM folds an EDITNNC on a deck NNC into that NNC and ignores one between logical neighbours
+    // (opm-common NNC::load_edit): of these three, only the pair (1,1,1)-(3,1,1) is counted.
+    if (with)
+      text += "NNC\n 1 1 1 3 3 3 0.5 /\n 2 1 1 4 2 3 1.25 /\n/\nEDIT\nEDITNNC\n 1 1 1 3 1 1 0.1 /\n 1 1 1 3 3 3 0.5 /\n"
+              " 1 1 1 2 1 1 0.1 /\n/\n";
+    const CpgRun r = mesh_of(tmp, text);
+    const CornerPointModel& m = *r.cs.reservoir.corner_point;
+    EXPECT_EQ(m.deck_nnc, with ? 2 : 0);
+    EXPECT_EQ(m.deck_editnnc, with ? 1 : 0);
+    bool noted = false;
+    for (const std::string& note : r.out.notes)
+      noted = noted || note.find("the deck's NNC adds 2 connections between cells and its EDITNNC multiplies 1") !=
+                           std::string::npos;
+    EXPECT_EQ(noted, with);
+  }
+}
+
 // Two cells of a column touching across a layer of zero thickness are connected as OPM Flow connects
 // them: not without PINCH (multiplier 0), with PINCH by MULTZ of the upper cell (MULTZ option TOP) or
 // the smallest MULTZ down to the last pinched cell (ALL).
