@@ -242,7 +242,7 @@ int cap_sites_off_bend_axes(SiteSet& set, const Cavity& cavity, const std::vecto
     for (size_t q = 0; q < cavity.faces.size(); ++q) {
       const ConstrainedFace& face = cavity.faces[q];
       const int s = set.internal_of[q];
-      if (face.side != FaceSide::Well || face.well != fs.well || s < 0) continue;
+      if (s < 0 || (face.side == FaceSide::Well && face.well != fs.well)) continue;
       if (set.sites[s].kind != SiteKind::InternalPolygon) continue;
       const PolygonFrame& f = frames[q];
       // Sphere of the site at t (through the polygon's circle) clear of the segment by the clearance.

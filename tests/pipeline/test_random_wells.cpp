@@ -100,6 +100,30 @@ TEST(RandomWells, EveryCaseMeshesConformingOrIsRefusedAsInput) {
   EXPECT_GE(meshed, 8);
 }
 
+// Narrow wedges at a bend (a short segment_length: no wedge longer than a segment outside the
+// bend): the fan of the inner-side wedge polygons' sites converges on the bend's focal line,
+// which free sites must own. Every site whose sphere covers the focal line is lowered off it,
+// reservoir polygons' included (docs/transition.md, "Bends: the focal line"): before, the
+// reservoir polygons' spheres covered the whole line, no free site was placed, and this 57-degree
+// bend failed the self-check (conformity) from 5 wedges on (segment_length 1.5 m and less).
+TEST(RandomWells, NarrowBendWedgesMeshAtEverySegmentLength) {
+  for (const double segment : {3.0, 1.5, 1.0, 0.5}) {
+    WellSpec w;
+    w.name = "B";
+    w.trajectory = {{121.27380110904662, 123.98985691436629, 1015.768043692008},
+                    {121.27380110904662, 123.98985691436629, 1029.768043692008},
+                    {121.41446089713006, 135.78741950047069, 1037.304470687008}};
+    w.radius = 0.1;
+    w.drainage_radius = 3;
+    w.rings = 4;
+    w.sectors = 12;
+    w.segment_length = segment;
+    w.end_caps = EndCaps::Flat;
+    SCOPED_TRACE("segment_length " + std::to_string(segment));
+    EXPECT_TRUE(meshes_or_is_refused(random_case("narrow_wedges", w), 0, true));
+  }
+}
+
 // Random bent wells (two legs, bends of 10-110 degrees in random planes): the bend wedges must
 // give a conforming mesh, convex transition cells with their sites inside (fvcheck), and a
 // volume equal to the box minus the wellbore hole, whose exact volume is the inner polygon's
