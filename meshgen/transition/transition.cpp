@@ -194,12 +194,13 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   // that touches the outer boundary is left as built (docs/optimization.md).
   const bool optimize = options.optimize && images.empty();
   std::shared_ptr<const TransitionCells> raw;
+  const std::vector<Vec3> outside = images.empty() ? well_polygon_centres(cavity, blocks) : std::vector<Vec3>{};
   if (optimize) {
     raw = std::make_shared<const TransitionCells>(out);
-    optimization = optimize_sites(set, cavity, node_coords, frames, options, out);
+    optimization = optimize_sites(set, cavity, node_coords, frames, options, outside, out);
   }
   // The optimiser's removals need a Q_S gain: sliver edges it left are removed here too.
-  if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, out);
+  if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, out);
   if (raw) out.unoptimized = std::move(raw);
   // Merge the stage reports.
   TransitionReport& r = out.report;

@@ -221,13 +221,18 @@ class PowerDiagram {
 /// The site optimiser (transition_optimize.cpp): rounds of independent site moves that
 /// remove or expand short edges, each followed by a rebuild of the exact diagram; `out` is a
 /// valid diagram of `set` on entry and on exit. Q_S's h is the entry diagram's h_ref.
+/// `outside_centres`: per cavity face, the FV centre of the cell beyond it (NaN where not known), so
+/// that a move may not turn a polygon face below fvcheck's orthogonality bound
+/// (well_polygon_centres).
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& options,
-                                  TransitionCells& out);
+                                  const std::vector<Vec3>& outside_centres, TransitionCells& out);
 /// Without optimisation: only the removal of sliver edges (kSliverEdge, transition_optimize.cpp),
 /// each kept unless a cell newly fails a shape check of the self-check. Returns the moves kept.
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
-                                       const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                                       TransitionCells& out);
+                        const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+                        const std::vector<Vec3>& outside_centres, TransitionCells& out);
+/// Per cavity face: the FV centre of the well cell beyond a well polygon; NaN for every other face.
+std::vector<Vec3> well_polygon_centres(const Cavity& cavity, const std::vector<WellBlock>& blocks);
 
 }  // namespace hm::transition_detail

@@ -15,6 +15,7 @@
 // (expansion). Boxes (reservoir cell centres) never move.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -122,11 +123,37 @@ struct ShapeFailures {
   int64_t count = 0;
 };
 
-ShapeFailures shape_failures(const PolyMesh& sub) {
+// A boundary face of the submesh is a cavity polygon; where the FV centre beyond it is known
+// (outside_centres, a well cell's), its Q_O is checked too, as fvcheck measures it on the
+// written mesh: from the transition cell's site to that centre.
+ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& global, const TransitionCells& t,
+                             const Cavity& cavity, const std::vector<Vec3>& outside_centres) {
   ShapeFailures out;
   out.cell.assign(sub.n_cells(), 0);
   const MeshGeometry geo = compute_geometry(sub);
   const CheckOptions opt;
+  if (!outside_centres.empty()) {
+    std::map<std::vector<int32_t>, int32_t> polygon_of;  // sorted global nodes -> cavity face
+    for (int c = 0; c < sub.n_cells(); ++c)
+      for (int32_t q : t.cell_polygons[c]) {
+        if (!std::isfinite(outside_centres[q].x)) continue;
+        std::vector<int32_t> key = cavity.faces[q].nodes;
+        std::sort(key.begin(), key.end());
+        polygon_of[key] = q;
+      }
+    for (int f = 0; f < sub.n_faces() && !polygon_of.empty(); ++f) {
+      if (sub.face_neighbour[f] >= 0) continue;
+      std::vector<int32_t> key;
+      for (const int32_t* v = sub.face_begin(f); v != sub.face_end(f); ++v) key.push_back(global[*v]);
+      std::sort(key.begin(), key.end());
+      const auto it = polygon_of.find(key);
+      if (it == polygon_of.end()) continue;
+      if (face_orthogonality_of(sub, geo, f, outside_centres[it->second]) < opt.min_orthogonality_deg) {
+        out.cell[sub.face_owner[f]] = 1;
+        ++out.count;
+      }
+    }
+  }
   for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)}) {
     out.count += r.violations;
     out.complete = out.complete && r.violations <= static_cast<int64_t>(r.worst_ids.size());
@@ -149,9 +176,9 @@ class SiteOptimizer {
  public:
   SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                 const std::vector<PolygonFrame>& frames, const std::vector<double>& h_ref,
-                const TransitionOptions& opt, bool slivers_only = false)
+                const TransitionOptions& opt, const std::vector<Vec3>& outside_centres, bool slivers_only = false)
       : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt),
-        slivers_only_(slivers_only) {}
+        outside_centres_(outside_centres), slivers_only_(slivers_only) {}
 
   // One round on `out` (a valid diagram of set_): true if some move was kept.
   // skew_only: only steps against skewed faces. Sets skewed_left() to the count on entry.
@@ -177,7 +204,7 @@ class SiteOptimizer {
     m.sub = transition_submesh(t, coords_, &m.global);
     m.qs = cell_shape_quality(m.sub, h_ref_);
     m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
-    m.failing = shape_failures(m.sub);
+    m.failing = shape_failures(m.sub, m.global, t, cavity_, outside_centres_);
     return m;
   }
   // The cells of `after` (a diagram of the same sites, so the same cell per site) that fail a
@@ -224,6 +251,7 @@ class SiteOptimizer {
   const std::vector<PolygonFrame>& frames_;
   const std::vector<double>& h_ref_;
   const TransitionOptions& opt_;
+  const std::vector<Vec3>& outside_centres_;
   std::set<std::array<int, 9>> refused_;
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   int skewed_left_ = 0;
@@ -553,11 +581,12 @@ bool has_sliver_edge(const TransitionCells& t) {
 }  // namespace
 
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
-                        const std::vector<PolygonFrame>& frames, const TransitionOptions& opt, TransitionCells& out) {
+                        const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+                        const std::vector<Vec3>& outside_centres, TransitionCells& out) {
   if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, true);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, true);
   while (rep.rounds < kSliverRounds) {
     ++rep.rounds;
     if (!optimizer.round(out, rep, false)) break;
@@ -568,10 +597,10 @@ int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Ve
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                                  TransitionCells& out) {
+                                  const std::vector<Vec3>& outside_centres, TransitionCells& out) {
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;  // the raw diagram's: the same reference before and after
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres);
   while (rep.rounds < opt.max_rounds) {
     ++rep.rounds;
     if (!optimizer.round(out, rep, false)) break;
@@ -583,6 +612,19 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
   }
   out.h_ref = h_ref;
   return rep;
+}
+
+std::vector<Vec3> well_polygon_centres(const Cavity& cavity, const std::vector<WellBlock>& blocks) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<Vec3> out(cavity.faces.size(), Vec3{nan, nan, nan});
+  for (size_t q = 0; q < cavity.faces.size(); ++q) {
+    const ConstrainedFace& face = cavity.faces[q];
+    if (face.side != FaceSide::Well || face.outside_cell < 0) continue;
+    for (const WellBlock& b : blocks)
+      if (b.well == face.well && static_cast<size_t>(face.outside_cell) < b.cell_attrs.size())
+        out[q] = b.cell_attrs[face.outside_cell].fv_center;
+  }
+  return out;
 }
 
 }  // namespace hm::transition_detail

@@ -115,6 +115,27 @@ TEST(Bends, BendsAtTheLimitMeshAndPassTheSelfCheck) {
   EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << ": " << r.reason;
 }
 
+// The optimiser keeps the faces on the well's polygons above fvcheck's orthogonality bound, measured
+// as the self-check does (transition site to the well cell's FV centre): before, it judged only the
+// faces between two transition cells, and a move could take a flat end's outer-ring face below 45
+// degrees, refused by the self-check at every angle of this sweep configuration (12 of 156 cases of
+// the bend sweep, docs/transition.md).
+TEST(Bends, OptimisedFlatEndKeepsItsPolygonFacesOrthogonalEnough) {
+  for (const double beta : {30.0, 45.0}) {
+    BendCase b;
+    b.beta_deg = beta;
+    b.r_over_dx = 1.4;
+    b.inc_deg = 50;
+    b.plane_deg = beta == 30.0 ? 333 : 117;
+    b.short_legs = true;
+    b.caps = false;
+    b.optimize = true;
+    const RealisticCase rc = make_bend_case(b);
+    const CaseResult r = mesh_and_check(rc);
+    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << ": " << r.reason;
+  }
+}
+
 // Validation: a bend at the limit passes, one degree above is refused naming the trajectory.
 TEST(Bends, ValidationRefusesBendsAboveTheLimit) {
   EXPECT_NO_THROW(parse_case(paper_with_bend(kMaxBendDegrees)));
