@@ -40,6 +40,8 @@ constexpr double kBendAxisSpacing = 0.5;
 // Free sites on a focal line start this fraction of a spacing off the symmetric positions
 // (no free site in the bend's plane: symmetric placements make co-spherical quadruples).
 constexpr double kBendAxisOffset = 0.137;
+// Positions tried per free site of a focal line, the nominal one and kBendAxisShifts shifted.
+constexpr int kBendAxisShifts = 4;
 
 struct Obstacle {
   Vec3 p;
@@ -347,8 +349,15 @@ int place_tip_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
   for (const FocalSegment& fs : segments) {
     const int n = std::max(2, static_cast<int>(std::lround(norm(fs.b - fs.a) / fs.spacing)));
     for (int k = 0; k < n; ++k) {
-      const Vec3 f = fs.a + ((k + 0.5 + kBendAxisOffset) / n) * (fs.b - fs.a);
-      try_place(f, fs.clearance);
+      // A position in some sphere's clearance moves toward the segment's middle, by eighths of a
+      // spacing up to half of one, to where the line leaves that sphere.
+      const double toward_middle = k + 0.5 + kBendAxisOffset < 0.5 * n ? 1.0 : -1.0;
+      for (int step = 0; step <= kBendAxisShifts; ++step) {
+        const int before = added;
+        const double at = k + 0.5 + kBendAxisOffset + toward_middle * step * 0.5 / kBendAxisShifts;
+        try_place(fs.a + (at / n) * (fs.b - fs.a), fs.clearance);
+        if (added > before) break;
+      }
     }
   }
   for (const WellEnd& end : ends) {

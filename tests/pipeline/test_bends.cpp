@@ -136,6 +136,30 @@ TEST(Bends, OptimisedFlatEndKeepsItsPolygonFacesOrthogonalEnough) {
   }
 }
 
+// Free sites on a bend's focal line: a nominal position within some sphere's clearance moves
+// toward the line's middle to where the line leaves that sphere (transition_tips.cpp,
+// kBendAxisShifts). Three cases of the bend sweep whose raw diagram failed conformity (free sites
+// missing next to reservoir cells' spheres, the fans of wedge sites meeting on the line) mesh.
+TEST(Bends, FocalLineFreeSitesStepOutOfBlockedPositions) {
+  struct Sweep {
+    double beta, r_over_dx, inc, plane;
+    bool short_legs, caps;
+  };
+  for (const Sweep& c : {Sweep{45.0, 1.4, 0, 43, true, false}, Sweep{52.5, 0.6, 50, 110, false, true},
+                         Sweep{60.0, 1.4, 50, 224, false, true}}) {
+    BendCase b;
+    b.beta_deg = c.beta;
+    b.r_over_dx = c.r_over_dx;
+    b.inc_deg = c.inc;
+    b.plane_deg = c.plane;
+    b.short_legs = c.short_legs;
+    b.caps = c.caps;
+    const RealisticCase rc = make_bend_case(b);
+    const CaseResult r = mesh_and_check(rc);
+    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << ": " << r.reason;
+  }
+}
+
 // Validation: a bend at the limit passes, one degree above is refused naming the trajectory.
 TEST(Bends, ValidationRefusesBendsAboveTheLimit) {
   EXPECT_NO_THROW(parse_case(paper_with_bend(kMaxBendDegrees)));
