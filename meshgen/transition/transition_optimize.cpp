@@ -114,8 +114,8 @@ std::vector<int> skewed_faces_of_cells(const PolyMesh& sub, std::vector<int>* sk
 // The transition cells of a diagram's submesh that fail a shape check the self-check applies to
 // the written mesh (meshgen/pipeline/self_check.cpp, fvcheck's checks at their defaults):
 // convexity, the FV centre (the site) inside, orthogonality of the faces between two transition
-// cells, planarity of every face. The faces on the cavity's polygons are the submesh's boundary and not measured here (the
-// segment ends on the cell beyond, which the submesh does not hold). The checks report the cells
+// cells and of the faces on well polygons (toward the well cell's FV centre, which the submesh
+// does not hold: shape_failures is given it), planarity of every face. The checks report the cells
 // they fail through worst_ids (at most 10); `complete` is false when a check failed more.
 struct ShapeFailures {
   std::vector<char> cell;
