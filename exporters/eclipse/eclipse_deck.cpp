@@ -117,7 +117,7 @@ std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::str
   const size_t n = static_cast<size_t>(nx) * ny * nz;
   std::vector<int> actnum(n, 0);
   std::vector<double> poro(n, res.porosity), kx(n, res.permeability.x), ky(n, res.permeability.y),
-      kz(n, res.permeability.z), top(n), bottom(n);
+      kz(n, res.permeability.z), top(n), bottom(n), multpv(n, 1.0);
   for (int c = 0; c < mesh.n_cells(); ++c) {
     const auto& ijk = mesh.cell_ijk[c];
     if (mesh.cell_region[c] != kReservoir || ijk[0] < 0) continue;
@@ -128,6 +128,7 @@ std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::str
     const size_t g = ijk[0] + static_cast<size_t>(nx) * (ijk[1] + static_cast<size_t>(ny) * ijk[2]);
     actnum[g] = 1;
     poro[g] = mesh.cell_porosity[c];
+    multpv[g] = mesh.pore_volume_mult(c);
     kx[g] = mesh.cell_perm[c].x;
     ky[g] = mesh.cell_perm[c].y;
     kz[g] = mesh.cell_perm[c].z;
@@ -149,6 +150,7 @@ std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::str
   }
   o.eclipse_array("ACTNUM", actnum);
   o.eclipse_array("PORO", poro);
+  if (!mesh.cell_pore_volume_mult.empty()) o.eclipse_array("MULTPV", multpv);
   o.eclipse_array("PERMX", kx);
   o.eclipse_array("PERMY", ky);
   o.eclipse_array("PERMZ", kz);
@@ -170,13 +172,13 @@ double eclipse_relaxation_time_days(const CaseSpec& cs, const PolyMesh& mesh, co
   double inv_k[3] = {0, 0, 0}, phi = 0, pv = 0;
   int n = 0;
   for (int cell = 0; cell < mesh.n_cells(); ++cell) {
-    pv += geo.cell_volume[cell] * mesh.cell_porosity[cell];
+    pv += geo.cell_volume[cell] * mesh.cell_porosity[cell] * mesh.pore_volume_mult(cell);
     if (mesh.cell_region[cell] != kReservoir) continue;
     const Vec3& k = mesh.cell_perm[cell];
     inv_k[0] += 1 / k.x;
     inv_k[1] += 1 / k.y;
     inv_k[2] += 1 / k.z;
-    phi += mesh.cell_porosity[cell];
+    phi += mesh.cell_porosity[cell] * mesh.pore_volume_mult(cell);
     ++n;
   }
   double tau = 0;
@@ -352,6 +354,14 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     }
     o.eclipse_array("ACTNUM", actnum);
     o.eclipse_array("PORO", poro);
+    if (model_only && !mesh.cell_pore_volume_mult.empty()) {
+      // flow's own pore volumes, as the model's: with near-well cells PORV (EDIT) carries them instead.
+      std::vector<double> multpv(nd, 1.0);
+      for (size_t g = 0; g < nd; ++g)
+        if (L.deck_cell[g] >= 0) multpv[g] = mesh.pore_volume_mult(L.deck_cell[g]);
+      o << "-- The model's pore-volume multipliers (its MULTPV and PORV edits as OPM read them).\n";
+      o.eclipse_array("MULTPV", multpv);
+    }
     o << "-- PERMX/Y/Z are required by flow; the transmissibilities used are TRANX/Y/Z and NNC.\n";
     o.eclipse_array("PERMX", kx);
     o.eclipse_array("PERMY", ky);
@@ -385,8 +395,10 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   } else {
     TextOut o;
     std::vector<double> porv(nd, 0.0);
-    for (int c = 0; c < nc; ++c) porv[L.cell_deck_index[c]] = geo.cell_volume[c] * mesh.cell_porosity[c];
-    o << "-- Pore volume = cell volume * porosity (rm3).\n";
+    for (int c = 0; c < nc; ++c)
+      porv[L.cell_deck_index[c]] = geo.cell_volume[c] * mesh.cell_porosity[c] * mesh.pore_volume_mult(c);
+    o << (mesh.cell_pore_volume_mult.empty() ? "-- Pore volume = cell volume * porosity (rm3).\n"
+                                             : "-- Pore volume = cell volume * porosity * the model's pore-volume multiplier (MULTPV, PORV) (rm3).\n");
     o.eclipse_array("PORV", porv);
     o << "-- Transmissibilities (cP.rm3/day/bar) between logical reservoir neighbours; 0 elsewhere,\n"
       << "-- which removes flow's own geometric values (all other connections are NNC).\n";

@@ -18,6 +18,11 @@ struct Field {
   bool integer;
   std::function<double(const PolyMesh&, size_t c, int d)> get;
   std::function<void(PolyMesh&, size_t c, int d, double v)> set;
+  /// An optional field (null for the others): whether the mesh carries it (else it is not written), and
+  /// how a mesh read back makes room for it (an absent one is not missing: the mesh has none).
+  std::function<bool(const PolyMesh&)> carried = nullptr;
+  std::function<void(PolyMesh&)> make_room = nullptr;
+  bool positive = false;  ///< values must be > 0
 };
 
 double at(const Vec3& v, int d) { return d == 0 ? v.x : d == 1 ? v.y : v.z; }
@@ -42,6 +47,10 @@ const std::vector<Field>& fields() {
        [](PolyMesh& m, size_t c, int d, double v) { put(m.cell_perm[c], d, v); }},
       {"porosity", 1, false, [](const PolyMesh& m, size_t c, int) { return m.cell_porosity[c]; },
        [](PolyMesh& m, size_t c, int, double v) { m.cell_porosity[c] = v; }},
+      {"pore_volume_multiplier", 1, false, [](const PolyMesh& m, size_t c, int) { return m.cell_pore_volume_mult[c]; },
+       [](PolyMesh& m, size_t c, int, double v) { m.cell_pore_volume_mult[c] = v; },
+       [](const PolyMesh& m) { return !m.cell_pore_volume_mult.empty(); },
+       [](PolyMesh& m) { m.cell_pore_volume_mult.assign(static_cast<size_t>(m.n_cells()), 1.0); }, true},
       HM_RADIAL_INT("radial_well", well),
       HM_RADIAL_INT("radial_ring", ring),
       HM_RADIAL_INT("radial_sector", sector),
@@ -71,6 +80,7 @@ std::vector<VtuCellArray> mesh_cell_arrays(const PolyMesh& m) {
   const size_t nc = static_cast<size_t>(m.n_cells());
   std::vector<VtuCellArray> out;
   for (const Field& f : fields()) {
+    if (f.carried && !f.carried(m)) continue;
     VtuCellArray a;
     a.name = f.name;
     a.components = f.components;
@@ -102,7 +112,7 @@ RestoredArrays restore_mesh_cell_arrays(const std::vector<VtuCellArray>& arrays,
   for (const Field& f : fields()) {
     const auto it = std::find_if(arrays.begin(), arrays.end(), [&](const VtuCellArray& a) { return a.name == f.name; });
     if (it == arrays.end()) {
-      r.missing.push_back(f.name);
+      if (!f.make_room) r.missing.push_back(f.name);
       continue;
     }
     const VtuCellArray& a = *it;
@@ -118,13 +128,15 @@ RestoredArrays restore_mesh_cell_arrays(const std::vector<VtuCellArray>& arrays,
     }
     // Cells in parallel (each writes its own cell), except metric_scale: every cell writes the
     // mesh's one value, the last cell's wins. The error names the first bad cell in cell order.
+    if (f.make_room) f.make_room(m);
     const bool per_mesh = std::string(f.name) == "metric_scale";
     std::atomic<int64_t> first_bad{static_cast<int64_t>(nc)};
     auto restore = [&](int64_t b, int64_t e) {
       for (int64_t c = b; c < e; ++c)
         for (int d = 0; d < f.components; ++d) {
           const double v = a.values[static_cast<size_t>(c) * a.components + (isotropic ? 0 : d)];
-          const bool ok = std::isfinite(v) && (!f.integer || (v == std::floor(v) && std::fabs(v) < 2147483647.0));
+          const bool ok = std::isfinite(v) && (!f.integer || (v == std::floor(v) && std::fabs(v) < 2147483647.0)) &&
+                          (!f.positive || v > 0);
           if (!ok) {
             int64_t seen = first_bad.load();
             while (c < seen && !first_bad.compare_exchange_weak(seen, c)) {
@@ -138,7 +150,7 @@ RestoredArrays restore_mesh_cell_arrays(const std::vector<VtuCellArray>& arrays,
     else parallel_ranges(static_cast<int64_t>(nc), restore);
     if (first_bad.load() < static_cast<int64_t>(nc)) {
       r.error = a.name + ": cell " + std::to_string(first_bad.load()) + ": " +
-                (f.integer ? "not a 32-bit integer" : "not a finite number");
+                (f.integer ? "not a 32-bit integer" : f.positive ? "not a finite number > 0" : "not a finite number");
       return r;
     }
   }

@@ -10,7 +10,7 @@
 namespace hm {
 
 /// The arrays written for every mesh, in file order: region, fv_center, ijk, permeability,
-/// porosity, radial_well, radial_ring, radial_sector, radial_segment, radial_band, radial_r_in,
+/// porosity, pore_volume_multiplier (only when the mesh carries one), radial_well, radial_ring, radial_sector, radial_segment, radial_band, radial_r_in,
 /// radial_r_out, radial_r_center, radial_angle, radial_length, radial_cap_center, metric_scale.
 std::vector<VtuCellArray> mesh_cell_arrays(const PolyMesh& mesh);
 

@@ -27,6 +27,7 @@
 #include "meshgen/case/meshed_trajectory.hpp"
 #include "meshgen/case/segment_distance.hpp"
 #include "meshgen/case/survey.hpp"
+#include "meshgen/core/polymesh.hpp"
 
 namespace hm {
 namespace {
@@ -295,8 +296,8 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
     std::snprintf(pv, sizeof pv, "%.6g rm3 in OPM against %.6g", model.other_pore_volume_opm, model.other_pore_volume_ours);
     notes.push_back(f.path("grdecl") + ": " + std::to_string(model.other_pore_volume) +
                     " active cells have a pore volume other than volume x PORO x NTG (MULTPV or PORV in the deck; " + pv +
-                    "), which the mesh's porosity is: the model's pore volumes there are not carried "
-                    "(docs/corner-point.md, \"MINPV\")");
+                    "): the mesh carries it as their pore-volume multiplier, and the near-well cells take the "
+                    "multiplier of the model cell they lie in (docs/corner-point.md, \"Pore volumes\")");
   }
   if (model.deck_nnc > 0 || model.deck_editnnc > 0)
     notes.push_back(f.path("grdecl") + ": the deck's NNC adds " + std::to_string(model.deck_nnc) +
@@ -312,6 +313,10 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
     if (!model.actnum[c]) continue;  // inactive cells carry no rock
     const std::string cell = f.path("grdecl") + ": cell " + std::to_string(c);
     require(r.cell_poro[c] > 0 && r.cell_poro[c] <= 1, cell, "porosity x NTG must be in (0, 1], got " + fmt(r.cell_poro[c]));
+    if (!r.cell_pore_volume_mult.empty())
+      require(std::isfinite(r.cell_pore_volume_mult[c]) && r.cell_pore_volume_mult[c] > 0, cell,
+              "its pore volume in OPM (MULTPV, PORV) is " + fmt(r.cell_pore_volume_mult[c]) +
+                  " x volume x PORO x NTG: must be > 0");
     require(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0, cell, "permeability must be > 0");
     for (double k : {r.cell_permx[c], r.cell_permy[c], r.cell_permz[c]})
       require(k >= kMinPermeability && k <= kMaxPermeability, cell,
@@ -403,6 +408,7 @@ void refine_near_wells(CaseSpec& cs) {
   r.cell_permy = grid.cell_permy;
   r.cell_permz = grid.cell_permz;
   r.cell_poro = grid.cell_poro;
+  r.cell_pore_volume_mult = grid.cell_pore_volume_mult;
   r.corner_point = grid.corner_point;
 }
 
@@ -717,6 +723,12 @@ Vec3 reservoir_permeability(const ReservoirSpec& r, int c) {
 }
 
 double reservoir_porosity(const ReservoirSpec& r, int c) { return r.cell_poro.empty() ? r.porosity : r.cell_poro[c]; }
+
+void assign_reservoir_rock(const ReservoirSpec& r, int c, CellAttributes& at) {
+  at.perm = reservoir_permeability(r, c);
+  at.porosity = reservoir_porosity(r, c);
+  at.pore_volume_mult = r.cell_pore_volume_mult.empty() ? 1.0 : r.cell_pore_volume_mult[c];
+}
 
 std::vector<double> well_measured_depths(const WellSpec& ws) {
   if (ws.trajectory_md.size() == ws.trajectory.size()) return ws.trajectory_md;

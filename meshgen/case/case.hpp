@@ -19,6 +19,7 @@ class InputError : public std::runtime_error {
 };
 
 struct CornerPointModel;
+struct CellAttributes;
 
 struct ReservoirSpec {
   std::vector<double> x, y, z;        ///< node coordinates, strictly increasing, >= 2 each
@@ -28,6 +29,9 @@ struct ReservoirSpec {
   /// Per-cell rock in natural order (size nx*ny*nz), or empty for the uniform values above:
   /// a model read from `reservoir.grdecl` (PERMX/PERMY x NTG, PERMZ in mD; PORO x NTG).
   std::vector<double> cell_permx, cell_permy, cell_permz, cell_poro;
+  /// Per cell as above, or empty (every cell 1): the model's pore-volume multiplier (OPM's pore volume
+  /// over volume x PORO x NTG: MULTPV, PORV edits), finite and > 0 on active cells.
+  std::vector<double> cell_pore_volume_mult;
   std::string grdecl;                 ///< the model file the grid came from, or empty
   /// A true corner-point model (grdecl whose cells are not all axis-aligned boxes): its cells are
   /// the mesh's reservoir cells (meshgen/grids/corner_point_grid.hpp); x/y/z are then only its
@@ -57,6 +61,8 @@ int reservoir_cell_at(const ReservoirSpec& r, Vec3 p);
 /// Rock of reservoir cell c (uniform or per cell).
 Vec3 reservoir_permeability(const ReservoirSpec& r, int c);
 double reservoir_porosity(const ReservoirSpec& r, int c);
+/// The rock a mesh cell takes from reservoir cell c: permeability, porosity, pore-volume multiplier.
+void assign_reservoir_rock(const ReservoirSpec& r, int c, CellAttributes& at);
 
 enum class WellType { Producer, Injector };
 

@@ -182,6 +182,7 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   r.actnum.resize(n);
   r.parent_cell.resize(n);
   for (auto* a : {&r.permx, &r.permy, &r.permz, &r.poro, &r.ntg}) a->resize(n);
+  if (!m.pore_volume_mult.empty()) r.pore_volume_mult.resize(n);
   for (int d = 0; d < 6; ++d)
     if (!m.trans_mult[d].empty()) r.trans_mult[d].resize(n);
   for (int k = 0; k < r.nz; ++k)
@@ -209,6 +210,7 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
         r.permz[c] = m.permz[pc];
         r.poro[c] = m.poro[pc];
         r.ntg[c] = m.ntg[pc];
+        if (!m.pore_volume_mult.empty()) r.pore_volume_mult[c] = m.pore_volume_mult[pc];
         // +x, -x, +y, -y act on the parent's faces; z on every child.
         const bool at[6] = {si[I].child == si[I].of - 1, si[I].child == 0, sj[J].child == sj[J].of - 1,
                             sj[J].child == 0, true, true};

@@ -187,8 +187,11 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
         if (minpv && c < limit.size() && porv[c] < limit[c]) ++m.below_minpv, m.below_minpv_pore_volume += porv[c];
         // The same doubles OPM multiplies (EclipseGrid volume, PORO, NTG): a relative 1e-12 is rounding.
         const double ours = m.opm_volume[c] * m.poro[c] * m.ntg[c];
-        if (std::abs(porv[c] - ours) > kPoreVolumeRounding * std::max(std::abs(ours), std::abs(porv[c])))
+        if (std::abs(porv[c] - ours) > kPoreVolumeRounding * std::max(std::abs(ours), std::abs(porv[c]))) {
           ++m.other_pore_volume, m.other_pore_volume_opm += porv[c], m.other_pore_volume_ours += ours;
+          if (m.pore_volume_mult.empty()) m.pore_volume_mult.assign(n, 1.0);
+          if (ours > 0) m.pore_volume_mult[c] = porv[c] / ours;  // else PORO or NTG is 0: refused by the case
+        }
       }
     }
     {
@@ -243,6 +246,7 @@ void set_rock(const CornerPointModel& m, ReservoirSpec& r) {
     r.cell_poro[c] = m.poro[c] * m.ntg[c];
   }
   r.cell_permz = m.permz;
+  r.cell_pore_volume_mult = m.pore_volume_mult;
 }
 
 }  // namespace

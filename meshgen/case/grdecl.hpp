@@ -62,6 +62,9 @@ struct CornerPointModel {
   /// porosity is: their count and OPM's pore volume of them against that product (docs/corner-point.md).
   int64_t other_pore_volume = 0;
   double other_pore_volume_opm = 0, other_pore_volume_ours = 0;
+  /// Per cell: OPM's pore volume over volume x PORO x NTG on those cells, exactly 1 elsewhere (inactive
+  /// cells included); empty when every cell's is 1. The mesh carries it (PolyMesh::cell_pore_volume_mult).
+  std::vector<double> pore_volume_mult;
   /// NNC and EDITNNC of the deck (OPM's EclipseState::getInputNNC): the connections NNC adds between two
   /// cells and the EDITNNC records multiplying the transmissibility of given cell pairs. The mesh connects
   /// cells through shared faces only and carries neither (docs/corner-point.md, "NNC and EDITNNC").

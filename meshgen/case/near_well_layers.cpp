@@ -120,6 +120,7 @@ void split_layers_near_wells(CaseSpec& cs) {
   r.cell_permy = repeat_layers(r.cell_permy, layer_size, children);
   r.cell_permz = repeat_layers(r.cell_permz, layer_size, children);
   r.cell_poro = repeat_layers(r.cell_poro, layer_size, children);
+  r.cell_pore_volume_mult = repeat_layers(r.cell_pore_volume_mult, layer_size, children);
   r.z = z;
   cs.notes.push_back(note.str());
 }

@@ -257,6 +257,10 @@ PolyMesh MeshBuilder::finish(BuildReport* report) {
     m.cell_porosity[c] = cells_[c].porosity;
     m.cell_radial[c] = cells_[c].radial;
   }
+  if (std::any_of(cells_.begin(), cells_.end(), [](const CellAttributes& a) { return a.pore_volume_mult != 1.0; })) {
+    m.cell_pore_volume_mult.resize(nc);
+    for (size_t c = 0; c < nc; ++c) m.cell_pore_volume_mult[c] = cells_[c].pore_volume_mult;
+  }
   if (report) *report = report_;
   *this = MeshBuilder{};
   return m;
@@ -280,6 +284,13 @@ CsrReport check_csr_invariants(const PolyMesh& m) {
   for (size_t f = 0; f < m.face_trans_mult.size(); ++f)
     if (!(std::isfinite(m.face_trans_mult[f]) && m.face_trans_mult[f] >= 0)) {
       bad("face_trans_mult[" + std::to_string(f) + "] is not a finite value >= 0");
+      break;
+    }
+  if (!m.cell_pore_volume_mult.empty() && m.cell_pore_volume_mult.size() != static_cast<size_t>(nc))
+    bad("cell_pore_volume_mult is neither empty nor of size n_cells");
+  for (size_t c = 0; c < m.cell_pore_volume_mult.size(); ++c)
+    if (!(std::isfinite(m.cell_pore_volume_mult[c]) && m.cell_pore_volume_mult[c] > 0)) {
+      bad("cell_pore_volume_mult[" + std::to_string(c) + "] is not a finite value > 0");
       break;
     }
   if (m.cell_fv_center.size() != static_cast<size_t>(nc) || m.cell_ijk.size() != static_cast<size_t>(nc) ||
@@ -342,6 +353,7 @@ PolyMesh cells_as_mesh(const PolyMesh& mesh, const std::vector<char>& keep, std:
     at.ijk = mesh.cell_ijk[c];
     at.perm = mesh.cell_perm[c];
     at.porosity = mesh.cell_porosity[c];
+    at.pore_volume_mult = mesh.cell_pore_volume_mult.empty() ? 1.0 : mesh.cell_pore_volume_mult[c];
     at.radial = mesh.cell_radial[c];
     b.add_cell(faces, at);
     cell_of->push_back(c);

@@ -71,6 +71,10 @@ struct PolyMesh {
   std::vector<std::array<int32_t, 3>> cell_ijk;  ///< n_cells, (i,j,k) of reservoir cells, {-1,-1,-1} otherwise
   std::vector<Vec3> cell_perm;            ///< n_cells, diagonal permeability (kx, ky, kz) in mD
   std::vector<double> cell_porosity;      ///< n_cells, porosity in [0, 1]
+  /// n_cells or empty (every cell 1): the pore-volume multiplier of a corner-point model's cell, OPM's
+  /// pore volume over volume x PORO x NTG (MULTPV, PORV edits; docs/corner-point.md), finite and > 0.
+  /// A cell's pore volume is its volume x cell_porosity x this.
+  std::vector<double> cell_pore_volume_mult;
   std::vector<RadialCellInfo> cell_radial;  ///< n_cells, radial structure of well cells
 
   // ---- frame
@@ -94,6 +98,8 @@ struct PolyMesh {
   const int32_t* cell_end(int c) const { return cell_faces.data() + cell_face_ptr[c + 1]; }
   /// +1 if cell c owns face f (outward normal), -1 if c is its neighbour.
   int face_sign(int f, int c) const { return face_owner[f] == c ? 1 : -1; }
+  /// Cell c's pore-volume multiplier (1 when the mesh carries none).
+  double pore_volume_mult(int c) const { return cell_pore_volume_mult.empty() ? 1.0 : cell_pore_volume_mult[c]; }
 };
 
 /// Per-cell attributes handed to the builder with each cell.
@@ -103,6 +109,7 @@ struct CellAttributes {
   std::array<int32_t, 3> ijk{-1, -1, -1};
   Vec3 perm{0, 0, 0};
   double porosity = 0;
+  double pore_volume_mult = 1;
   RadialCellInfo radial;
 };
 

@@ -632,8 +632,7 @@ CornerPointCells add_corner_point_cells(const CornerPointModel& model, const Cor
     for (int q = 0; q < 8; ++q) centre += model_cell_corner(model, c, q);
     at.fv_center = centre / 8.0;
     at.ijk = {c % model.nx, (c / model.nx) % model.ny, c / (model.nx * model.ny)};
-    at.perm = reservoir_permeability(rock, c);
-    at.porosity = reservoir_porosity(rock, c);
+    assign_reservoir_rock(rock, c, at);
     out.cell_id[c] = builder.add_cell(faces, at);
   }
   return out;

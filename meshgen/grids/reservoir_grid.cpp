@@ -90,8 +90,7 @@ std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const Reserv
     at.fv_center = grid.cell_center(c);
     const auto ijk = grid.cell_ijk(c);
     at.ijk = {ijk[0], ijk[1], ijk[2]};
-    at.perm = reservoir_permeability(spec, c);
-    at.porosity = reservoir_porosity(spec, c);
+    assign_reservoir_rock(spec, c, at);
     cell_id[c] = builder.add_cell(faces, at, &face_ids);
     for (int axis = 0; axis < 3; ++axis) high_face[axis][c] = face_ids[2 * axis + 1];
   }

@@ -809,11 +809,7 @@ WellBlock make_gabriel_well_block(const CaseSpec& cs, int w) {
                           (for_gabriel && for_centres ? " and the cells' centring" : ""));
   // A radial cell replaces the reservoir rock around its FV centre: it takes the rock of the
   // model cell that holds that centre.
-  for (CellAttributes& at : block.cell_attrs) {
-    const int c = reservoir_cell_at(cs.reservoir, at.fv_center);
-    at.perm = reservoir_permeability(cs.reservoir, c);
-    at.porosity = reservoir_porosity(cs.reservoir, c);
-  }
+  for (CellAttributes& at : block.cell_attrs) assign_reservoir_rock(cs.reservoir, reservoir_cell_at(cs.reservoir, at.fv_center), at);
   return block;
 }
 

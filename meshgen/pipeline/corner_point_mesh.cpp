@@ -180,9 +180,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   std::sort(dead.begin(), dead.end());
   const CornerPointLocator rock_of(model, faces, dead, coords);
   auto set_rock = [&](CellAttributes& at) {
-    const int c = rock_of.cell_at_or_nearest(at.fv_center);
-    at.perm = reservoir_permeability(cs.reservoir, c);
-    at.porosity = reservoir_porosity(cs.reservoir, c);
+    assign_reservoir_rock(cs.reservoir, rock_of.cell_at_or_nearest(at.fv_center), at);
   };
   for (WellBlock& b : out.blocks)
     for (CellAttributes& at : b.cell_attrs) set_rock(at);

@@ -361,9 +361,7 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
   const TransitionCellMaps maps = add_transition_cells(
       transitions,
       [&](CellAttributes& at) {
-        const int rock_cell = reservoir_cell_at(cs.reservoir, at.fv_center);
-        at.perm = reservoir_permeability(cs.reservoir, rock_cell);
-        at.porosity = reservoir_porosity(cs.reservoir, rock_cell);
+        assign_reservoir_rock(cs.reservoir, reservoir_cell_at(cs.reservoir, at.fv_center), at);
       },
       builder, out.transition_reports);
   out.mesh = builder.finish(&out.build_report);

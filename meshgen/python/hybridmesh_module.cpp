@@ -60,6 +60,13 @@ py::array view(const std::vector<hm::Vec3>& v, py::handle owner) {
   static_assert(sizeof(hm::Vec3) == 3 * sizeof(double), "Vec3 must be three packed doubles");
   return view(reinterpret_cast<const double*>(v.data()), v.size(), 3, owner);
 }
+/// An optional per-face or per-cell factor of the mesh (empty: 1 everywhere) as n values.
+py::array view_or_ones(const std::vector<double>& v, int n, py::handle owner) {
+  if (!v.empty()) return view(v, owner);
+  py::array_t<double> ones(static_cast<py::ssize_t>(n));
+  std::fill(ones.mutable_data(), ones.mutable_data() + n, 1.0);
+  return std::move(ones);
+}
 
 py::object json_to_python(const nlohmann::json& j) {
   return py::module_::import("json").attr("loads")(
@@ -171,12 +178,9 @@ PYBIND11_MODULE(hybridmesh, mod) {
       .def_property_readonly("face_patch", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.face_patch, s); })
       .def_property_readonly(
           "face_trans_mult",
-          [](py::object s) -> py::array {
+          [](py::object s) {
             const hm::PolyMesh& m = s.cast<Mesh&>().result.mesh;
-            if (!m.face_trans_mult.empty()) return view(m.face_trans_mult, s);
-            py::array_t<double> ones(static_cast<py::ssize_t>(m.n_faces()));
-            std::fill(ones.mutable_data(), ones.mutable_data() + m.n_faces(), 1.0);
-            return std::move(ones);
+            return view_or_ones(m.face_trans_mult, m.n_faces(), s);
           },
           "n_faces: the corner-point model's transmissibility multiplier of each face (1 where it has none)")
       .def_property_readonly("cell_face_ptr", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.cell_face_ptr, s); })
@@ -193,6 +197,13 @@ PYBIND11_MODULE(hybridmesh, mod) {
       .def_property_readonly("face_centroids", [](py::object s) { return view(s.cast<Mesh&>().result.geometry.face_centroid, s); })
       .def_property_readonly("permeability", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.cell_perm, s); })
       .def_property_readonly("porosity", [](py::object s) { return view(s.cast<Mesh&>().result.mesh.cell_porosity, s); })
+      .def_property_readonly(
+          "pore_volume_multiplier",
+          [](py::object s) {
+            const hm::PolyMesh& m = s.cast<Mesh&>().result.mesh;
+            return view_or_ones(m.cell_pore_volume_mult, m.n_cells(), s);
+          },
+          "n_cells: the corner-point model's pore-volume multiplier of each cell (MULTPV, PORV; 1 where it has none)")
       .def_property_readonly("transmissibilities",
                              [](py::object s) { return view(s.cast<Mesh&>().transmissibilities().face, s); },
                              "n_faces: TPFA transmissibility (cP.rm3/day/bar); wellbore faces: connection factor")

@@ -138,7 +138,7 @@ inline FlowComparison compare_flow(const hm::CaseSpec& cs, const hm::PolyMesh& m
     for (size_t g = 0; g < L.deck_cell.size(); ++g) {
       if (L.deck_cell[g] < 0) continue;
       const int32_t cell = L.deck_cell[g];
-      const double pv = geo.cell_volume[cell] * mesh.cell_porosity[cell];
+      const double pv = geo.cell_volume[cell] * mesh.cell_porosity[cell] * mesh.pore_volume_mult(cell);
       c.max_rel_porv = std::max(c.max_rel_porv, std::abs(porv[g].get<double>() - pv) / pv);
     }
   } else {

@@ -286,6 +286,73 @@ TEST(FlowCornerPoint, ModelWithMultipliersAndWellsMatchesSolverDemo) {
   EXPECT_GT(miss, 1e-3);
 }
 
+// Pore volumes other than volume x PORO x NTG (MULTPV: an aquifer column x 1000, every seventh cell x 2.5;
+// docs/corner-point.md, "Pore volumes"). With near-well cells the deck's PORV carries them (flow's INIT PORV
+// equals ours, the multiplier included, on every cell; the near-well cells take their model cell's), the
+// transient runs to the same steady state. The model alone: the deck's MULTPV makes flow's own pore
+// volumes OPM's of the model as read. Fail halves: without the multiplier both miss by far more.
+TEST(FlowCornerPoint, PoreVolumeMultipliersAreCarried) {
+  REQUIRE_FLOW();
+  TiltedModel g;
+  g.keywords = pore_volume_keywords(g);
+  {
+    TempDir tmp("flow_cpw_multpv");
+    CornerPointFlowRun r;
+    run_case(tmp, g, two_wells_yaml(), &r);
+    if (HasFatalFailure()) return;
+    const hm::PolyMesh& mesh = r.out.mesh;
+    ASSERT_EQ(mesh.cell_pore_volume_mult.size(), static_cast<size_t>(mesh.n_cells()));
+    int model = 0, near_well = 0;
+    double miss_without = 0;
+    for (int c = 0; c < mesh.n_cells(); ++c) {
+      if (mesh.cell_pore_volume_mult[c] == 1.0) continue;
+      (mesh.cell_region[c] == hm::kReservoir ? model : near_well) += 1;
+      miss_without = std::max(miss_without, std::abs(mesh.cell_pore_volume_mult[c] - 1));
+    }
+    std::printf("[ figures  ] pore-volume multipliers on %d model cells and %d near-well cells; flow against ours: "
+                "PORV %.3g, pressure %.3g, rate %.3g relative at most\n",
+                model, near_well, r.c.max_rel_porv, r.c.max_rel_pressure, r.c.max_rel_rate);
+    EXPECT_GT(model, 100);
+    EXPECT_GT(near_well, 10);
+    expect_flow_is_solver_demo(r);  // PORV to 1e-6 with the multiplier (compare_flow)
+    EXPECT_GE(miss_without, 1.5);   // fail half: PORV without it would miss by this much
+  }
+  TempDir tmp("flow_cpm_multpv");
+  std::ofstream(tmp.path / "M.GRDECL") << g.text();
+  std::ofstream(tmp.path / "cpm.yaml") << "name: cpm\nreservoir: {grdecl: M.GRDECL}\n";
+  const hm::CaseSpec cs = hm::load_case((tmp.path / "cpm.yaml").string());
+  const hm::CornerPointModel& m = *cs.reservoir.corner_point;
+  for (const bool carried : {true, false}) {
+    hm::HybridMesh out = hm::build_hybrid_mesh(cs);
+    if (!carried) out.mesh.cell_pore_volume_mult.clear();
+    const hm::Transmissibilities trans =
+        hm::compute_transmissibilities(out.mesh, out.geometry, hm::deck_transmissibility_options());
+    const fs::path dir = tmp.path / (carried ? "deck" : "deck_without");
+    const hm::WriteStatus st = hm::write_eclipse_deck(dir.string(), cs, out.mesh, out.geometry, trans);
+    ASSERT_TRUE(st.ok) << st.message;
+    const FlowRun run = run_flow(dir, "CPM");
+    ASSERT_EQ(run.flow.exit_code, 0) << run.flow.output.substr(0, 2000);
+    const auto& porv = run.results["init"]["porv"];
+    ASSERT_EQ(porv.size(), m.actnum.size());
+    double worst = 0, total_flow = 0;
+    for (size_t c = 0; c < m.actnum.size(); ++c) {
+      if (!m.actnum[c]) continue;
+      const double opm = m.opm_volume[c] * m.poro[c] * m.ntg[c] * (m.pore_volume_mult.empty() ? 1.0 : m.pore_volume_mult[c]);
+      worst = std::max(worst, std::abs(porv[c].get<double>() / opm - 1));
+      total_flow += porv[c].get<double>();
+    }
+    std::printf("[ figures  ] model alone%s: flow's PORV against OPM's of the model as read: %.3g relative at most, "
+                "total %.6g against %.6g\n", carried ? "" : " (fail half: no MULTPV)", worst, total_flow,
+                m.active_pore_volume);
+    if (carried) {
+      EXPECT_LT(worst, 1e-6);
+      EXPECT_NEAR(total_flow / m.active_pore_volume, 1.0, 1e-6);
+    } else {
+      EXPECT_GT(worst, 0.5);  // the aquifer column at 1/1000, the others at 1/2.5
+    }
+  }
+}
+
 // A layer pinching out beside the producer (zero thickness from x = 110 m, thinning from 70 m): without PINCH
 // the cells above and below it carry no flow where they touch, with PINCH they do, near-well cells and
 // cavity walls included; flow runs both decks and matches solver_demo. The two runs' rates differ by far

@@ -241,6 +241,7 @@ void expect_same_mesh(const PolyMesh& q, const PolyMesh& m) {
   EXPECT_EQ(q.cell_region, m.cell_region);
   EXPECT_EQ(q.cell_ijk, m.cell_ijk);
   EXPECT_EQ(q.cell_porosity, m.cell_porosity);
+  EXPECT_EQ(q.cell_pore_volume_mult, m.cell_pore_volume_mult);  // empty stays empty
   for (int c = 0; c < m.n_cells(); ++c) {
     EXPECT_TRUE(q.cell_fv_center[c] == m.cell_fv_center[c]) << c;
     EXPECT_TRUE(q.cell_perm[c] == m.cell_perm[c]) << c;
@@ -270,6 +271,8 @@ TEST(VtuRoundTrip, TopologyCoordinatesAndArraysAreIdentical) {
     m.cell_ijk[c] = {c, 2 * c, 3 * c};
     m.cell_perm[c] = {100.0 / 3 + c, 0.1 * c, 1e-3};
     m.cell_porosity[c] = 0.1 + c / 7.0;
+    m.cell_pore_volume_mult.resize(m.n_cells());
+    m.cell_pore_volume_mult[c] = c % 3 == 0 ? 1000.0 / 3 : 1.0;
     RadialCellInfo& r = m.cell_radial[c];
     r = {c % 2, c, c + 1, c + 2, 0.1 * c, 0.2 + c, 1.0 / 3, 2 * M_PI / 7, 0.7, c % 3 - 1, Vec3{1.0 / 3, 2, c + 0.5}};
   }

@@ -150,6 +150,29 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsRegionMultipliers) {
   std::printf("[ figures  ] refined model: %d connections x 0.1, %d x 0.02, %d x 1\n", seen[0.1], seen[0.02], seen[1.0]);
 }
 
+// MULTPV on the model as read: every child of a refined model has its parent's pore-volume multiplier (a
+// share of the parent's pore volume in proportion to its volume); without MULTPV none.
+TEST(NearWellRefinement, ChildrenKeepTheModelsPoreVolumeMultipliers) {
+  for (const bool multpv : {false, true}) {
+    TempDir tmp("cprefine_multpv");
+    hmtest::TiltedModel g;
+    g.nx = 6, g.ny = 3, g.nz = 10;
+    if (multpv) g.keywords = hmtest::pore_volume_keywords(g);
+    std::ofstream(tmp.path / "M.GRDECL") << g.text();
+    const CornerPointModel m = read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
+    const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}});
+    ASSERT_EQ(r.pore_volume_mult.empty(), !multpv);
+    if (!multpv) continue;
+    ASSERT_EQ(r.pore_volume_mult.size(), r.corners.size());
+    int aquifer = 0;
+    for (size_t a = 0; a < r.corners.size(); ++a) {
+      EXPECT_EQ(r.pore_volume_mult[a], m.pore_volume_mult[r.parent_cell[a]]) << a;
+      aquifer += r.pore_volume_mult[a] > 999;
+    }
+    EXPECT_EQ(aquifer, 1 * 2 * g.nz + 1 * 1 * g.nz + 1 * 2 * g.nz);  // column i = 0 split 1 x (2, 1, 2)
+  }
+}
+
 // The splits: fine near the well, coarser away, none far off or in narrow columns; the same when
 // the model sits at UTM coordinates.
 TEST(NearWellRefinement, SplitsFollowTheWellWhereverTheModelSits) {

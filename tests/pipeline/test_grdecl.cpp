@@ -762,9 +762,10 @@ TEST(CornerPoint, CellsBelowMinpvAreCountedAndNoted) {
   }
 }
 
-// MULTPV (OPM's pore volume other than volume x PORO x NTG, which the mesh's porosity is): the cells are
-// counted and named in a note; without it none (the same doubles: no rounding counted).
-TEST(CornerPoint, PoreVolumesOtherThanTheRocksAreNoted) {
+// MULTPV (OPM's pore volume other than volume x PORO x NTG, the mesh's porosity): the cells are counted and
+// named in a note, and carried as the cells' pore-volume multiplier, so that the mesh's pore volume is
+// OPM's; without MULTPV no note and no multiplier (the same doubles: no rounding counted).
+TEST(CornerPoint, PoreVolumesOtherThanTheRocksAreCarried) {
   const SyntheticCpg g;
   const int n = g.nx * g.ny * g.nz;
   for (const bool multpv : {false, true}) {
@@ -788,6 +789,27 @@ TEST(CornerPoint, PoreVolumesOtherThanTheRocksAreNoted) {
     bool noted = false;
     for (const std::string& note : r.out.notes) noted = noted || note.find("other than volume x PORO x NTG") != std::string::npos;
     EXPECT_EQ(noted, multpv);
+    // The multiplier per cell, and the mesh's pore volume against OPM's (as its volume against OPM's).
+    EXPECT_EQ(m.pore_volume_mult.empty(), !multpv);
+    const PolyMesh& mesh = r.out.mesh;
+    EXPECT_EQ(mesh.cell_pore_volume_mult.empty(), !multpv);
+    double pv = 0, pv_rock_only = 0;
+    for (int c = 0; c < mesh.n_cells(); ++c) {
+      const auto& ijk = mesh.cell_ijk[c];
+      const int cell = ijk[0] + g.nx * (ijk[1] + g.ny * ijk[2]);
+      const double want = multpv && cell % 10 == 0 && m.opm_volume[cell] > 0 ? 2.5 : 1.0;
+      EXPECT_NEAR(mesh.pore_volume_mult(c), want, 1e-12 * want) << cell;
+      pv += r.out.geometry.cell_volume[c] * mesh.cell_porosity[c] * mesh.pore_volume_mult(c);
+      pv_rock_only += r.out.geometry.cell_volume[c] * mesh.cell_porosity[c];
+    }
+    const auto [mesh_volume, opm_volume] = volumes(r);
+    std::printf("[ figures  ] %s: mesh pore volume / OPM's %.9f (volume %.9f); without the multiplier %.6f\n",
+                multpv ? "MULTPV" : "none", pv / m.active_pore_volume, mesh_volume / opm_volume,
+                pv_rock_only / m.active_pore_volume);
+    EXPECT_NEAR(pv / m.active_pore_volume, 1.0, 1e-6);
+    if (multpv) {
+      EXPECT_GT(std::abs(pv_rock_only / m.active_pore_volume - 1), 1e-2);
+    }
   }
 }
 

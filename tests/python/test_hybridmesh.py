@@ -50,6 +50,7 @@ class BuiltMesh(unittest.TestCase):
         np.testing.assert_array_equal(listed, 1 + interior.astype(np.int64))
         np.testing.assert_array_equal(m.face_patch == -1, interior)
         np.testing.assert_array_equal(m.face_trans_mult, np.ones(m.n_faces))  # a box case: no multipliers
+        np.testing.assert_array_equal(m.pore_volume_multiplier, np.ones(m.n_cells))
         cell_of_entry = np.repeat(np.arange(m.n_cells), np.diff(cp))
         is_owner = m.face_owner[cf] == cell_of_entry
         is_neighbour = m.face_neighbour[cf] == cell_of_entry
@@ -214,6 +215,23 @@ class ModelMultipliers(unittest.TestCase):
         for pair, t in p.items():
             expected = 0.5 if pair[0][2] != pair[1][2] else 1.0
             self.assertAlmostEqual(q[pair] / t, expected, places=12)
+
+    def test_multpv_on_the_cells(self):
+        """MULTPV 2.5 on the top layer's cells: their pore-volume multiplier, 1 elsewhere."""
+        nx, ny, nz = 4, 3, 5
+        n = nx * ny * nz
+        coord = "".join(f"{10 * i} {10 * j} 1000 {10 * i} {10 * j} 1050\n" for j in range(ny + 1) for i in range(nx + 1))
+        zcorn = "".join(f"{4 * nx * ny}*{1000 + 10 * (k + s)}\n" for k in range(nz) for s in (0, 1))
+        text = (f"SPECGRID\n {nx} {ny} {nz} 1 F /\nCOORD\n{coord}/\nZCORN\n{zcorn}/\n"
+                f"PERMX\n{n}*100 /\nPORO\n{n}*0.2 /\nMULTPV\n{nx * ny}*2.5 {n - nx * ny}*1 /\n")
+        with tempfile.TemporaryDirectory() as d:
+            with open(os.path.join(d, "pv.GRDECL"), "w", encoding="utf-8") as f:
+                f.write(text)
+            mesh = hybridmesh.build(hybridmesh.parse_case("name: pv\nreservoir: {grdecl: pv.GRDECL}\n", d))
+        top = mesh.cell_ijk[:, 2] == 0
+        self.assertEqual(top.sum(), nx * ny)
+        np.testing.assert_allclose(mesh.pore_volume_multiplier[top], 2.5, rtol=1e-12)
+        np.testing.assert_array_equal(mesh.pore_volume_multiplier[~top], 1.0)
 
 
 if __name__ == "__main__":

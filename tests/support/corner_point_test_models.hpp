@@ -114,6 +114,16 @@ inline std::string multiplier_keywords(const TiltedModel& g, int barrier_k) {
   return o.str();
 }
 
+/// Pore volumes other than the rock's: MULTPV 1000 on the column i = 0 (an aquifer, as geomodellers attach
+/// one) and 2.5 on every seventh other cell, 1 elsewhere.
+inline std::string pore_volume_keywords(const TiltedModel& g) {
+  std::ostringstream o;
+  o << "MULTPV\n";
+  for (int c = 0; c < g.nx * g.ny * g.nz; ++c) o << (c % g.nx == 0 ? 1000.0 : c % 7 == 0 ? 2.5 : 1.0) << "\n";
+  o << "/\n";
+  return o.str();
+}
+
 /// MULTNUM regions 1 (i < 4), 2 (i >= 4, k < 8) and 3 (i >= 4, k >= 8) and MULTREGT records between them:
 /// 1-2 x 0.1 in every direction, 2-3 x 0.02 in Z only (flow applies neither to an X connection of 2-3).
 inline std::string region_multiplier_keywords(const TiltedModel& g) {
