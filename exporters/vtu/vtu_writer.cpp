@@ -54,65 +54,88 @@ void header_line(std::ostringstream& xml, const Block& b, uint64_t offset, const
   xml << " format=\"appended\" offset=\"" << offset << "\"/>\n";
 }
 
-// VTK_HEXAHEDRON's faces as local point indices, outward (vtkHexahedron's face order).
-constexpr int kHexFaces[6][4] = {{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}};
+// A standard VTK cell type the writer uses for cells of its shape: its faces as local point indices,
+// outward, in VTK's face order (vtkHexahedron, vtkWedge; the reader's tables), and its points as the
+// "base" points (the outward cycle of VTK face `base_face`, reordered by `base`) followed by the base
+// points' partners across the side edges.
+struct StandardCell {
+  uint8_t vtk_type;
+  int n_points, n_faces, n_base, base_face;
+  std::array<int, 4> base;  ///< point i (< n_base) is vertex base[i] of the base face's outward cycle
+  std::array<std::array<int, 4>, 6> faces;
+  std::array<int, 6> face_size;
+};
+constexpr StandardCell kHexahedron{
+    12, 8, 6, 4, 4, {0, 3, 2, 1}, {{{0, 4, 7, 3}, {1, 2, 6, 5}, {0, 1, 5, 4}, {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}}},
+    {4, 4, 4, 4, 4, 4}};
+constexpr StandardCell kWedge{13, 6, 5, 3, 0, {0, 1, 2, 0}, {{{0, 1, 2}, {3, 5, 4}, {0, 3, 4, 1}, {1, 4, 5, 2}, {2, 5, 3, 0}}},
+                              {3, 3, 4, 4, 4, 0}};
 
-// The canonical form of a quadrilateral cycle (canonical_cycle on 4 ids, without allocation).
-std::array<int32_t, 4> canonical_quad(const int32_t* q, bool* reversed) {
-  const int k = static_cast<int>(std::min_element(q, q + 4) - q);
-  const bool rev = q[(k + 3) % 4] < q[(k + 1) % 4];
-  std::array<int32_t, 4> out;
-  for (int i = 0; i < 4; ++i) out[i] = rev ? q[(k + 4 - i) % 4] : q[(k + i) % 4];
+// The canonical form of a cycle of 3 or 4 ids (smallest first, then its smaller neighbour), without
+// allocation; `reversed` says whether that reverses it.
+std::array<int32_t, 4> canonical_small_cycle(const int32_t* q, int k, bool* reversed) {
+  const int s = static_cast<int>(std::min_element(q, q + k) - q);
+  const bool rev = q[(s + k - 1) % k] < q[(s + 1) % k];
+  std::array<int32_t, 4> out{-1, -1, -1, -1};
+  for (int i = 0; i < k; ++i) out[i] = rev ? q[(s + k - i) % k] : q[(s + i) % k];
   *reversed = rev;
   return out;
 }
 
-// A cell whose six outward quadrilaterals are, cycle for cycle and orientation for orientation,
-// the faces of a VTK_HEXAHEDRON on 8 distinct nodes: returns true with the 8 point ids in VTK
-// order and, for each VTK face k, the cell-local index of the face it is (`which[k]`).
-// Combinatorial only: the geometry (planar or not) is the same whichever type is written.
-// The cell's outward cycles are nodes[off[i] .. off[i + 1]) for i < n_faces.
-bool as_hexahedron(const std::vector<int32_t>& nodes, const std::vector<int>& off, std::array<int32_t, 8>* pts,
-                   std::array<int, 6>* which) {
+// A cell whose outward faces are, cycle for cycle and orientation for orientation, the faces of
+// `type` on distinct nodes: returns true with the point ids in VTK order and, for each VTK face k,
+// the cell-local index of the face it is (`which[k]`). Combinatorial only: the geometry (planar or
+// not) is the same whichever type is written. The cell's outward cycles are nodes[off[i] .. off[i + 1]).
+bool as_standard_cell(const StandardCell& type, const std::vector<int32_t>& nodes, const std::vector<int>& off,
+                      std::array<int32_t, 8>* pts, std::array<int, 6>* which) {
   const int n_faces = static_cast<int>(off.size()) - 1;
-  if (n_faces != 6) return false;
-  for (int q = 0; q < 6; ++q)
-    if (off[q + 1] - off[q] != 4) return false;
+  if (n_faces != type.n_faces) return false;
+  std::array<int, 6> sizes{};
+  int triangles = 0, want_triangles = 0;
+  for (int q = 0; q < n_faces; ++q) {
+    sizes[q] = off[q + 1] - off[q];
+    if (sizes[q] != 3 && sizes[q] != 4) return false;
+    triangles += sizes[q] == 3;
+    want_triangles += type.face_size[q] == 3;
+  }
+  if (triangles != want_triangles) return false;
   auto face = [&](int q) { return nodes.data() + off[q]; };
-  // Bottom: the first face, whose outward cycle is VTK's (0, 3, 2, 1).
-  const int32_t* b = face(0);
-  std::array<int32_t, 8> p{b[0], b[3], b[2], b[1], -1, -1, -1, -1};
-  for (int i = 0; i < 4; ++i) {
-    // p[i + 4]: the one node joined to p[i] by an edge that is not on the bottom face.
-    for (int q = 0; q < 6; ++q) {
+  // The base: the cell's first face of the base face's size, taken as that VTK face.
+  int base_face = 0;
+  while (sizes[base_face] != type.face_size[type.base_face]) ++base_face;
+  const int32_t* b = face(base_face);
+  std::array<int32_t, 8> p;
+  p.fill(-1);
+  for (int i = 0; i < type.n_base; ++i) p[i] = b[type.base[i]];
+  const auto base_end = p.begin() + type.n_base;
+  for (int i = 0; i < type.n_base; ++i) {
+    // p[i + n_base]: the one node joined to p[i] by an edge that is not on the base face.
+    for (int q = 0; q < n_faces; ++q) {
       const int32_t* f = face(q);
-      for (int e = 0; e < 4; ++e) {
-        const int32_t u = f[e], v = f[(e + 1) % 4];
+      for (int e = 0; e < sizes[q]; ++e) {
+        const int32_t u = f[e], v = f[(e + 1) % sizes[q]];
         const int32_t other = u == p[i] ? v : v == p[i] ? u : -1;
-        if (other < 0 || std::find(p.begin(), p.begin() + 4, other) != p.begin() + 4) continue;
-        if (p[i + 4] >= 0 && p[i + 4] != other) return false;
-        p[i + 4] = other;
+        if (other < 0 || std::find(p.begin(), base_end, other) != base_end) continue;
+        if (p[i + type.n_base] >= 0 && p[i + type.n_base] != other) return false;
+        p[i + type.n_base] = other;
       }
     }
-    if (p[i + 4] < 0) return false;
+    if (p[i + type.n_base] < 0) return false;
   }
-  std::array<int32_t, 8> sorted = p;
-  std::sort(sorted.begin(), sorted.end());
-  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;
+  for (int i = 0; i < type.n_points; ++i)
+    for (int j = 0; j < i; ++j)
+      if (p[i] == p[j]) return false;
   std::array<std::array<int32_t, 4>, 6> keys;
-  std::array<bool, 6> revs;
-  for (int q = 0; q < 6; ++q) {
+  std::array<bool, 6> revs{};
+  for (int q = 0; q < n_faces; ++q) keys[q] = canonical_small_cycle(face(q), sizes[q], &revs[q]);
+  for (int k = 0; k < n_faces; ++k) {
+    int32_t cycle[4];
+    for (int i = 0; i < type.face_size[k]; ++i) cycle[i] = p[type.faces[k][i]];
     bool rev = false;
-    keys[q] = canonical_quad(face(q), &rev);
-    revs[q] = rev;
-  }
-  for (int k = 0; k < 6; ++k) {
-    bool rev = false;
-    const int32_t quad[4] = {p[kHexFaces[k][0]], p[kHexFaces[k][1]], p[kHexFaces[k][2]], p[kHexFaces[k][3]]};
-    const std::array<int32_t, 4> key = canonical_quad(quad, &rev);
+    const std::array<int32_t, 4> key = canonical_small_cycle(cycle, type.face_size[k], &rev);
     int found = -1;
-    for (int q = 0; q < 6 && found < 0; ++q)
-      if (keys[q] == key && revs[q] == rev) found = q;
+    for (int q = 0; q < n_faces && found < 0; ++q)
+      if (sizes[q] == type.face_size[k] && keys[q] == key && revs[q] == rev) found = q;
     if (found < 0) return false;
     (*which)[k] = found;
   }
@@ -140,9 +163,9 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
                   std::to_string(nc * static_cast<size_t>(a.components)));
   }
 
-  // Topology: hexahedra as VTK_HEXAHEDRON (12); every other cell as VTK_POLYHEDRON (42) with its
-  // distinct nodes in first-use order and its outward faces. face_patch follows the faces as a
-  // reader sees them: the face stream of a polyhedron, vtkHexahedron's face order for a hexahedron.
+  // Topology: hexahedra as VTK_HEXAHEDRON (12), triangular prisms as VTK_WEDGE (13); every other cell
+  // as VTK_POLYHEDRON (42) with its distinct nodes in first-use order and its outward faces. face_patch
+  // follows the faces as a reader sees them: the face stream of a polyhedron, VTK's face order otherwise.
   std::vector<int64_t> connectivity, offsets, faces, faceoffsets;
   std::vector<uint8_t> types(nc, 42);
   std::vector<int32_t> face_patch;
@@ -176,14 +199,17 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
       local_patch.push_back(m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f]);
       if (has_mult) local_mult.push_back(m.face_trans_mult[f]);
     }
-    std::array<int32_t, 8> hex{};
+    std::array<int32_t, 8> pts{};
     std::array<int, 6> which{};
-    if (as_hexahedron(local, local_off, &hex, &which)) {
-      types[c] = 12;
-      connectivity.insert(connectivity.end(), hex.begin(), hex.end());
-      for (int k = 0; k < 6; ++k) face_patch.push_back(local_patch[which[k]]);
+    const StandardCell* standard = nullptr;
+    for (const StandardCell* type : {&kHexahedron, &kWedge})
+      if (!standard && as_standard_cell(*type, local, local_off, &pts, &which)) standard = type;
+    if (standard) {
+      types[c] = standard->vtk_type;
+      connectivity.insert(connectivity.end(), pts.begin(), pts.begin() + standard->n_points);
+      for (int k = 0; k < standard->n_faces; ++k) face_patch.push_back(local_patch[which[k]]);
       if (has_mult)
-        for (int k = 0; k < 6; ++k) face_mult.push_back(local_mult[which[k]]);
+        for (int k = 0; k < standard->n_faces; ++k) face_mult.push_back(local_mult[which[k]]);
     } else {
       any_polyhedron = true;
       const size_t n_local = local_off.size() - 1;

@@ -1,5 +1,5 @@
-// VTK XML UnstructuredGrid (.vtu) writer: hexahedra as VTK_HEXAHEDRON (12), every other cell as
-// VTK_POLYHEDRON (42), binary appended raw data with UInt64 headers. Layout in docs/output-formats.md.
+// VTK XML UnstructuredGrid (.vtu) writer: hexahedra as VTK_HEXAHEDRON (12), triangular prisms as
+// VTK_WEDGE (13), every other cell as VTK_POLYHEDRON (42), binary appended raw data with UInt64 headers. Layout in docs/output-formats.md.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -46,7 +46,7 @@ struct WriteStatus {
 /// Writes the mesh with its own per-cell data (mesh_cell_arrays, vtu_mesh_arrays.hpp: region,
 /// fv_center, ijk, rock, radial structure) and `extra`, plus field data `face_patch` (boundary
 /// patch of every face of every cell, in the order a reader sees the faces: the `faces` stream of
-/// a polyhedron, vtkHexahedron's face order for a hexahedron; -1 for interior faces). Writes `path + ".tmp"` then renames it, so a
+/// a polyhedron, vtkHexahedron's or vtkWedge's face order; -1 for interior faces). Writes `path + ".tmp"` then renames it, so a
 /// failed write never leaves a complete-looking file. Never throws for I/O problems.
 WriteStatus write_vtu(const std::string& path, const PolyMesh& mesh, const std::vector<VtuCellArray>& extra = {});
 

@@ -345,6 +345,40 @@ TEST(VtuRoundTrip, PolyhedraAndHexahedraTogether) {
   fs::remove_all(d);
 }
 
+// Triangular prisms (the cells of a hemispherical cap's rings) go out as VTK_WEDGE (13), whose
+// parametric centre is the cell's own (a polyhedron's is its bounding-box centre, which VTK 9.1's
+// validator uses: docs/output-formats.md), with face_patch in vtkWedge's face order; read back, the
+// same mesh. A box cut along a diagonal plane into two prisms, one boundary face per prism a wellbore.
+TEST(VtuRoundTrip, TriangularPrismsAsWedges) {
+  MeshBuilder mb;
+  const Vec3 corner[8] = {{0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {2, 3, 0}, {0, 0, 1}, {2, 0, 1}, {0, 3, 1}, {2, 3, 1}};
+  for (const Vec3& p : corner) mb.add_node(p);
+  // Prism A: bottom (0, 1, 2), top (4, 5, 6); prism B: bottom (1, 3, 2), top (5, 7, 6); shared quad 1-2-6-5.
+  const std::vector<CellFace> a = {{{0, 2, 1}, kOuterBoundary}, {{4, 5, 6}, kOuterBoundary}, {{0, 1, 5, 4}, wellbore_patch(0)},
+                                   {{1, 2, 6, 5}, kInteriorFace}, {{0, 4, 6, 2}, kOuterBoundary}};
+  const std::vector<CellFace> b = {{{1, 2, 3}, kOuterBoundary}, {{5, 7, 6}, kOuterBoundary}, {{1, 3, 7, 5}, kOuterBoundary},
+                                   {{3, 2, 6, 7}, wellbore_patch(1)}, {{2, 1, 5, 6}, kInteriorFace}};
+  CellAttributes at;
+  at.fv_center = {0.6, 1, 0.5};
+  mb.add_cell(a, at);
+  at.fv_center = {1.4, 2, 0.5};
+  mb.add_cell(b, at);
+  BuildReport br;
+  const PolyMesh m = mb.finish(&br);
+  ASSERT_TRUE(br.ok);
+  const MeshGeometry g = compute_geometry(m);
+  EXPECT_NEAR(g.cell_volume[0] + g.cell_volume[1], 6.0, 1e-12);
+  const fs::path d = temp_dir("wedges");
+  const std::string path = (d / "mesh.vtu").string();
+  ASSERT_TRUE(write_vtu(path, m).ok);
+  EXPECT_EQ(hm_slurp(path).find("Name=\"faces\""), std::string::npos);  // no polyhedron
+  const ReadResult r = read_vtu(path);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_TRUE(r.build.ok);
+  expect_same_mesh(r.mesh, m);
+  fs::remove_all(d);
+}
+
 TEST(VtuWriter, UnwritablePathGivesAStatusAndLeavesNoFile) {
   const PolyMesh m = box_grid(1, 1, 1);
   const WriteStatus a = write_vtu("/nonexistent_dir_hm/x.vtu", m);
