@@ -391,7 +391,20 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   std::string edit_text;
   int tran_connections = 0;
   if (model_only) {
-    edit_text = "-- A corner-point model's cells: flow's own pore volumes and transmissibilities (GRID include).\n";
+    TextOut o;
+    o << "-- A corner-point model's cells: flow's own pore volumes and transmissibilities (GRID include).\n";
+    const CornerPointModel& m = *cs.reservoir.corner_point;
+    if (!m.edit_nnc.empty()) {  // the model as read (a model-only deck is never refined)
+      o << "-- The model's EDITNNC (as OPM keeps it for flow's own connections, records of a pair multiplied).\n"
+        << "EDITNNC\n";
+      const int64_t nx = m.nx, nxy = nx * m.ny;
+      for (const auto& [pair, mult] : m.edit_nnc)
+        o << pair.first % nx + 1 << ' ' << (pair.first / nx) % m.ny + 1 << ' ' << pair.first / nxy + 1 << ' '
+          << pair.second % nx + 1 << ' ' << (pair.second / nx) % m.ny + 1 << ' ' << pair.second / nxy + 1 << ' ' << mult
+          << " /\n";
+      o << "/\n";
+    }
+    edit_text = std::move(o.text);
   } else {
     TextOut o;
     std::vector<double> porv(nd, 0.0);

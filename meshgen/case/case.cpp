@@ -299,11 +299,10 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
                     "): the mesh carries it as their pore-volume multiplier, and the near-well cells take the "
                     "multiplier of the model cell they lie in (docs/corner-point.md, \"Pore volumes\")");
   }
-  if (model.deck_nnc > 0 || model.deck_editnnc > 0)
+  if (model.deck_nnc > 0)
     notes.push_back(f.path("grdecl") + ": the deck's NNC adds " + std::to_string(model.deck_nnc) +
-                    " connections between cells and its EDITNNC multiplies " + std::to_string(model.deck_editnnc) +
-                    " cell pairs' transmissibilities; the mesh connects cells through their shared faces only and "
-                    "carries neither (nor its decks), so OPM Flow on the model's own deck has connections the mesh "
+                    " connections between cells; the mesh connects cells through their shared faces only and does "
+                    "not carry them (nor its decks), so OPM Flow on the model's own deck has connections the mesh "
                     "does not (docs/corner-point.md, \"NNC and EDITNNC\")");
   // Axis-aligned boxes, all active, no multiplier: the rectilinear grid (the same mesh as the box
   // form); else the model's own cells (meshgen/grids/corner_point_grid.hpp), which carry multipliers.

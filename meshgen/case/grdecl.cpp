@@ -198,6 +198,11 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
       const Opm::NNC& nnc = state.getInputNNC();
       m.deck_nnc = static_cast<int64_t>(nnc.input().size());
       m.deck_editnnc = static_cast<int64_t>(nnc.edit().size());
+      for (const Opm::NNCdata& e : nnc.edit()) {
+        const int64_t a = static_cast<int64_t>(std::min(e.cell1, e.cell2)), b = static_cast<int64_t>(std::max(e.cell1, e.cell2));
+        const auto [it, fresh] = m.edit_nnc.emplace(std::make_pair(a, b), e.trans);
+        if (!fresh) it->second *= e.trans;
+      }
     }
     if (grid.isPinchActive()) {
       m.pinch.active = true;
@@ -270,8 +275,16 @@ Vec3 pillar_point(const CornerPointModel& m, int p, double z) {
   return {a[0] + t * (a[3] - a[0]), a[1] + t * (a[4] - a[1]), z};
 }
 
+double edit_nnc_multiplier(const CornerPointModel& m, int64_t a, int64_t b) {
+  if (m.edit_nnc.empty()) return 1.0;
+  const bool refined = !m.parent_cell.empty();
+  const int64_t pa = refined ? m.parent_cell[a] : a, pb = refined ? m.parent_cell[b] : b;
+  const auto it = m.edit_nnc.find({std::min(pa, pb), std::max(pa, pb)});
+  return it == m.edit_nnc.end() ? 1.0 : it->second;
+}
+
 bool has_transmissibility_multipliers(const CornerPointModel& m) {
-  if (m.region_mult) return true;
+  if (m.region_mult || !m.edit_nnc.empty()) return true;
   for (const std::vector<double>& v : m.trans_mult)
     if (std::any_of(v.begin(), v.end(), [](double x) { return x != 1.0; })) return true;
   return false;

@@ -67,8 +67,13 @@ struct CornerPointModel {
   std::vector<double> pore_volume_mult;
   /// NNC and EDITNNC of the deck (OPM's EclipseState::getInputNNC): the connections NNC adds between two
   /// cells and the EDITNNC records multiplying the transmissibility of given cell pairs. The mesh connects
-  /// cells through shared faces only and carries neither (docs/corner-point.md, "NNC and EDITNNC").
+  /// cells through shared faces only and does not carry NNC (docs/corner-point.md, "NNC and EDITNNC").
   int64_t deck_nnc = 0, deck_editnnc = 0;
+  /// EDITNNC as OPM keeps it for flow's own connections (NNC::edit(): pairs that are not logical
+  /// neighbours and not a deck NNC, e.g. across a fault), by pair of natural indices of the model as
+  /// read (smaller first): the product of its records' multipliers. The mesh carries it on the faces
+  /// between the pair's cells (edit_nnc_multiplier, connection_multiplier).
+  std::map<std::pair<int64_t, int64_t>, double> edit_nnc;
   /// MULTREGT: OPM's own region multipliers (TransMult::getRegionMultiplier, in the model as read: a
   /// refined model asks with its cells' parents), null without the keyword; its records and the region
   /// arrays they name (MULTNUM, FLUXNUM, OPERNUM; per cell of the model as read) as the deck gives them,
@@ -99,7 +104,12 @@ ReservoirSpec rectilinear_reservoir(const CornerPointModel& model, const std::st
 /// one cell of the model as read.
 double region_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
 
-/// Whether any of the model's transmissibility multipliers (trans_mult) is not 1, or it has MULTREGT.
+/// EDITNNC's multiplier of the connection between model cells a and b (natural indices of `model`,
+/// refined or not: a refined model asks with its cells' parents); 1 for a pair it does not name.
+double edit_nnc_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
+
+/// Whether any of the model's transmissibility multipliers (trans_mult) is not 1, or it has MULTREGT or
+/// EDITNNC (edit_nnc).
 bool has_transmissibility_multipliers(const CornerPointModel& model);
 
 /// Whether every cell is an axis-aligned box on common axes and active (exact equality, no tolerance):

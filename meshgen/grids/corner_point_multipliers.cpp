@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <array>
 #include <map>
+#include <set>
 
 namespace hm {
 
@@ -42,7 +43,7 @@ double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b
     double down = multiplier(model, 4, top);
     if (model.pinch.multz_all)
       for (int64_t c = top + nxy; c < bottom; c += nxy) down = std::min(down, multiplier(model, 4, c));
-    return down * multiplier(model, 5, bottom) * region_multiplier(model, a, b);
+    return down * multiplier(model, 5, bottom) * region_multiplier(model, a, b) * edit_nnc_multiplier(model, a, b);
   }
   const int64_t nx = model.nx, nxy = static_cast<int64_t>(model.nx) * model.ny;
   const int64_t ia = a % nx, ja = (a / nx) % model.ny, ka = a / nxy;
@@ -50,7 +51,8 @@ double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b
   const int axis = ia != ib ? 0 : ja != jb ? 1 : 2;
   const bool plus = axis == 0 ? ib > ia : axis == 1 ? jb > ja : kb > ka;
   const int dir = 2 * axis + (plus ? 0 : 1), opposite = 2 * axis + (plus ? 1 : 0);
-  return multiplier(model, dir, a) * multiplier(model, opposite, b) * region_multiplier(model, a, b);
+  return multiplier(model, dir, a) * multiplier(model, opposite, b) * region_multiplier(model, a, b) *
+         edit_nnc_multiplier(model, a, b);
 }
 
 FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& model, const CornerPointCellFaces* cells,
@@ -83,12 +85,19 @@ FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& m
         toward[triangle_key(coords, t.nodes.data())] = t.inside;
     }
   out.face.assign(static_cast<size_t>(mesh.n_faces()), 1.0);
+  std::set<std::pair<int64_t, int64_t>> edited;  // EDITNNC pairs found on faces between model cells
   for (int32_t f = 0; f < mesh.n_faces(); ++f) {
     const int32_t n = mesh.face_neighbour[f];
     if (n < 0) continue;
     const int64_t a = model_cell(mesh.face_owner[f]), b = model_cell(n);
     if (a >= 0 && b >= 0) {
       out.face[f] = connection_multiplier(model, a, b);
+      if (edit_nnc_multiplier(model, a, b) != 1.0) {
+        ++out.edit_nnc_faces;
+        const bool refined = !model.parent_cell.empty();
+        const int64_t pa = refined ? model.parent_cell[a] : a, pb = refined ? model.parent_cell[b] : b;
+        edited.insert({std::min(pa, pb), std::max(pa, pb)});
+      }
       if (across_pinched_layers(model, a, b)) ++(model.pinch.active ? out.pinch_faces : out.unpinched_faces);
       else out.model_faces += out.face[f] != 1.0;
     } else if (a >= 0 || b >= 0) {
@@ -101,6 +110,7 @@ FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& m
       out.wall_faces += out.face[f] != 1.0;
     }
   }
+  out.edit_nnc_pairs_on_faces = static_cast<int64_t>(edited.size());
   if (cells != nullptr)
     for (size_t c = 0; c < cells->faces.size(); ++c) {
       if (!cells->meshed[c] || active[c]) continue;

@@ -20,7 +20,7 @@ bool across_pinched_layers(const CornerPointModel& model, int64_t a, int64_t b);
 /// (I where their i differ, else J where their j differ, else K). Across pinched-out layers of a
 /// column: 0 without PINCH (OPM Flow does not connect them), else MULTZ of the upper cell (MULTZ
 /// option TOP; ALL: the smallest MULTZ from it down to the last pinched cell) x MULTZ- of the lower.
-/// Times MULTREGT's region multiplier (region_multiplier).
+/// Times MULTREGT's region multiplier (region_multiplier) and EDITNNC's (edit_nnc_multiplier).
 double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
 
 struct FaceMultipliers {
@@ -30,6 +30,8 @@ struct FaceMultipliers {
   int64_t pinch_faces = 0;      ///< faces between two cells of a column across pinched-out layers, with PINCH
   int64_t unpinched_faces = 0;  ///< the same without PINCH: multiplier 0, as OPM Flow does not connect them
   int64_t unmatched_walls = 0;  ///< faces of a model cell toward a near-well cell that are none of its cavity triangles (a bug)
+  int64_t edit_nnc_faces = 0;   ///< faces between model cells that an EDITNNC record multiplies
+  int64_t edit_nnc_pairs_on_faces = 0;  ///< EDITNNC pairs (of the model as read) found on those faces
   /// Model faces between two cells of a cavity (deactivated) whose multiplier is not 1: the near-well
   /// cells replace both cells and do not carry it. Count and range.
   int64_t inside_cavities = 0;

@@ -52,6 +52,17 @@ void apply_model_multipliers(HybridMesh& out, const CornerPointModel& model, con
     out.notes.push_back("reservoir: the model's transmissibility multipliers (MULTX..MULTZ-, FAULTS/MULTFLT) act on " +
                         std::to_string(fm.model_faces) + " faces between model cells and " + std::to_string(fm.wall_faces) +
                         " faces between model cells and near-well cells (docs/corner-point.md)");
+  if (!model.edit_nnc.empty()) {
+    const int64_t missed = static_cast<int64_t>(model.edit_nnc.size()) - fm.edit_nnc_pairs_on_faces;
+    out.notes.push_back("reservoir: the model's EDITNNC names " + std::to_string(model.edit_nnc.size()) +
+                        " cell pairs; it multiplies the " + std::to_string(fm.edit_nnc_faces) + " faces between " +
+                        std::to_string(fm.edit_nnc_pairs_on_faces) + " of them" +
+                        (missed > 0 ? "; " + std::to_string(missed) +
+                                          " share no face in the mesh (cells that do not touch, or replaced by near-well "
+                                          "cells), as OPM Flow finds no connection to edit"
+                                    : std::string()) +
+                        " (docs/corner-point.md, \"NNC and EDITNNC\")");
+  }
   if (fm.unpinched_faces > 0)
     out.notes.push_back("reservoir: " + std::to_string(fm.unpinched_faces) +
                         " faces join cells of a column across layers of zero thickness; the model has no PINCH, so "

@@ -249,7 +249,8 @@ TEST(FlowCornerPoint, InclinedPillarsWithADeviatedWellMatchesSolverDemo) {
 // The model's transmissibility multipliers (MULTX..MULTZ-, FAULTS/MULTFLT) with near-well cells
 // (docs/corner-point.md, "Transmissibility multipliers"): MULTX, MULTY-, MULTZ on every layer (0.02 on
 // the producer's layer 6, inside its cavity) and a fault of 6 m throw between the wells with MULTFLT
-// 0.05, and MULTREGT between three MULTNUM regions (region_multiplier_keywords). The mesh carries them on
+// 0.05, MULTREGT between three MULTNUM regions (region_multiplier_keywords) and EDITNNC on the connections
+// across the fault (edit_nnc_keywords). The mesh carries them on
 // the faces between model cells and on the cavity walls; flow runs the deck and matches solver_demo. Fail
 // half: solver_demo without the multipliers misses flow.
 TEST(FlowCornerPoint, ModelWithMultipliersAndWellsMatchesSolverDemo) {
@@ -257,7 +258,7 @@ TEST(FlowCornerPoint, ModelWithMultipliersAndWellsMatchesSolverDemo) {
   TempDir tmp("flow_cpw_mult");
   TiltedModel g;
   g.fault_i = 8, g.throw_m = 6;
-  g.keywords = multiplier_keywords(g, 6) + region_multiplier_keywords(g);
+  g.keywords = multiplier_keywords(g, 6) + region_multiplier_keywords(g) + edit_nnc_keywords(g);
   CornerPointFlowRun r;
   run_case(tmp, g, two_wells_yaml(), &r);
   if (HasFatalFailure()) return;
@@ -434,7 +435,9 @@ struct OwnVsOurs {
   size_t only_ours = 0, only_flow = 0;
 };
 
-OwnVsOurs compare_with_flows_own(const hm::CaseSpec& cs, const fs::path& dir, bool drop_multipliers = false) {
+// deck_case: the case whose deck flow runs, when not cs (a fail half: ours without what the deck keeps).
+OwnVsOurs compare_with_flows_own(const hm::CaseSpec& cs, const fs::path& dir, bool drop_multipliers = false,
+                                 const hm::CaseSpec* deck_case = nullptr) {
   OwnVsOurs out;
   const hm::HybridMesh hm_out = hm::build_hybrid_mesh(cs);
   hm::PolyMesh ours_mesh = hm_out.mesh;  // the fail half's: the model's multipliers left out of ours
@@ -442,7 +445,8 @@ OwnVsOurs compare_with_flows_own(const hm::CaseSpec& cs, const fs::path& dir, bo
   const hm::Transmissibilities trans =
       hm::compute_transmissibilities(ours_mesh, hm_out.geometry, hm::deck_transmissibility_options());
   hm::EclipseDeckInfo info;
-  const hm::WriteStatus st = hm::write_eclipse_deck(dir.string(), cs, hm_out.mesh, hm_out.geometry, trans, {}, &info);
+  const hm::WriteStatus st =
+      hm::write_eclipse_deck(dir.string(), deck_case ? *deck_case : cs, hm_out.mesh, hm_out.geometry, trans, {}, &info);
   EXPECT_TRUE(st.ok) << st.message;
   const std::string name = hm::eclipse_deck_name(cs);
   const FlowRun run = run_flow(dir, name);
@@ -509,7 +513,7 @@ void print_own_vs_ours(const char* label, const OwnVsOurs& d, int kind = -1) {
 // models to 1e-6 on every pair; with HM_REEK_DECK the same figures for Reek (measured, not asserted).
 TEST(FlowCornerPoint, OurModelTransmissibilitiesAgainstFlowsOwn) {
   REQUIRE_FLOW();
-  for (int variant : {0, 1, 2, 3}) {
+  for (int variant : {0, 1, 2, 3, 4}) {
     TempDir tmp("cpw_own");
     TiltedModel g;
     g.inclined_pillars = variant == 1;
@@ -519,12 +523,13 @@ TEST(FlowCornerPoint, OurModelTransmissibilitiesAgainstFlowsOwn) {
       g.keywords = multiplier_keywords(g, 6);
     }
     if (variant == 3) g.keywords += region_multiplier_keywords(g);  // and MULTREGT between MULTNUM regions
+    if (variant == 4) g.keywords += edit_nnc_keywords(g);           // and EDITNNC across the fault
     std::ofstream(tmp.path / "M.GRDECL") << g.text();
     std::ofstream(tmp.path / "cpm.yaml") << "name: cpm\nreservoir: {grdecl: M.GRDECL}\n";
     const hm::CaseSpec cs = hm::load_case((tmp.path / "cpm.yaml").string());
     const OwnVsOurs d = compare_with_flows_own(cs, tmp.path / "deck");
-    static const char* kLabel[4] = {"tilted, vertical pillars", "inclined pillars", "tilted, fault, multipliers",
-                                    "tilted, fault, multipliers, MULTREGT"};
+    static const char* kLabel[5] = {"tilted, vertical pillars", "inclined pillars", "tilted, fault, multipliers",
+                                    "tilted, fault, multipliers, MULTREGT", "tilted, fault, multipliers, EDITNNC"};
     print_own_vs_ours(kLabel[variant], d);
     if (variant == 3) {  // fail half: ours without MULTREGT (the deck keeps it, flow applies it)
       hm::CaseSpec plain = cs;
@@ -537,6 +542,18 @@ TEST(FlowCornerPoint, OurModelTransmissibilitiesAgainstFlowsOwn) {
       std::printf("[ figures  ] fail half: without MULTREGT in ours %zu of %zu pairs differ by more than 1 %%\n", off,
                   without.rel.size());
       EXPECT_GT(off, 100u);
+    }
+    if (variant == 4) {  // fail half: ours without EDITNNC (the deck keeps it, flow applies it)
+      ASSERT_EQ(cs.reservoir.corner_point->edit_nnc.size(), static_cast<size_t>(g.ny * (2 * g.nz - 3)));
+      hm::CaseSpec plain = cs;
+      auto model = std::make_shared<hm::CornerPointModel>(*cs.reservoir.corner_point);
+      model->edit_nnc.clear();
+      plain.reservoir.corner_point = model;
+      const OwnVsOurs without = compare_with_flows_own(plain, tmp.path / "deck_without_editnnc", false, &cs);
+      size_t off = 0;
+      for (size_t i = 0; i < without.rel.size(); ++i) off += without.kind[i] == 3 && std::abs(without.rel[i]) > 0.3;
+      std::printf("[ figures  ] fail half: without EDITNNC in ours %zu pairs across the fault differ by more than 30 %%\n", off);
+      EXPECT_GT(off, static_cast<size_t>(g.ny * (g.nz - 2)));
     }
     if (variant == 2) {  // fail half: ours without the multipliers are not flow's
       const OwnVsOurs without = compare_with_flows_own(cs, tmp.path / "deck_without", true);

@@ -813,8 +813,8 @@ TEST(CornerPoint, PoreVolumesOtherThanTheRocksAreCarried) {
   }
 }
 
-// NNC and EDITNNC of the model's deck, which the mesh does not carry: counted (as OPM reads them) and
-// named in a note; without them no note.
+// NNC and EDITNNC of the model's deck: NNC, which the mesh does not carry, counted (as OPM reads it) and
+// named in a note; EDITNNC kept as OPM keeps it and noted with the faces it reaches; without them no note.
 TEST(CornerPoint, DeckNncAndEditnncAreCountedAndNoted) {
   for (const bool with : {false, true}) {
     TempDir tmp;
@@ -828,11 +828,19 @@ TEST(CornerPoint, DeckNncAndEditnncAreCountedAndNoted) {
     const CornerPointModel& m = *r.cs.reservoir.corner_point;
     EXPECT_EQ(m.deck_nnc, with ? 2 : 0);
     EXPECT_EQ(m.deck_editnnc, with ? 1 : 0);
-    bool noted = false;
-    for (const std::string& note : r.out.notes)
-      noted = noted || note.find("the deck's NNC adds 2 connections between cells and its EDITNNC multiplies 1") !=
-                           std::string::npos;
-    EXPECT_EQ(noted, with);
+    bool noted_nnc = false, noted_edit = false;
+    for (const std::string& note : r.out.notes) {
+      noted_nnc = noted_nnc || note.find("the deck's NNC adds 2 connections between cells; the mesh") != std::string::npos;
+      // (1,1,1)-(3,1,1) share no face: EDITNNC has nothing to act on, as in OPM Flow.
+      noted_edit = noted_edit || note.find("EDITNNC names 1 cell pairs; it multiplies the 0 faces between 0 of them; "
+                                           "1 share no face") != std::string::npos;
+    }
+    EXPECT_EQ(noted_nnc, with);
+    EXPECT_EQ(noted_edit, with);
+    EXPECT_EQ(m.edit_nnc.size(), with ? 1u : 0u);
+    if (with) {
+      EXPECT_EQ(m.edit_nnc.begin()->second, 0.1);
+    }
   }
 }
 

@@ -176,6 +176,15 @@ class BadInput(unittest.TestCase):
         self.assertEqual(cs.name, "my_case")
 
 
+def box_grdecl(nx, ny, nz):
+    """A box of nx x ny x nz cells of 10 m as GRDECL text, PERMX/Y 100, PERMZ 10 mD, PORO 0.2."""
+    n = nx * ny * nz
+    coord = "".join(f"{10 * i} {10 * j} 1000 {10 * i} {10 * j} 1050\n" for j in range(ny + 1) for i in range(nx + 1))
+    zcorn = "".join(f"{4 * nx * ny}*{1000 + 10 * (k + s)}\n" for k in range(nz) for s in (0, 1))
+    return (f"SPECGRID\n {nx} {ny} {nz} 1 F /\nCOORD\n{coord}/\nZCORN\n{zcorn}/\n"
+            f"PERMX\n{n}*100 /\nPERMY\n{n}*100 /\nPERMZ\n{n}*10 /\nPORO\n{n}*0.2 /\n")
+
+
 class ModelMultipliers(unittest.TestCase):
     """A 4 x 3 x 5 box of 10 m cells given as GRDECL with MULTZ 0.5: meshed as its corner-point cells,
     every face between two layers carries 0.5, every other face 1, and the transmissibilities include it."""
@@ -183,10 +192,7 @@ class ModelMultipliers(unittest.TestCase):
     def test_multz_on_the_faces_between_layers(self):
         nx, ny, nz = 4, 3, 5
         n = nx * ny * nz
-        coord = "".join(f"{10 * i} {10 * j} 1000 {10 * i} {10 * j} 1050\n" for j in range(ny + 1) for i in range(nx + 1))
-        zcorn = "".join(f"{4 * nx * ny}*{1000 + 10 * (k + s)}\n" for k in range(nz) for s in (0, 1))
-        text = (f"SPECGRID\n {nx} {ny} {nz} 1 F /\nCOORD\n{coord}/\nZCORN\n{zcorn}/\n"
-                f"PERMX\n{n}*100 /\nPERMY\n{n}*100 /\nPERMZ\n{n}*10 /\nPORO\n{n}*0.2 /\n")
+        text = box_grdecl(nx, ny, nz)
         with tempfile.TemporaryDirectory() as d:
             for name, extra in (("plain", ""), ("mult", f"MULTZ\n{n}*0.5 /\n")):
                 with open(os.path.join(d, name + ".GRDECL"), "w", encoding="utf-8") as f:
@@ -220,10 +226,7 @@ class ModelMultipliers(unittest.TestCase):
         """MULTPV 2.5 on the top layer's cells: their pore-volume multiplier, 1 elsewhere."""
         nx, ny, nz = 4, 3, 5
         n = nx * ny * nz
-        coord = "".join(f"{10 * i} {10 * j} 1000 {10 * i} {10 * j} 1050\n" for j in range(ny + 1) for i in range(nx + 1))
-        zcorn = "".join(f"{4 * nx * ny}*{1000 + 10 * (k + s)}\n" for k in range(nz) for s in (0, 1))
-        text = (f"SPECGRID\n {nx} {ny} {nz} 1 F /\nCOORD\n{coord}/\nZCORN\n{zcorn}/\n"
-                f"PERMX\n{n}*100 /\nPORO\n{n}*0.2 /\nMULTPV\n{nx * ny}*2.5 {n - nx * ny}*1 /\n")
+        text = box_grdecl(nx, ny, nz) + f"MULTPV\n{nx * ny}*2.5 {n - nx * ny}*1 /\n"
         with tempfile.TemporaryDirectory() as d:
             with open(os.path.join(d, "pv.GRDECL"), "w", encoding="utf-8") as f:
                 f.write(text)

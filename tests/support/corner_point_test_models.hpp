@@ -124,6 +124,21 @@ inline std::string pore_volume_keywords(const TiltedModel& g) {
   return o.str();
 }
 
+/// An EDIT section with EDITNNC on the connections across the fault (fault_i > 0, throw_m between one and
+/// two layers): cell (fault_i, J, K) with (fault_i + 1, J, K - 1) x 0.1 and with (fault_i + 1, J, K - 2) x 0.5
+/// (1-based), pairs flow connects across the fault and OPM keeps in NNC::edit(). Append it last.
+inline std::string edit_nnc_keywords(const TiltedModel& g) {
+  std::ostringstream o;
+  o << "EDIT\nEDITNNC\n";
+  for (int J = 1; J <= g.ny; ++J)
+    for (int K = 2; K <= g.nz; ++K) {
+      o << " " << g.fault_i << " " << J << " " << K << " " << g.fault_i + 1 << " " << J << " " << K - 1 << " 0.1 /\n";
+      if (K > 2) o << " " << g.fault_i << " " << J << " " << K << " " << g.fault_i + 1 << " " << J << " " << K - 2 << " 0.5 /\n";
+    }
+  o << "/\n";
+  return o.str();
+}
+
 /// MULTNUM regions 1 (i < 4), 2 (i >= 4, k < 8) and 3 (i >= 4, k >= 8) and MULTREGT records between them:
 /// 1-2 x 0.1 in every direction, 2-3 x 0.02 in Z only (flow applies neither to an X connection of 2-3).
 inline std::string region_multiplier_keywords(const TiltedModel& g) {
