@@ -160,6 +160,37 @@ TEST(PermeabilityFrame, ScaledCaseTakesTheAreaRadiusWhereItFitsElseTheInscribedO
   EXPECT_EQ(scaled_two.wells[1].drainage_radius, inscribed);
 }
 
+// A bend the case allows (59 degrees, under its 60) that the permeability frame of kv/kh 0.01 sharpens
+// beyond what a radial block holds (2 atan(10 tan(29.5 deg)) = 160 degrees) is refused with both angles
+// and the way out, naming the field; at kv/kh 0.5 the same bend is 77 degrees in the frame and passes.
+TEST(PermeabilityFrame, BendSharpenedPastTheBlocksLimitIsRefusedWithBothAngles) {
+  for (const double kz : {1.0, 50.0}) {
+    CaseSpec cs;
+    cs.metric = MeshMetric::Permeability;
+    cs.reservoir.x = cs.reservoir.y = {0, 100};
+    cs.reservoir.z = {1000, 1100};
+    cs.reservoir.permeability = {100, 100, kz};
+    WellSpec w;
+    w.trajectory = {{10, 50, 1040}, {40, 50, 1040 + 30 * std::tan(29.5 * M_PI / 180)}, {70, 50, 1040}};
+    cs.wells.push_back(w);
+    std::string message;
+    try {
+      scaled_case(cs, permeability_frame(cs));
+    } catch (const InputError& e) {
+      message = e.what();
+    }
+    if (kz == 50.0) {
+      EXPECT_EQ(message, "");
+      continue;
+    }
+    EXPECT_NE(message.find("wells[0].trajectory: the bend at point 1, 59 degrees as given, is 160 degrees in the "
+                           "permeability frame"),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("metric: euclidean"), std::string::npos) << message;
+  }
+}
+
 // The case as meshed keeps the physical measured depths (perforations are given in them) and the
 // physical volumes of its wellbore (det S = 1: only its shape changes).
 TEST(PermeabilityFrame, ScaledCaseKeepsMeasuredDepths) {
