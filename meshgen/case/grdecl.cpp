@@ -99,7 +99,7 @@ void read_region_multipliers(const Opm::Deck& deck, const Opm::EclipseState& sta
 double region_multiplier(const CornerPointModel& m, int64_t a, int64_t b) {
   if (!m.region_mult) return 1.0;
   const bool refined = !m.parent_cell.empty();
-  const int64_t pa = refined ? m.parent_cell[a] : a, pb = refined ? m.parent_cell[b] : b;
+  const int64_t pa = cell_as_read(m, a), pb = cell_as_read(m, b);
   if (pa == pb) return 1.0;
   const int64_t nx = refined ? m.parent_nx : m.nx, ny = refined ? m.parent_ny : m.ny;
   // flow's direction of an intersection: its axis, plus side (EclTransmissibility::update).
@@ -277,8 +277,7 @@ Vec3 pillar_point(const CornerPointModel& m, int p, double z) {
 
 double edit_nnc_multiplier(const CornerPointModel& m, int64_t a, int64_t b) {
   if (m.edit_nnc.empty()) return 1.0;
-  const bool refined = !m.parent_cell.empty();
-  const int64_t pa = refined ? m.parent_cell[a] : a, pb = refined ? m.parent_cell[b] : b;
+  const int64_t pa = cell_as_read(m, a), pb = cell_as_read(m, b);
   const auto it = m.edit_nnc.find({std::min(pa, pb), std::max(pa, pb)});
   return it == m.edit_nnc.end() ? 1.0 : it->second;
 }

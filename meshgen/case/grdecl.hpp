@@ -104,6 +104,11 @@ ReservoirSpec rectilinear_reservoir(const CornerPointModel& model, const std::st
 /// one cell of the model as read.
 double region_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
 
+/// The cell of the model as read that cell c of `model` (refined or not) lies in.
+inline int64_t cell_as_read(const CornerPointModel& model, int64_t c) {
+  return model.parent_cell.empty() ? c : model.parent_cell[static_cast<size_t>(c)];
+}
+
 /// EDITNNC's multiplier of the connection between model cells a and b (natural indices of `model`,
 /// refined or not: a refined model asks with its cells' parents); 1 for a pair it does not name.
 double edit_nnc_multiplier(const CornerPointModel& model, int64_t a, int64_t b);

@@ -94,8 +94,7 @@ FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& m
       out.face[f] = connection_multiplier(model, a, b);
       if (edit_nnc_multiplier(model, a, b) != 1.0) {
         ++out.edit_nnc_faces;
-        const bool refined = !model.parent_cell.empty();
-        const int64_t pa = refined ? model.parent_cell[a] : a, pb = refined ? model.parent_cell[b] : b;
+        const int64_t pa = cell_as_read(model, a), pb = cell_as_read(model, b);
         edited.insert({std::min(pa, pb), std::max(pa, pb)});
       }
       if (across_pinched_layers(model, a, b)) ++(model.pinch.active ? out.pinch_faces : out.unpinched_faces);
