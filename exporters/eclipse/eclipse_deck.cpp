@@ -154,6 +154,17 @@ std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::str
   o.eclipse_array("PERMX", kx);
   o.eclipse_array("PERMY", ky);
   o.eclipse_array("PERMZ", kz);
+  if (mesh.n_nncs() > 0) {
+    o << "-- The model's NNC between the cells above (an EDITNNC of the same pair folded in), T in cP.rm3/day/bar.\n"
+      << "NNC\n";
+    for (int k = 0; k < mesh.n_nncs(); ++k) {
+      const auto a = mesh.cell_ijk[mesh.nnc_cells[k][0]], b = mesh.cell_ijk[mesh.nnc_cells[k][1]];
+      if (a[0] < 0 || b[0] < 0) continue;  // not between two reservoir cells: no (i, j, k) to name
+      o << a[0] + 1 << ' ' << a[1] + 1 << ' ' << a[2] + 1 << ' ' << b[0] + 1 << ' ' << b[1] + 1 << ' ' << b[2] + 1 << ' '
+        << mesh.nnc_trans[k] << " /\n";
+    }
+    o << "/\n";
+  }
   return std::move(o.text);
 }
 
@@ -224,7 +235,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
   const int nc = mesh.n_cells();
   const CsrReport csr = check_csr_invariants(mesh);
   if (!csr.ok) return fail("invalid mesh: " + (csr.problems.empty() ? std::string("?") : csr.problems[0]));
-  if (static_cast<int>(geo.cell_volume.size()) != nc || static_cast<int>(trans.face.size()) != mesh.n_faces())
+  if (static_cast<int>(geo.cell_volume.size()) != nc || static_cast<int>(trans.face.size()) != mesh.n_faces() ||
+      trans.nnc.size() != mesh.nnc_cells.size())
     return fail("geometry or transmissibilities do not belong to this mesh (sizes differ)");
   for (int c = 0; c < nc; ++c)
     if (!(geo.cell_volume[c] > 0))
@@ -381,6 +393,17 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
         const auto a = L.deck_ijk(r.a), b = L.deck_ijk(r.b);
         o << a[0] + 1 << ' ' << a[1] + 1 << ' ' << a[2] + 1 << ' ' << b[0] + 1 << ' ' << b[1] + 1 << ' ' << b[2] + 1
           << ' ' << r.t << " /\n";
+      }
+      o << "/\n";
+    }
+    if (model_only && mesh.n_nncs() > 0) {
+      // flow computes the model's own connections; the deck's NNC adds the rest, as in the model's deck.
+      o << "-- The model's NNC (an EDITNNC of the same pair folded in, as OPM reads it).\nNNC\n";
+      for (int k = 0; k < mesh.n_nncs(); ++k) {
+        const auto a = L.deck_ijk(L.cell_deck_index[mesh.nnc_cells[k][0]]),
+                   b = L.deck_ijk(L.cell_deck_index[mesh.nnc_cells[k][1]]);
+        o << a[0] + 1 << ' ' << a[1] + 1 << ' ' << a[2] + 1 << ' ' << b[0] + 1 << ' ' << b[1] + 1 << ' ' << b[2] + 1
+          << ' ' << trans.nnc[k] << " /\n";
       }
       o << "/\n";
     }

@@ -228,6 +228,16 @@ EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseL
     }
     raw.push_back({a, b, t});
   }
+  // Connections without a face (a model's NNC) are NNC records too; a pair that also shares faces
+  // gets one record, their sum, as flow adds a deck NNC to its own connection of the pair.
+  for (int k = 0; k < mesh.n_nncs(); ++k) {
+    const double t = trans.nnc[k];
+    if (t == 0) continue;
+    out.total += t;
+    int32_t a = L.cell_deck_index[mesh.nnc_cells[k][0]], b = L.cell_deck_index[mesh.nnc_cells[k][1]];
+    if (a > b) std::swap(a, b);
+    raw.push_back({a, b, t});
+  }
   std::sort(raw.begin(), raw.end(), [](const auto& x, const auto& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
   for (const auto& r : raw) {
     if (!out.nnc.empty() && out.nnc.back().a == r.a && out.nnc.back().b == r.b)

@@ -399,8 +399,32 @@ struct Parsed {
   bool has_face_patch = false;
   std::vector<double> face_mult;  ///< field data face_trans_mult, in face_patch's order (empty: none)
   bool reservoir_cells_are_model = false;  ///< field data reservoir_cells_are_model (1)
+  std::vector<std::array<int32_t, 2>> nnc_cells;  ///< field data nnc_cells (connections without a face)
+  std::vector<double> nnc_trans;                  ///< field data nnc_trans
   std::vector<std::string> warnings;
 };
+
+// Field data nnc_cells (pairs of distinct cell ids) and nnc_trans (finite, >= 0), both or neither.
+void read_nnc_fields(const Source& src, vtkXMLDataElement* field_data, int64_t n_cells, Parsed& out) {
+  vtkXMLDataElement* cells = data_array(field_data, "nnc_cells");
+  vtkXMLDataElement* trans = data_array(field_data, "nnc_trans");
+  if (!cells && !trans) return;
+  if (!cells || !trans) fail("field data nnc_cells and nnc_trans come together");
+  const int64_t n = count_attr(cells, "NumberOfTuples", kMaxIds);
+  if (count_attr(trans, "NumberOfTuples", kMaxIds) != n) fail("field data nnc_cells and nnc_trans differ in length");
+  const Array c = read_array(src, cells, 2 * n), t = read_array(src, trans, n);
+  if (!c.is_int || c.components != 2) fail("nnc_cells must be a 2-component integer array");
+  if (t.components != 1) fail("nnc_trans must be a 1-component array");
+  for (int64_t q = 0; q < n; ++q) {
+    const int64_t a = c.i[2 * q], b = c.i[2 * q + 1];
+    if (a < 0 || a >= n_cells || b < 0 || b >= n_cells || a == b)
+      fail("nnc_cells: connection " + std::to_string(q) + " is not a pair of two distinct cells of the file");
+    const double v = t.is_int ? static_cast<double>(t.i[q]) : t.d[q];
+    if (!(std::isfinite(v) && v >= 0)) fail("nnc_trans: " + std::to_string(v) + " is not a finite value >= 0");
+    out.nnc_cells.push_back({static_cast<int32_t>(a), static_cast<int32_t>(b)});
+    out.nnc_trans.push_back(v);
+  }
+}
 
 void read_piece(const Source& src, vtkXMLDataElement* piece, Parsed& out) {
   const int64_t np = count_attr(piece, "NumberOfPoints", kMaxIds), nc = count_attr(piece, "NumberOfCells", kMaxIds);
@@ -602,6 +626,7 @@ Parsed parse_document(Source& src) {
     if (a.components != 1 || !(v == 0 || v == 1)) fail("field data reservoir_cells_are_model must be one value, 0 or 1");
     out.reservoir_cells_are_model = v == 1;
   }
+  read_nnc_fields(src, child(grid, "FieldData"), static_cast<int64_t>(out.cells.size()), out);
   return out;
 }
 
@@ -877,6 +902,8 @@ ReadResult convert(const Source& src, Parsed&& in, VtuAssembly assembly) {
   }
   if (!in.face_mult.empty()) place_face_multipliers(in.face_mult, res.mesh);
   res.mesh.reservoir_cells_are_model = in.reservoir_cells_are_model;
+  res.mesh.nnc_cells = std::move(in.nnc_cells);
+  res.mesh.nnc_trans = std::move(in.nnc_trans);
   read_cell_data(src, in);  // now: the file's cells no longer take memory
   res.warnings = std::move(in.warnings);
   PolyMesh& m = res.mesh;

@@ -247,6 +247,14 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   const std::vector<int32_t> one{1};
   Block model_field = make_block("Int32", "reservoir_cells_are_model", 1, one);
   model_field.tuples = 1;
+  // Connections without a face (a model's NNC): the pairs' cell ids and their transmissibilities.
+  const bool has_nnc = m.n_nncs() > 0;
+  std::vector<int32_t> nnc_pairs;
+  for (const auto& p : m.nnc_cells) nnc_pairs.insert(nnc_pairs.end(), p.begin(), p.end());
+  Block nnc_cells_field = make_block("Int32", "nnc_cells", 2, nnc_pairs);
+  nnc_cells_field.tuples = m.n_nncs();
+  Block nnc_trans_field = make_block("Float64", "nnc_trans", 1, m.nnc_trans);
+  nnc_trans_field.tuples = m.n_nncs();
   std::vector<Block> point_blocks{make_block("Float64", "Points", 3, points)};
   std::vector<Block> cell_blocks{make_block("Int64", "connectivity", 1, connectivity),
                                  make_block("Int64", "offsets", 1, offsets), make_block("UInt8", "types", 1, types)};
@@ -276,6 +284,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   place(field, "      ");
   if (has_mult) place(mult_field, "      ");
   if (m.reservoir_cells_are_model) place(model_field, "      ");
+  if (has_nnc) place(nnc_cells_field, "      "), place(nnc_trans_field, "      ");
   xml << "    </FieldData>\n    <Piece NumberOfPoints=\"" << m.nodes.size() << "\" NumberOfCells=\"" << nc << "\">\n";
   xml << "      <Points>\n";
   for (const Block& b : point_blocks) place(b, "        ");
@@ -298,6 +307,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   emit(field);
   if (has_mult) emit(mult_field);
   if (m.reservoir_cells_are_model) emit(model_field);
+  if (has_nnc) emit(nnc_cells_field), emit(nnc_trans_field);
   for (const Block& b : point_blocks) emit(b);
   for (const Block& b : cell_blocks) emit(b);
   for (const Block& b : data_blocks) emit(b);

@@ -34,6 +34,7 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   r.cells = mesh.n_cells();
   r.faces = mesh.n_faces();
   r.nodes = mesh.n_nodes();
+  r.connections_without_face = mesh.n_nncs();
   r.structure = check_csr_invariants(mesh);
   if (!r.structure.ok) {
     for (const char* name :

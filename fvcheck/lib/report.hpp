@@ -39,6 +39,9 @@ struct FvReport {
   CsrReport structure;                       ///< CSR invariants; when not ok the checks are skipped
   /// Cells the shape checks do not judge: a corner-point model's cells (PolyMesh::reservoir_cells_are_model).
   int64_t model_cells_not_judged = 0;
+  /// Connections without a face (PolyMesh::nnc_cells: a model's NNC); their pairs and values are
+  /// checked with the structure, they have no geometry to judge.
+  int64_t connections_without_face = 0;
   std::vector<CheckResult> checks;           ///< fixed order: convexity, conformity, closure, volume,
                                              ///< orthogonality, auto_centering, planarity
   std::vector<double> q_s, q_o_cell, q_p_cell;  ///< per cell (empty if skipped); Q_O Euclidean

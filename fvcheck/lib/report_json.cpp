@@ -40,6 +40,7 @@ json report_json(const FvReport& r) {
   j["nodes"] = r.nodes;
   j["boundary_faces"] = r.boundary_faces;
   j["model_cells_not_judged"] = r.model_cells_not_judged;
+  j["connections_without_face"] = r.connections_without_face;
   j["structure"] = {{"ok", r.structure.ok}, {"problems", r.structure.problems}};
   j["options"] = {{"rel_tol", r.options.rel_tol},
                   {"closure_tol", r.options.closure_tol},

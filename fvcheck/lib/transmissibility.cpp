@@ -421,6 +421,10 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
   // A corner-point model's multipliers act on the connection, not on its halves (as in OPM Flow).
   if (!m.face_trans_mult.empty())
     for (int f = 0; f < nf; ++f) t.face[f] *= m.face_trans_mult[f];
+  // Connections without a face carry the deck's value (METRIC); mD.m without the Darcy constant.
+  t.nnc = m.nnc_trans;
+  if (!opt.metric_units)
+    for (double& v : t.nnc) v /= kDarcyMetric;
   for (int f = 0; f < nf; ++f) {
     if (!bad[f]) continue;
     t.negative += bad[f];

@@ -47,6 +47,9 @@ struct Transmissibilities {
   /// connection factor (= half_owner, q = CF/mu (p_cell - p_w)); other boundary faces: 0. Times
   /// PolyMesh::face_trans_mult (a corner-point model's multipliers) where the mesh has them.
   std::vector<double> face;
+  /// n_nncs: the transmissibilities of the mesh's connections without a face (PolyMesh::nnc_trans,
+  /// in the units of `face`).
+  std::vector<double> nnc;
   /// Number of half-transmissibilities that are negative or not finite (FV centre beyond or on
   /// the face plane). They are kept as computed, never replaced by their absolute value
   /// (TransmissibilityOptions::reservoir_halves_opm computes another form, which is never negative).

@@ -299,15 +299,11 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
                     "): the mesh carries it as their pore-volume multiplier, and the near-well cells take the "
                     "multiplier of the model cell they lie in (docs/corner-point.md, \"Pore volumes\")");
   }
-  if (model.deck_nnc > 0)
-    notes.push_back(f.path("grdecl") + ": the deck's NNC adds " + std::to_string(model.deck_nnc) +
-                    " connections between cells; the mesh connects cells through their shared faces only and does "
-                    "not carry them (nor its decks), so OPM Flow on the model's own deck has connections the mesh "
-                    "does not (docs/corner-point.md, \"NNC and EDITNNC\")");
   // Axis-aligned boxes, all active, no multiplier: the rectilinear grid (the same mesh as the box
   // form); else the model's own cells (meshgen/grids/corner_point_grid.hpp), which carry multipliers.
-  ReservoirSpec r = is_rectilinear(model) && !has_transmissibility_multipliers(model) ? rectilinear_reservoir(model, f.path("grdecl"))
-                                          : corner_point_reservoir(shared, f.path("grdecl"));
+  ReservoirSpec r = is_rectilinear(model) && !has_transmissibility_multipliers(model) && model.nnc.empty()
+                       ? rectilinear_reservoir(model, f.path("grdecl"))
+                       : corner_point_reservoir(shared, f.path("grdecl"));
   for (size_t c = 0; c < r.cell_poro.size(); ++c) {
     if (!model.actnum[c]) continue;  // inactive cells carry no rock
     const std::string cell = f.path("grdecl") + ": cell " + std::to_string(c);

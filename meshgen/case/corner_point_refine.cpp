@@ -154,6 +154,10 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   r.map_origin = m.map_origin;
   r.map_unit_x = m.map_unit_x;
   r.map_unit_y = m.map_unit_y;
+  // Keyed by the cells of the model as read (cell_as_read), so they hold for the children as they are.
+  r.nnc = m.nnc;
+  r.edit_nnc = m.edit_nnc;
+  r.deck_editnnc = m.deck_editnnc;
 
   // Pillars: pillar line I lies in model slice si[I].parent at s = child / of (the last line at s = 1).
   auto line = [](const std::vector<Slot>& sl, int I, int& parent, double& s) {

@@ -14,6 +14,7 @@
 #include <opm/input/eclipse/Parser/ErrorGuard.hpp>
 #include <opm/input/eclipse/Parser/ParseContext.hpp>
 #include <opm/input/eclipse/Parser/Parser.hpp>
+#include <opm/input/eclipse/Units/UnitSystem.hpp>
 #include <opm/input/eclipse/Units/Units.hpp>
 
 #include <algorithm>
@@ -196,7 +197,15 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
     }
     {
       const Opm::NNC& nnc = state.getInputNNC();
-      m.deck_nnc = static_cast<int64_t>(nnc.input().size());
+      const Opm::UnitSystem metric = Opm::UnitSystem::newMETRIC();
+      for (const Opm::NNCdata& e : nnc.input()) {
+        const double t = metric.from_si(Opm::UnitSystem::measure::transmissibility, e.trans);
+        if (!(std::isfinite(t) && t >= 0))
+          throw InputError(key + ": its NNC between cells " + std::to_string(e.cell1) + " and " +
+                           std::to_string(e.cell2) + " (natural indices) has the transmissibility " + std::to_string(t) +
+                           ": it must be finite and >= 0");
+        m.nnc.push_back({static_cast<int64_t>(std::min(e.cell1, e.cell2)), static_cast<int64_t>(std::max(e.cell1, e.cell2)), t});
+      }
       m.deck_editnnc = static_cast<int64_t>(nnc.edit().size());
       for (const Opm::NNCdata& e : nnc.edit()) {
         const int64_t a = static_cast<int64_t>(std::min(e.cell1, e.cell2)), b = static_cast<int64_t>(std::max(e.cell1, e.cell2));

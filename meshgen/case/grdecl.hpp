@@ -65,10 +65,17 @@ struct CornerPointModel {
   /// Per cell: OPM's pore volume over volume x PORO x NTG on those cells, exactly 1 elsewhere (inactive
   /// cells included); empty when every cell's is 1. The mesh carries it (PolyMesh::cell_pore_volume_mult).
   std::vector<double> pore_volume_mult;
-  /// NNC and EDITNNC of the deck (OPM's EclipseState::getInputNNC): the connections NNC adds between two
-  /// cells and the EDITNNC records multiplying the transmissibility of given cell pairs. The mesh connects
-  /// cells through shared faces only and does not carry NNC (docs/corner-point.md, "NNC and EDITNNC").
-  int64_t deck_nnc = 0, deck_editnnc = 0;
+  /// NNC of the deck as OPM reads it (EclipseState::getInputNNC().input(): an EDITNNC of the same pair
+  /// folded in): connections between two cells that need not share a face, by natural indices of the
+  /// model as read (a < b), transmissibility in cP.rm3/day/bar (METRIC). The mesh carries them
+  /// (PolyMesh::nnc_cells; docs/corner-point.md, "NNC and EDITNNC").
+  struct Nnc {
+    int64_t a = 0, b = 0;
+    double trans = 0;
+  };
+  std::vector<Nnc> nnc;
+  /// EDITNNC records OPM keeps for flow's own connections (NNC::edit()).
+  int64_t deck_editnnc = 0;
   /// EDITNNC as OPM keeps it for flow's own connections (NNC::edit(): pairs that are not logical
   /// neighbours and not a deck NNC, e.g. across a fault), by pair of natural indices of the model as
   /// read (smaller first): the product of its records' multipliers. The mesh carries it on the faces

@@ -293,6 +293,18 @@ CsrReport check_csr_invariants(const PolyMesh& m) {
       bad("cell_pore_volume_mult[" + std::to_string(c) + "] is not a finite value > 0");
       break;
     }
+  if (m.nnc_trans.size() != m.nnc_cells.size()) bad("nnc_trans and nnc_cells differ in size");
+  for (size_t k = 0; k < m.nnc_cells.size(); ++k) {
+    const auto [a, b] = m.nnc_cells[k];
+    if (a < 0 || a >= nc || b < 0 || b >= nc || a == b) {
+      bad("nnc_cells[" + std::to_string(k) + "] is not a pair of two distinct valid cells");
+      break;
+    }
+    if (k < m.nnc_trans.size() && !(std::isfinite(m.nnc_trans[k]) && m.nnc_trans[k] >= 0)) {
+      bad("nnc_trans[" + std::to_string(k) + "] is not a finite value >= 0");
+      break;
+    }
+  }
   if (m.cell_fv_center.size() != static_cast<size_t>(nc) || m.cell_ijk.size() != static_cast<size_t>(nc) ||
       m.cell_perm.size() != static_cast<size_t>(nc) || m.cell_porosity.size() != static_cast<size_t>(nc) ||
       m.cell_radial.size() != static_cast<size_t>(nc))

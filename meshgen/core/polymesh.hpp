@@ -77,6 +77,14 @@ struct PolyMesh {
   std::vector<double> cell_pore_volume_mult;
   std::vector<RadialCellInfo> cell_radial;  ///< n_cells, radial structure of well cells
 
+  // ---- connections without a face
+  /// A corner-point deck's NNC (docs/corner-point.md, "NNC and EDITNNC"): two cells that share no face
+  /// and exchange flow through a given transmissibility. n_nncs pairs of distinct valid cell ids.
+  std::vector<std::array<int32_t, 2>> nnc_cells;
+  /// n_nncs: their transmissibilities in cP.rm3/day/bar (METRIC), as the deck gives them (OPM folds an
+  /// EDITNNC of the pair in); finite and >= 0. They do not depend on the geometry or the frame.
+  std::vector<double> nnc_trans;
+
   // ---- frame
   /// Diagonal of the permeability frame S the mesh was built in (case `metric: permeability`,
   /// docs/anisotropy.md), product 1; (1, 1, 1) for a Euclidean mesh. cell_radial's radii and
@@ -91,6 +99,7 @@ struct PolyMesh {
   int n_nodes() const { return static_cast<int>(nodes.size()); }
   int n_faces() const { return static_cast<int>(face_owner.size()); }
   int n_cells() const { return static_cast<int>(cell_region.size()); }
+  int n_nncs() const { return static_cast<int>(nnc_cells.size()); }
   int face_size(int f) const { return face_node_ptr[f + 1] - face_node_ptr[f]; }
   const int32_t* face_begin(int f) const { return face_nodes.data() + face_node_ptr[f]; }
   const int32_t* face_end(int f) const { return face_nodes.data() + face_node_ptr[f + 1]; }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -78,6 +79,47 @@ void apply_model_multipliers(HybridMesh& out, const CornerPointModel& model, con
                         " model faces between cavity cells carry transmissibility multipliers (" + range +
                         ") that the near-well cells replacing those cells do not (docs/corner-point.md)");
   }
+}
+
+// The deck's NNCs as the mesh's connections without a face. A pair's cells are the mesh cells of the
+// two model cells it names; in a refined model the two children, one of each, whose FV centres are
+// nearest (the deck gives one transmissibility between two cells, not a distribution over children).
+// A pair with a cell that is inactive or replaced by near-well cells has nothing to connect, as in OPM
+// Flow's run of a deck whose cell is inactive.
+void attach_deck_nncs(HybridMesh& out, const CornerPointModel& model) {
+  if (model.nnc.empty()) return;
+  PolyMesh& m = out.mesh;
+  std::map<int64_t, std::vector<int32_t>> cells_of;  // cell of the model as read -> its mesh cells
+  for (const CornerPointModel::Nnc& e : model.nnc) cells_of[e.a], cells_of[e.b];
+  for (int c = 0; c < m.n_cells(); ++c) {
+    const auto& ijk = m.cell_ijk[c];
+    if (m.cell_region[c] != kReservoir || ijk[0] < 0) continue;
+    const int64_t natural = ijk[0] + int64_t(model.nx) * (ijk[1] + int64_t(model.ny) * ijk[2]);
+    if (auto it = cells_of.find(cell_as_read(model, natural)); it != cells_of.end()) it->second.push_back(c);
+  }
+  int64_t missing = 0, among_children = 0;
+  for (const CornerPointModel::Nnc& e : model.nnc) {
+    const std::vector<int32_t>&ca = cells_of[e.a], &cb = cells_of[e.b];
+    if (ca.empty() || cb.empty()) {
+      ++missing;
+      continue;
+    }
+    std::array<int32_t, 2> pair{ca[0], cb[0]};
+    double best = norm2(m.cell_fv_center[ca[0]] - m.cell_fv_center[cb[0]]);
+    for (const int32_t x : ca)
+      for (const int32_t y : cb)
+        if (const double d = norm2(m.cell_fv_center[x] - m.cell_fv_center[y]); d < best) best = d, pair = {x, y};
+    among_children += ca.size() > 1 || cb.size() > 1;
+    m.nnc_cells.push_back(pair);
+    m.nnc_trans.push_back(e.trans);
+  }
+  std::string note = "reservoir: the deck's NNC connects " + std::to_string(m.n_nncs()) + " of its " +
+                     std::to_string(model.nnc.size()) + " cell pairs in the mesh, as connections without a face";
+  if (among_children > 0)
+    note += "; " + std::to_string(among_children) + " of them join the refined cells' children nearest each other";
+  if (missing > 0)
+    note += "; " + std::to_string(missing) + " name a cell that is inactive or replaced by near-well cells and connect nothing";
+  out.notes.push_back(note + " (docs/corner-point.md, \"NNC and EDITNNC\")");
 }
 
 std::string well_names(const CaseSpec& cs, const std::vector<int>& wells) {
@@ -204,6 +246,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   out.mesh = builder.finish(&out.build_report);
   fill_cell_maps(out, maps);
   if (out.build_report.ok) apply_model_multipliers(out, model, &faces, out.cavities.reservoir_active, coords);
+  attach_deck_nncs(out, model);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   std::vector<int> all_wells(nw);
@@ -239,6 +282,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
   stage.mark("reservoir_cells");
   fill_cell_maps(out, TransitionCellMaps{});
   if (out.build_report.ok) apply_model_multipliers(out, model, nullptr, all_present(model), {});
+  attach_deck_nncs(out, model);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   if (cells.zero_volume_cells > 0)

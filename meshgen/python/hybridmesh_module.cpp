@@ -204,6 +204,16 @@ PYBIND11_MODULE(hybridmesh, mod) {
             return view_or_ones(m.cell_pore_volume_mult, m.n_cells(), s);
           },
           "n_cells: the corner-point model's pore-volume multiplier of each cell (MULTPV, PORV; 1 where it has none)")
+      .def_property_readonly(
+          "nnc_cells",
+          [](py::object s) {
+            const auto& v = s.cast<Mesh&>().result.mesh.nnc_cells;
+            return view(v.empty() ? nullptr : v[0].data(), v.size(), 2, s);
+          },
+          "(n_nncs, 2): the cells of each connection without a face (the model's NNC)")
+      .def_property_readonly("nnc_transmissibilities",
+                             [](py::object s) { return view(s.cast<Mesh&>().result.mesh.nnc_trans, s); },
+                             "n_nncs: their transmissibilities (cP.rm3/day/bar)")
       .def_property_readonly("transmissibilities",
                              [](py::object s) { return view(s.cast<Mesh&>().transmissibilities().face, s); },
                              "n_faces: TPFA transmissibility (cP.rm3/day/bar); wellbore faces: connection factor")

@@ -93,6 +93,12 @@ void check_problem(const FlowProblem& pb, const Transmissibilities& tr) {
   if (static_cast<int>(tr.face.size()) != nf || static_cast<int>(tr.half_owner.size()) != nf)
     throw std::invalid_argument("solve_tpfa: transmissibilities do not match the mesh (" + std::to_string(tr.face.size()) +
                                 " values for " + std::to_string(nf) + " faces)");
+  if (tr.nnc.size() != m.nnc_cells.size())
+    throw std::invalid_argument("solve_tpfa: transmissibilities do not match the mesh (" + std::to_string(tr.nnc.size()) +
+                                " values for " + std::to_string(m.nnc_cells.size()) + " connections without a face)");
+  for (size_t k = 0; k < tr.nnc.size(); ++k)
+    if (!std::isfinite(tr.nnc[k]))
+      throw std::invalid_argument("solve_tpfa: non-finite transmissibility of connection " + std::to_string(k));
   if (static_cast<int>(pb.geo->face_centroid.size()) != nf)
     throw std::invalid_argument("solve_tpfa: geometry does not match the mesh");
   if (!(pb.viscosity_cp > 0) || !std::isfinite(pb.viscosity_cp))
@@ -185,29 +191,39 @@ std::vector<BoundaryTerm> boundary_terms(const FlowProblem& pb, const Transmissi
   return terms;
 }
 
-/// Face f seen from cell c towards `other`: the coefficient T b_up / mu and the gravity term
-/// G (z_c - z_other) of its potential difference p_c - p_other - G (z_c - z_other).
+/// A connection (a face, or a connection without a face) seen from cell c towards `other`: the
+/// coefficient T b_up / mu and the gravity term G (z_c - z_other) of its potential difference
+/// p_c - p_other - G (z_c - z_other).
 struct FaceTerm {
   double coef, gravity_drop;
 };
-FaceTerm face_term(const FlowProblem& pb, const Transmissibilities& tr, const FluidState& st, int32_t f, int32_t c,
-                   int32_t other) {
+/// The connection of transmissibility `trans` between cells a and b (a face's owner and neighbour, an
+/// NNC's pair): its upstream b is decided once from a's side (a tie goes to a), so that both rows use
+/// the same b and the matrix stays symmetric.
+FaceTerm connection_term(const FlowProblem& pb, const FluidState& st, double trans, int32_t a, int32_t b, int32_t c,
+                         int32_t other) {
   const PolyMesh& m = *pb.mesh;
-  const double t = tr.face[f] / pb.viscosity_cp;
-  if (!std::isfinite(t)) throw std::invalid_argument("solve_tpfa: non-finite transmissibility on face " + std::to_string(f));
-  // OPM: face density = mean of the two cells' densities; mobility b/mu of the upstream cell.
+  const double t = trans / pb.viscosity_cp;
+  // OPM: density = mean of the two cells' densities; mobility b/mu of the upstream cell.
   const double drop =
       (st.rho[c] + st.rho[other]) / 2 * gravity_factor(pb) * (m.cell_fv_center[c].z - m.cell_fv_center[other].z);
   double b_up = 1.0;
   if (st.p != nullptr) {
-    // Decided once per face, from the owner's side (a tie goes to the owner), so that both
-    // rows of the face use the same b and the matrix stays symmetric.
-    const int32_t own = m.face_owner[f], nei = m.face_neighbour[f];
-    const double dz = m.cell_fv_center[own].z - m.cell_fv_center[nei].z;
-    const double dphi = (*st.p)[own] - (*st.p)[nei] - (st.rho[own] + st.rho[nei]) / 2 * gravity_factor(pb) * dz;
-    b_up = dphi >= 0 ? st.b[own] : st.b[nei];
+    const double dz = m.cell_fv_center[a].z - m.cell_fv_center[b].z;
+    const double dphi = (*st.p)[a] - (*st.p)[b] - (st.rho[a] + st.rho[b]) / 2 * gravity_factor(pb) * dz;
+    b_up = dphi >= 0 ? st.b[a] : st.b[b];
   }
   return {t * b_up, drop};
+}
+FaceTerm face_term(const FlowProblem& pb, const Transmissibilities& tr, const FluidState& st, int32_t f, int32_t c,
+                   int32_t other) {
+  if (!std::isfinite(tr.face[f]))
+    throw std::invalid_argument("solve_tpfa: non-finite transmissibility on face " + std::to_string(f));
+  return connection_term(pb, st, tr.face[f], pb.mesh->face_owner[f], pb.mesh->face_neighbour[f], c, other);
+}
+FaceTerm nnc_term(const FlowProblem& pb, const Transmissibilities& tr, const FluidState& st, int k, int32_t c) {
+  const auto [a, b] = pb.mesh->nnc_cells[k];
+  return connection_term(pb, st, tr.nnc[k], a, b, c, c == a ? b : a);
 }
 
 TpfaSystem assemble_with(const FlowProblem& pb, const Transmissibilities& tr, const FluidState& st) {
@@ -221,8 +237,19 @@ TpfaSystem assemble_with(const FlowProblem& pb, const Transmissibilities& tr, co
   // Row c: the neighbours through c's interior faces, merged (two cells may share several faces).
   // The upstream b of a face is the same seen from both cells, so the matrix stays symmetric.
   std::vector<std::pair<int32_t, double>> row;
+  std::vector<std::vector<int>> nncs_of(m.nnc_cells.empty() ? 0 : n);
+  for (int k = 0; k < m.n_nncs(); ++k)
+    for (const int32_t c : m.nnc_cells[k]) nncs_of[c].push_back(k);
   for (int c = 0; c < n; ++c) {
     row.clear();
+    if (!nncs_of.empty())
+      for (const int k : nncs_of[c]) {
+        const FaceTerm ct = nnc_term(pb, tr, st, k, c);
+        const auto [a, b] = m.nnc_cells[k];
+        row.push_back({c == a ? b : a, -ct.coef});
+        diag[c] += ct.coef;
+        sys.rhs[c] += ct.coef * ct.gravity_drop;
+      }
     for (const int32_t* it = m.cell_begin(c); it != m.cell_end(c); ++it) {
       const int32_t f = *it, o = m.face_owner[f], nb = m.face_neighbour[f];
       if (nb < 0) continue;
@@ -292,6 +319,13 @@ std::vector<double> mass_balance_residual(const FlowProblem& pb, const Transmiss
     const double flux = ft.coef * (p[o] - p[nb] - ft.gravity_drop);  // surface volume from o to nb
     r[o] += flux;
     r[nb] -= flux;
+  }
+  for (int k = 0; k < m.n_nncs(); ++k) {
+    const auto [a, b] = m.nnc_cells[k];
+    const FaceTerm ct = nnc_term(pb, tr, st, k, a);
+    const double flux = ct.coef * (p[a] - p[b] - ct.gravity_drop);
+    r[a] += flux;
+    r[b] -= flux;
   }
   for (const BoundaryTerm& t : boundary_terms(pb, tr, st)) r[t.cell] += t.c * (p[t.cell] - t.p_ext);
   return r;

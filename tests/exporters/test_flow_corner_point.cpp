@@ -287,6 +287,48 @@ TEST(FlowCornerPoint, ModelWithMultipliersAndWellsMatchesSolverDemo) {
   EXPECT_GT(miss, 1e-3);
 }
 
+// The model's NNC (nnc_keywords: four connections between cells that share no face, one a conduit
+// between the two wells' surroundings; docs/corner-point.md, "NNC and EDITNNC") become the mesh's
+// connections without a face, between the cells they name with the deck's values; the deck's NNC records
+// carry them, flow runs it and matches solver_demo. Fail half: solver_demo without them misses flow.
+TEST(FlowCornerPoint, ModelNncIsCarriedAndMatchesSolverDemo) {
+  REQUIRE_FLOW();
+  TempDir tmp("flow_cpw_nnc");
+  TiltedModel g;
+  g.keywords = nnc_keywords();
+  CornerPointFlowRun r;
+  run_case(tmp, g, two_wells_yaml(), &r);
+  if (HasFatalFailure()) return;
+  const hm::PolyMesh& mesh = r.out.mesh;
+  std::map<std::pair<std::array<int32_t, 3>, std::array<int32_t, 3>>, double> expected;
+  for (const auto& e : nnc_records()) {
+    std::array<int32_t, 3> a{int(e[0]) - 1, int(e[1]) - 1, int(e[2]) - 1}, b{int(e[3]) - 1, int(e[4]) - 1, int(e[5]) - 1};
+    expected[{std::min(a, b), std::max(a, b)}] = e[6];
+  }
+  ASSERT_EQ(mesh.n_nncs(), static_cast<int>(expected.size()));
+  for (int k = 0; k < mesh.n_nncs(); ++k) {
+    const auto a = mesh.cell_ijk[mesh.nnc_cells[k][0]], b = mesh.cell_ijk[mesh.nnc_cells[k][1]];
+    const auto it = expected.find({std::min(a, b), std::max(a, b)});
+    ASSERT_NE(it, expected.end()) << "connection " << k << " joins cells the deck does not name";
+    EXPECT_NEAR(mesh.nnc_trans[k], it->second, 1e-12 * it->second);
+  }
+  expect_corner_point_run("tilted, NNC", tmp, r);
+  hm::PolyMesh plain = mesh;
+  plain.nnc_cells.clear();
+  plain.nnc_trans.clear();
+  const hm::FlowSolution s = hm::solve_tpfa(hm::deck_flow_problem(r.cs, plain, r.out.geometry),
+                                            hm::compute_transmissibilities(plain, r.out.geometry,
+                                                                           hm::deck_transmissibility_options()));
+  double miss = 0, pressure_miss = 0;
+  for (size_t w = 0; w < s.well_rate_m3_per_day.size(); ++w)
+    miss = std::max(miss, std::abs(s.well_rate_m3_per_day[w] / r.ours.well_rate_m3_per_day[w] - 1));
+  for (size_t c = 0; c < s.pressure.size(); ++c)
+    pressure_miss = std::max(pressure_miss, std::abs(s.pressure[c] / r.ours.pressure[c] - 1));
+  std::printf("[ figures  ] fail half: without the NNC the well rates differ by %.3g, the pressures by %.3g\n", miss,
+              pressure_miss);
+  EXPECT_GT(miss, 1e-3);
+}
+
 // Pore volumes other than volume x PORO x NTG (MULTPV: an aquifer column x 1000, every seventh cell x 2.5;
 // docs/corner-point.md, "Pore volumes"). With near-well cells the deck's PORV carries them (flow's INIT PORV
 // equals ours, the multiplier included, on every cell; the near-well cells take their model cell's), the
@@ -513,23 +555,25 @@ void print_own_vs_ours(const char* label, const OwnVsOurs& d, int kind = -1) {
 // models to 1e-6 on every pair; with HM_REEK_DECK the same figures for Reek (measured, not asserted).
 TEST(FlowCornerPoint, OurModelTransmissibilitiesAgainstFlowsOwn) {
   REQUIRE_FLOW();
-  for (int variant : {0, 1, 2, 3, 4}) {
+  for (int variant : {0, 1, 2, 3, 4, 5}) {
     TempDir tmp("cpw_own");
     TiltedModel g;
     g.inclined_pillars = variant == 1;
     g.nz = variant == 1 ? 22 : 16;
-    if (variant >= 2) {  // a fault of 6 m throw and multipliers on every face (flow applies them itself)
+    if (variant >= 2 && variant <= 4) {  // a fault of 6 m throw and multipliers on every face (flow applies them)
       g.fault_i = 6, g.throw_m = 6;
       g.keywords = multiplier_keywords(g, 6);
     }
     if (variant == 3) g.keywords += region_multiplier_keywords(g);  // and MULTREGT between MULTNUM regions
     if (variant == 4) g.keywords += edit_nnc_keywords(g);           // and EDITNNC across the fault
+    if (variant == 5) g.keywords = nnc_keywords();                  // NNC between cells sharing no face
     std::ofstream(tmp.path / "M.GRDECL") << g.text();
     std::ofstream(tmp.path / "cpm.yaml") << "name: cpm\nreservoir: {grdecl: M.GRDECL}\n";
     const hm::CaseSpec cs = hm::load_case((tmp.path / "cpm.yaml").string());
     const OwnVsOurs d = compare_with_flows_own(cs, tmp.path / "deck");
-    static const char* kLabel[5] = {"tilted, vertical pillars", "inclined pillars", "tilted, fault, multipliers",
-                                    "tilted, fault, multipliers, MULTREGT", "tilted, fault, multipliers, EDITNNC"};
+    static const char* kLabel[6] = {"tilted, vertical pillars", "inclined pillars", "tilted, fault, multipliers",
+                                    "tilted, fault, multipliers, MULTREGT", "tilted, fault, multipliers, EDITNNC",
+                                    "tilted, NNC"};
     print_own_vs_ours(kLabel[variant], d);
     if (variant == 3) {  // fail half: ours without MULTREGT (the deck keeps it, flow applies it)
       hm::CaseSpec plain = cs;
@@ -565,6 +609,15 @@ TEST(FlowCornerPoint, OurModelTransmissibilitiesAgainstFlowsOwn) {
       size_t fault_pairs = 0;
       for (int k : d.kind) fault_pairs += k == 3;
       EXPECT_GT(fault_pairs, 50u);
+    }
+    if (variant == 5) {  // no fault: the pairs that are not logical neighbours are exactly the NNC's
+      size_t nnc_pairs = 0;
+      double worst_nnc = 0;
+      for (size_t i = 0; i < d.rel.size(); ++i)
+        if (d.kind[i] == 3) ++nnc_pairs, worst_nnc = std::max(worst_nnc, std::abs(d.rel[i]));
+      std::printf("[ figures  ] NNC: %zu pairs, ours vs flow's max rel %.3g\n", nnc_pairs, worst_nnc);
+      EXPECT_EQ(nnc_pairs, nnc_records().size());
+      EXPECT_LT(worst_nnc, 1e-6);
     }
     EXPECT_GT(d.rel.size(), 1000u);
     EXPECT_EQ(d.only_flow, 0u);

@@ -242,6 +242,8 @@ void expect_same_mesh(const PolyMesh& q, const PolyMesh& m) {
   EXPECT_EQ(q.cell_ijk, m.cell_ijk);
   EXPECT_EQ(q.cell_porosity, m.cell_porosity);
   EXPECT_EQ(q.cell_pore_volume_mult, m.cell_pore_volume_mult);  // empty stays empty
+  EXPECT_EQ(q.nnc_cells, m.nnc_cells);
+  EXPECT_EQ(q.nnc_trans, m.nnc_trans);
   for (int c = 0; c < m.n_cells(); ++c) {
     EXPECT_TRUE(q.cell_fv_center[c] == m.cell_fv_center[c]) << c;
     EXPECT_TRUE(q.cell_perm[c] == m.cell_perm[c]) << c;
@@ -276,6 +278,9 @@ TEST(VtuRoundTrip, TopologyCoordinatesAndArraysAreIdentical) {
     RadialCellInfo& r = m.cell_radial[c];
     r = {c % 2, c, c + 1, c + 2, 0.1 * c, 0.2 + c, 1.0 / 3, 2 * M_PI / 7, 0.7, c % 3 - 1, Vec3{1.0 / 3, 2, c + 0.5}};
   }
+  // Connections without a face (a model's NNC), values not exact in decimal.
+  m.nnc_cells = {{0, m.n_cells() - 1}, {5, 2}};
+  m.nnc_trans = {1.0 / 3, 7e-5};
   const MeshGeometry g = compute_geometry(m);
 
   const fs::path d = temp_dir("roundtrip");

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -171,6 +172,69 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsPoreVolumeMultipliers) {
     }
     EXPECT_EQ(aquifer, 1 * 2 * g.nz + 1 * 1 * g.nz + 1 * 2 * g.nz);  // column i = 0 split 1 x (2, 1, 2)
   }
+}
+
+// NNC and EDITNNC of the model as read reach a refined model: both are kept as read (keyed by the
+// cells of the model as read), EDITNNC multiplies the connections between the children of its pairs,
+// and the mesh joins an NNC's two split parents at their two children nearest each other.
+TEST(NearWellRefinement, ChildrenKeepTheModelsNncAndEditnnc) {
+  TempDir tmp("cprefine_nnc");
+  hmtest::TiltedModel g;
+  g.fault_i = 7, g.throw_m = 6;
+  // (5, 1, 3) lies in the well's split column i = 4, (1, 5, 14) in its split row j = 4 (1-based).
+  g.keywords = "NNC\n 5 1 3 1 5 14 3 /\n/\n" + hmtest::edit_nnc_keywords(g);
+  std::ofstream(tmp.path / "M.GRDECL") << g.text();
+  std::ofstream(tmp.path / "c.yaml") << "name: c\nreservoir: {grdecl: M.GRDECL, near_well_cell_size: 4}\n"
+                                     << hmtest::vertical_well_yaml(90, 90, 1034, 1046);
+  const CaseSpec cs = load_case((tmp.path / "c.yaml").string());
+  const CornerPointModel& r = *cs.reservoir.corner_point;
+  ASSERT_FALSE(r.parent_cell.empty()) << "the model is not refined";
+  const CornerPointModel m = read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
+  ASSERT_EQ(m.nnc.size(), 1u);
+  ASSERT_EQ(r.nnc.size(), 1u);
+  EXPECT_EQ(r.nnc[0].a, m.nnc[0].a);
+  EXPECT_EQ(r.nnc[0].b, m.nnc[0].b);
+  EXPECT_EQ(r.nnc[0].trans, 3.0);
+  ASSERT_EQ(r.edit_nnc, m.edit_nnc);
+  ASSERT_FALSE(m.edit_nnc.empty());
+  // Between a child of each cell of an EDITNNC pair: the pair's multiplier; within one parent none.
+  std::map<int64_t, std::vector<int64_t>> children_of;
+  for (int64_t c = 0; c < static_cast<int64_t>(r.parent_cell.size()); ++c) children_of[r.parent_cell[c]].push_back(c);
+  int edited = 0;
+  for (const auto& [pair, mult] : m.edit_nnc) {
+    const std::vector<int64_t>&ca = children_of[pair.first], &cb = children_of[pair.second];
+    ASSERT_FALSE(ca.empty() || cb.empty());
+    EXPECT_EQ(edit_nnc_multiplier(r, ca.front(), cb.back()), mult);
+    EXPECT_EQ(edit_nnc_multiplier(r, cb.front(), ca.back()), mult);
+    if (ca.size() > 1) EXPECT_EQ(edit_nnc_multiplier(r, ca.front(), ca.back()), 1.0);
+    edited += ca.size() > 1 || cb.size() > 1;
+  }
+  std::printf("[ figures  ] refined model: %zu EDITNNC pairs, %d of them with a split cell\n", m.edit_nnc.size(), edited);
+  EXPECT_GT(edited, 0);
+  const HybridMesh out = build_hybrid_mesh(cs);
+  const PolyMesh& mesh = out.mesh;
+  ASSERT_EQ(mesh.n_nncs(), 1);
+  std::vector<int32_t> children[2];
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    const auto& ijk = mesh.cell_ijk[c];
+    if (mesh.cell_region[c] != kReservoir || ijk[0] < 0) continue;
+    const int64_t parent = cell_as_read(r, ijk[0] + int64_t(r.nx) * (ijk[1] + int64_t(r.ny) * ijk[2]));
+    for (int s = 0; s < 2; ++s)
+      if (parent == (s == 0 ? m.nnc[0].a : m.nnc[0].b)) children[s].push_back(c);
+  }
+  ASSERT_GT(children[0].size(), 1u);
+  ASSERT_GT(children[1].size(), 1u);
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int32_t x : children[0])
+    for (int32_t y : children[1]) nearest = std::min(nearest, norm(mesh.cell_fv_center[x] - mesh.cell_fv_center[y]));
+  const auto [ca, cb] = mesh.nnc_cells[0];
+  const bool a_first = std::count(children[0].begin(), children[0].end(), ca) == 1;
+  EXPECT_EQ(std::count(children[a_first ? 1 : 0].begin(), children[a_first ? 1 : 0].end(), cb), 1);
+  EXPECT_TRUE(a_first || std::count(children[1].begin(), children[1].end(), ca) == 1);
+  EXPECT_EQ(norm(mesh.cell_fv_center[ca] - mesh.cell_fv_center[cb]), nearest);
+  EXPECT_EQ(mesh.nnc_trans[0], 3.0);
+  std::printf("[ figures  ] NNC between parents of %zu and %zu children, joined %.3f m apart\n", children[0].size(),
+              children[1].size(), nearest);
 }
 
 // The splits: fine near the well, coarser away, none far off or in narrow columns; the same when

@@ -813,24 +813,46 @@ TEST(CornerPoint, PoreVolumesOtherThanTheRocksAreCarried) {
   }
 }
 
-// NNC and EDITNNC of the model's deck: NNC, which the mesh does not carry, counted (as OPM reads it) and
-// named in a note; EDITNNC kept as OPM keeps it and noted with the faces it reaches; without them no note.
-TEST(CornerPoint, DeckNncAndEditnncAreCountedAndNoted) {
+// NNC and EDITNNC of the model's deck: NNC as OPM reads it (an EDITNNC of the pair folded in, METRIC
+// units) carried as the mesh's connections without a face between the cells it names; EDITNNC kept as OPM
+// keeps it and noted with the faces it reaches; without them no note and no connection.
+TEST(CornerPoint, DeckNncIsCarriedAndEditnncNoted) {
   for (const bool with : {false, true}) {
     TempDir tmp;
     std::string text = SyntheticCpg{}.text();
     // OPM folds an EDITNNC on a deck NNC into that NNC and ignores one between logical neighbours
-    // (opm-common NNC::load_edit): of these three, only the pair (1,1,1)-(3,1,1) is counted.
+    // (opm-common NNC::load_edit): of these three, only the pair (1,1,1)-(3,1,1) is kept as an edit.
     if (with)
       text += "NNC\n 1 1 1 3 3 3 0.5 /\n 2 1 1 4 2 3 1.25 /\n/\nEDIT\nEDITNNC\n 1 1 1 3 1 1 0.1 /\n 1 1 1 3 3 3 0.5 /\n"
               " 1 1 1 2 1 1 0.1 /\n/\n";
     const CpgRun r = mesh_of(tmp, text);
     const CornerPointModel& m = *r.cs.reservoir.corner_point;
-    EXPECT_EQ(m.deck_nnc, with ? 2 : 0);
+    ASSERT_EQ(m.nnc.size(), with ? 2u : 0u);
     EXPECT_EQ(m.deck_editnnc, with ? 1 : 0);
+    const PolyMesh& mesh = r.out.mesh;
+    ASSERT_EQ(mesh.n_nncs(), with ? 2 : 0);
+    EXPECT_TRUE(check_csr_invariants(mesh).ok);
+    // (i, j, k) pair -> transmissibility (cP.rm3/day/bar): 0.5 x the folded EDITNNC 0.5, and 1.25.
+    std::map<std::pair<std::array<int32_t, 3>, std::array<int32_t, 3>>, double> expected{
+        {{{0, 0, 0}, {2, 2, 2}}, 0.25}, {{{1, 0, 0}, {3, 1, 2}}, 1.25}};
+    for (int k = 0; k < mesh.n_nncs(); ++k) {
+      auto a = mesh.cell_ijk[mesh.nnc_cells[k][0]], b = mesh.cell_ijk[mesh.nnc_cells[k][1]];
+      if (b < a) std::swap(a, b);
+      ASSERT_EQ(expected.count({a, b}), 1u) << k;
+      const double want = expected[{a, b}];
+      EXPECT_NEAR(mesh.nnc_trans[k], want, 1e-12);
+      EXPECT_EQ(mesh.cell_region[mesh.nnc_cells[k][0]], kReservoir);
+    }
+    // The transmissibilities of the connections: the deck's in METRIC, without the Darcy constant in mD.m.
+    const Transmissibilities t = compute_transmissibilities(mesh, r.out.geometry, deck_transmissibility_options());
+    EXPECT_EQ(t.nnc, mesh.nnc_trans);
+    TransmissibilityOptions md;
+    md.metric_units = false;
+    const Transmissibilities t_md = compute_transmissibilities(mesh, r.out.geometry, md);
+    for (int k = 0; k < mesh.n_nncs(); ++k) EXPECT_NEAR(t_md.nnc[k] * kDarcyMetric, mesh.nnc_trans[k], 1e-15);
     bool noted_nnc = false, noted_edit = false;
     for (const std::string& note : r.out.notes) {
-      noted_nnc = noted_nnc || note.find("the deck's NNC adds 2 connections between cells; the mesh") != std::string::npos;
+      noted_nnc = noted_nnc || note.find("the deck's NNC connects 2 of its 2 cell pairs in the mesh") != std::string::npos;
       // (1,1,1)-(3,1,1) share no face: EDITNNC has nothing to act on, as in OPM Flow.
       noted_edit = noted_edit || note.find("EDITNNC names 1 cell pairs; it multiplies the 0 faces between 0 of them; "
                                            "1 share no face") != std::string::npos;

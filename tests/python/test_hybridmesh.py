@@ -236,6 +236,22 @@ class ModelMultipliers(unittest.TestCase):
         np.testing.assert_allclose(mesh.pore_volume_multiplier[top], 2.5, rtol=1e-12)
         np.testing.assert_array_equal(mesh.pore_volume_multiplier[~top], 1.0)
 
+    def test_nnc_between_cells_sharing_no_face(self):
+        """NNC between two corner cells of the box: one connection without a face, its cells and T as given;
+        none without the keyword."""
+        nx, ny, nz = 4, 3, 5
+        with tempfile.TemporaryDirectory() as d:
+            for name, extra in (("plain", ""), ("nnc", "NNC\n 1 1 1 4 3 5 2.5 /\n/\n")):
+                with open(os.path.join(d, name + ".GRDECL"), "w", encoding="utf-8") as f:
+                    f.write(box_grdecl(nx, ny, nz) + extra)
+            plain = hybridmesh.build(hybridmesh.parse_case("name: p\nreservoir: {grdecl: plain.GRDECL}\n", d))
+            mesh = hybridmesh.build(hybridmesh.parse_case("name: n\nreservoir: {grdecl: nnc.GRDECL}\n", d))
+        self.assertEqual(plain.nnc_cells.shape, (0, 2))
+        self.assertEqual(mesh.nnc_cells.shape, (1, 2))
+        ends = sorted(tuple(mesh.cell_ijk[c]) for c in mesh.nnc_cells[0])
+        self.assertEqual(ends, [(0, 0, 0), (nx - 1, ny - 1, nz - 1)])
+        np.testing.assert_allclose(mesh.nnc_transmissibilities, [2.5], rtol=1e-12)
+
 
 if __name__ == "__main__":
     unittest.main()

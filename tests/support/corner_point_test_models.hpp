@@ -139,6 +139,23 @@ inline std::string edit_nnc_keywords(const TiltedModel& g) {
   return o.str();
 }
 
+/// NNC records (GRID section) between cells that share no face, away from the wells of the flow tests
+/// (P1 in column (5, 5), I1 in (3, 7), 1-based): a strong conduit between the two wells' surroundings and
+/// weaker ones between the model's corners. {I1 J1 K1 I2 J2 K2 T}, T in cP.rm3/day/bar.
+inline const std::vector<std::array<double, 7>>& nnc_records() {
+  static const std::vector<std::array<double, 7>> r{
+      {1, 9, 8, 8, 2, 8, 20}, {1, 1, 2, 9, 9, 15, 5}, {9, 1, 4, 1, 9, 12, 2}, {2, 2, 14, 8, 8, 3, 0.75}};
+  return r;
+}
+inline std::string nnc_keywords() {
+  std::ostringstream o;
+  o << "NNC\n";
+  for (const auto& r : nnc_records())
+    o << " " << r[0] << " " << r[1] << " " << r[2] << " " << r[3] << " " << r[4] << " " << r[5] << " " << r[6] << " /\n";
+  o << "/\n";
+  return o.str();
+}
+
 /// MULTNUM regions 1 (i < 4), 2 (i >= 4, k < 8) and 3 (i >= 4, k >= 8) and MULTREGT records between them:
 /// 1-2 x 0.1 in every direction, 2-3 x 0.02 in Z only (flow applies neither to an X connection of 2-3).
 inline std::string region_multiplier_keywords(const TiltedModel& g) {
