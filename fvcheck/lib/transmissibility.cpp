@@ -17,12 +17,6 @@ Vec3 times_perm(Vec3 perm, Vec3 v) { return {perm.x * v.x, perm.y * v.y, perm.z 
 /// Standard TPFA half: t = A n . K c / |c|^2, c from the FV centre to the face centroid.
 double generic_half(Vec3 area_out, Vec3 perm, Vec3 c) { return dot(area_out, times_perm(perm, c)) / norm2(c); }
 
-/// OPM's corner-point half (its EclTransmissibility): the permeability of the face's axis times
-/// |A . c| / |c|^2; `axis` 0, 1, 2 for an I, J, K face.
-double opm_half(Vec3 area_out, Vec3 perm, Vec3 c, int axis) {
-  const double k = axis == 0 ? perm.x : axis == 1 ? perm.y : perm.z;
-  return k * std::abs(dot(area_out, c)) / norm2(c);
-}
 
 /// Power/Voronoi cell: the face is orthogonal to the site-to-site segment, so the flux is
 /// A k_n / d with d the signed distance from the site to the face plane (n . c), exact for
@@ -288,9 +282,9 @@ void opm_pair_halves(const PolyMesh& m, const MeshGeometry& g, double unit, Tran
     if (!(total > 0)) continue;
     centroid = centroid / total;
     const int axis = model_face_axis(m, a, b);
-    const double ha = unit * opm_half(area, m.cell_perm[a], face_centre(a, b, centroid) - m.cell_fv_center[a], axis);
+    const double ha = unit * opm_half_transmissibility(area, m.cell_perm[a], face_centre(a, b, centroid) - m.cell_fv_center[a], axis);
     const double hb =
-        unit * opm_half(-1.0 * area, m.cell_perm[b], face_centre(b, a, centroid) - m.cell_fv_center[b], axis);
+        unit * opm_half_transmissibility(-1.0 * area, m.cell_perm[b], face_centre(b, a, centroid) - m.cell_fv_center[b], axis);
     for (int32_t f : faces) {
       const double w = norm(g.face_area[f]) / total;
       t->half_owner[f] = w * (m.face_owner[f] == a ? ha : hb);
@@ -393,7 +387,7 @@ Transmissibilities compute_transmissibilities(const PolyMesh& m, const MeshGeome
         const Vec3 a{std::abs(area_out.x), std::abs(area_out.y), std::abs(area_out.z)};
         axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
       }
-      return unit * opm_half(area_out, m.cell_perm[c], to_face, axis);
+      return unit * opm_half_transmissibility(area_out, m.cell_perm[c], to_face, axis);
     }
     return unit * generic_half(area_out, m.cell_perm[c], to_face);
   };

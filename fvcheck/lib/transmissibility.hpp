@@ -8,12 +8,9 @@
 
 #include "meshgen/core/geometry.hpp"
 #include "meshgen/core/polymesh.hpp"
+#include "meshgen/core/two_point.hpp"  // kDarcyMetric
 
 namespace hm {
-
-/// Eclipse METRIC Darcy constant CDARCY: k [mD] * length [m] -> transmissibility [cP.rm3/day/bar]
-/// (1 mD = 9.869233e-16 m2, 1 cP = 1e-3 Pa.s, 1 day = 86400 s, 1 bar = 1e5 Pa; E300 value).
-constexpr double kDarcyMetric = 0.00852702;
 
 struct TransmissibilityOptions {
   /// true: T in cP.rm3/day/bar (METRIC, = CDARCY * mD.m); false: T in mD.m (no Darcy constant).

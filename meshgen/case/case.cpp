@@ -288,8 +288,9 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
                   100 * model.below_minpv_pore_volume / model.active_pore_volume);
     notes.push_back(f.path("grdecl") + ": " + std::to_string(model.below_minpv) +
                     " active cells have a pore volume below the model's MINPV (" + pv +
-                    "): OPM Flow removes them and connects the cells above and below across them; the mesh keeps "
-                    "them as cells (docs/corner-point.md, \"MINPV\")");
+                    "): removed as OPM Flow removes them, and " + std::to_string(model.minpv_connections.size()) +
+                    " pairs of cells above and below connected across them as flow connects them (docs/corner-point.md, "
+                    "\"MINPV\")");
   }
   if (model.other_pore_volume > 0) {
     char pv[200];
@@ -379,6 +380,76 @@ void clip_paths_to_model(CaseSpec& cs, const std::vector<WellSpec>& as_given, Su
 
 // A corner-point model with wells: its columns near the wells split to the wells' scale
 // (meshgen/case/corner_point_refine.hpp); the case's reservoir becomes the refined model.
+// The case's reservoir becomes `model` (its axes and per-cell rock as corner_point_reservoir gives them).
+void use_model(ReservoirSpec& r, std::shared_ptr<const CornerPointModel> model) {
+  const ReservoirSpec grid = corner_point_reservoir(std::move(model), "reservoir.grdecl");
+  r.x = grid.x;
+  r.y = grid.y;
+  r.z = grid.z;
+  r.cell_permx = grid.cell_permx;
+  r.cell_permy = grid.cell_permy;
+  r.cell_permz = grid.cell_permz;
+  r.cell_poro = grid.cell_poro;
+  r.cell_pore_volume_mult = grid.cell_pore_volume_mult;
+  r.corner_point = grid.corner_point;
+}
+
+// Cells that MINPV removes near a well stay cells: the near-well cells replace the model's cells there,
+// and a removed cell on a well's path would cut the path (docs/corner-point.md, "MINPV"). Near: a corner
+// of the cell's box within kMinpvKeptRadii drainage radii of the path (sampled every quarter radius).
+// The connections MINPV makes across a kept cell are dropped (the cells connect through it).
+constexpr double kMinpvKeptRadii = 3.0;
+void keep_minpv_cells_near_wells(CaseSpec& cs) {
+  ReservoirSpec& r = cs.reservoir;
+  if (!r.corner_point || r.corner_point->minpv_removed.empty() || cs.wells.empty()) return;
+  const CornerPointModel& m = *r.corner_point;
+  std::vector<int64_t> kept;
+  for (const int64_t c : m.minpv_removed) {
+    const size_t i = static_cast<size_t>(c);
+    if (!(m.poro[i] * m.ntg[i] > 0) || !(m.opm_volume[i] > 0)) continue;  // nothing to mesh
+    Vec3 lo = m.corners[i][0], hi = lo;
+    for (const Vec3& p : m.corners[i]) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    bool near = false;
+    for (const WellSpec& w : cs.wells) {
+      const double reach = kMinpvKeptRadii * w.drainage_radius, step = w.drainage_radius / 4;
+      for (size_t k = 0; k + 1 < w.trajectory.size() && !near; ++k) {
+        const Vec3 a = w.trajectory[k], b = w.trajectory[k + 1];
+        const int n = 1 + static_cast<int>(norm(b - a) / step);
+        for (int q = 0; q <= n && !near; ++q) {
+          const Vec3 p = a + (b - a) * (double(q) / n);
+          const Vec3 d{std::max({lo.x - p.x, p.x - hi.x, 0.0}), std::max({lo.y - p.y, p.y - hi.y, 0.0}),
+                       std::max({lo.z - p.z, p.z - hi.z, 0.0})};
+          near = norm(d) <= reach;
+        }
+      }
+      if (near) break;
+    }
+    if (near) kept.push_back(c);
+  }
+  if (kept.empty()) return;
+  auto model = std::make_shared<CornerPointModel>(m);
+  const int64_t nxy = int64_t(m.nx) * m.ny;
+  std::vector<std::pair<int64_t, int64_t>> connections;
+  for (const auto& [up, low] : m.minpv_connections) {
+    bool across_kept = false;
+    for (const int64_t c : kept) across_kept = across_kept || (c % nxy == up % nxy && c > up && c < low);
+    if (!across_kept) connections.push_back({up, low});
+  }
+  for (const int64_t c : kept) model->actnum[static_cast<size_t>(c)] = 1;
+  model->minpv_connections = std::move(connections);
+  model->minpv_removed.erase(std::remove_if(model->minpv_removed.begin(), model->minpv_removed.end(),
+                                            [&](int64_t c) { return std::count(kept.begin(), kept.end(), c) > 0; }),
+                             model->minpv_removed.end());
+  cs.notes.push_back("reservoir.grdecl: " + std::to_string(kept.size()) + " of the cells below MINPV lie within " +
+                     fmt6(kMinpvKeptRadii) + " drainage radii of a well: kept as cells (the near-well cells replace "
+                     "the model's cells there), the other " + std::to_string(model->minpv_removed.size()) +
+                     " removed (docs/corner-point.md, \"MINPV\")");
+  use_model(r, std::move(model));
+}
+
 void refine_near_wells(CaseSpec& cs) {
   ReservoirSpec& r = cs.reservoir;
   if (!r.corner_point || cs.wells.empty() || r.near_well_cell_size < 0) return;
@@ -395,16 +466,7 @@ void refine_near_wells(CaseSpec& cs) {
   if (cells > kMaxCells)
     fail("reservoir.near_well_cell_size", "refining the model near the wells gives " + fmt_count(cells) + " cells > " +
                                               fmt_count(kMaxCells) + ": give a larger size, or off");
-  const ReservoirSpec grid = corner_point_reservoir(refined, "reservoir.grdecl");
-  r.x = grid.x;
-  r.y = grid.y;
-  r.z = grid.z;
-  r.cell_permx = grid.cell_permx;
-  r.cell_permy = grid.cell_permy;
-  r.cell_permz = grid.cell_permz;
-  r.cell_poro = grid.cell_poro;
-  r.cell_pore_volume_mult = grid.cell_pore_volume_mult;
-  r.corner_point = grid.corner_point;
+  use_model(r, refined);
 }
 
 ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, std::vector<std::string>& notes) {
@@ -681,6 +743,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   // The path's part inside the model, ended kSurfaceGapMin x R inside the surface: the refinement
   // follows it. Then, in the refined model, ended where the surface's faces near each end allow
   // (surface_gap, at least that much).
+  keep_minpv_cells_near_wells(cs);
   const std::vector<WellSpec> as_given = cs.wells;
   clip_paths_to_model(cs, as_given, SurfaceGapRule::Least, false);
   check_wells(cs);

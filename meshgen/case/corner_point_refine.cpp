@@ -158,6 +158,8 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   r.nnc = m.nnc;
   r.edit_nnc = m.edit_nnc;
   r.deck_editnnc = m.deck_editnnc;
+  r.minpv_connections = m.minpv_connections;
+  r.minpv_removed = m.minpv_removed;
 
   // Pillars: pillar line I lies in model slice si[I].parent at s = child / of (the last line at s = 1).
   auto line = [](const std::vector<Slot>& sl, int I, int& parent, double& s) {

@@ -26,6 +26,7 @@
 #include <sstream>
 
 #include "meshgen/case/case.hpp"
+#include "meshgen/case/minpv.hpp"
 
 namespace hm {
 
@@ -193,6 +194,30 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
           if (m.pore_volume_mult.empty()) m.pore_volume_mult.assign(n, 1.0);
           if (ours > 0) m.pore_volume_mult[c] = porv[c] / ours;  // else PORO or NTG is 0: refused by the case
         }
+      }
+      if (minpv) {
+        MinpvInput in;
+        in.nx = m.nx, in.ny = m.ny, in.nz = m.nz;
+        in.thickness.resize(n);
+        for (size_t c = 0; c < n; ++c) in.thickness[c] = grid.getCellThickness(c);
+        in.pore_volume = porv;
+        in.minpv = limit;
+        in.actnum = m.actnum;
+        in.z_tolerance = grid.isPinchActive() ? grid.getPinchThresholdThickness() : 0.0;
+        in.pinch_nogap = grid.getPinchGapMode() == Opm::PinchMode::ModeEnum::NOGAP;  // as processEclipseFormat
+        const MinpvResult removed = opm_minpv(in);
+        for (const int64_t c : removed.removed) m.actnum[static_cast<size_t>(c)] = 0;
+        // Measured against flow 2022.10 (docs/corner-point.md, "MINPV"): across removed cells of no
+        // thickness only, the connection becomes an NNC face of its grid, to which its transmissibility
+        // code gives 0 (the cells connect only as PINCH connects them); across a removed cell with
+        // thickness, a K face with the cells' own halves.
+        const int64_t nxy = int64_t(m.nx) * m.ny;
+        for (const auto& [up, low] : removed.connections) {
+          bool gap = false;
+          for (int64_t c = up + nxy; c < low && !gap; c += nxy) gap = in.thickness[static_cast<size_t>(c)] > 0;
+          if (gap) m.minpv_connections.push_back({up, low});
+        }
+        m.minpv_removed = removed.removed;
       }
     }
     {

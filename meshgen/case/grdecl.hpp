@@ -54,10 +54,18 @@ struct CornerPointModel {
     bool multz_all = false;       ///< MULTZ_OPTION ALL: the smallest MULTZ down the pinched column (else TOP)
   } pinch;
   /// MINPV (MINPV, MINPORV, MINPVV): active cells whose pore volume (OPM's, PORV with NTG and MULTPV) is
-  /// below it, which OPM Flow removes (opm-grid's MinpvProcessor) and connects across; the mesh keeps
-  /// them as cells (docs/corner-point.md, "MINPV"). Their count and pore volume, and the active total.
+  /// below it, which OPM Flow removes (opm-grid's MinpvProcessor) and connects across: they are inactive
+  /// here too (actnum 0; docs/corner-point.md, "MINPV"). Their count and pore volume, and the active total
+  /// before their removal.
   int64_t below_minpv = 0;
   double below_minpv_pore_volume = 0, active_pore_volume = 0;
+  /// The cells of a column OPM Flow connects across removed cells (upper, lower; natural indices of the
+  /// model as read): the mesh connects them through the cells' own faces as flow does (a connection
+  /// without a face where a gap is left between them).
+  std::vector<std::pair<int64_t, int64_t>> minpv_connections;
+  /// The cells MINPV removed (natural indices of the model as read), in order; a case keeps those near
+  /// its wells (keep_minpv_cells_near_wells in case.cpp: the near-well cells replace them).
+  std::vector<int64_t> minpv_removed;
   /// Active cells whose OPM pore volume is not volume x PORO x NTG (MULTPV, PORV edits), which the mesh's
   /// porosity is: their count and OPM's pore volume of them against that product (docs/corner-point.md).
   int64_t other_pore_volume = 0;

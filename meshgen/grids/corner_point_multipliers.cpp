@@ -33,17 +33,30 @@ bool across_pinched_layers(const CornerPointModel& model, int64_t a, int64_t b) 
   return a % nxy == b % nxy && std::abs(a / nxy - b / nxy) > 1;
 }
 
+bool minpv_connects(const CornerPointModel& model, int64_t a, int64_t b) {
+  if (model.minpv_connections.empty()) return false;
+  const int64_t pa = cell_as_read(model, a), pb = cell_as_read(model, b);
+  return std::binary_search(model.minpv_connections.begin(), model.minpv_connections.end(),
+                            std::make_pair(std::min(pa, pb), std::max(pa, pb)));
+}
+
+double column_connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b) {
+  // OPM's applyAllZMultipliers_ (MULTZ option ALL): the smallest MULTZ from the upper cell down to
+  // the last cell between; TOP: the upper cell's, as between logical neighbours.
+  const int64_t nxy = static_cast<int64_t>(model.nx) * model.ny;
+  const int64_t top = std::min(a, b), bottom = std::max(a, b);
+  double down = multiplier(model, 4, top);
+  if (model.pinch.multz_all)
+    for (int64_t c = top + nxy; c < bottom; c += nxy) down = std::min(down, multiplier(model, 4, c));
+  return down * multiplier(model, 5, bottom) * region_multiplier(model, a, b) * edit_nnc_multiplier(model, a, b);
+}
+
 double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b) {
   if (across_pinched_layers(model, a, b)) {
-    if (!model.pinch.active) return 0.0;
-    // OPM's applyAllZMultipliers_ (MULTZ option ALL): the smallest MULTZ from the upper cell down to
-    // the last pinched cell; TOP: the upper cell's, as between logical neighbours.
-    const int64_t nxy = static_cast<int64_t>(model.nx) * model.ny;
-    const int64_t top = std::min(a, b), bottom = std::max(a, b);
-    double down = multiplier(model, 4, top);
-    if (model.pinch.multz_all)
-      for (int64_t c = top + nxy; c < bottom; c += nxy) down = std::min(down, multiplier(model, 4, c));
-    return down * multiplier(model, 5, bottom) * region_multiplier(model, a, b) * edit_nnc_multiplier(model, a, b);
+    // A pair MINPV connects has one connection, the mesh's connection without a face (its faces, where
+    // the cells between had no thickness somewhere, carry none of it).
+    if (!model.pinch.active || minpv_connects(model, a, b)) return 0.0;
+    return column_connection_multiplier(model, a, b);
   }
   const int64_t nx = model.nx, nxy = static_cast<int64_t>(model.nx) * model.ny;
   const int64_t ia = a % nx, ja = (a / nx) % model.ny, ka = a / nxy;

@@ -15,11 +15,22 @@ namespace hm {
 /// face between them crosses layers of zero thickness (pinched out).
 bool across_pinched_layers(const CornerPointModel& model, int64_t a, int64_t b);
 
+/// Whether OPM Flow connects model cells a and b (natural indices, refined or not) across cells its MINPV
+/// processing removes (CornerPointModel::minpv_connections, asked with the cells as read).
+bool minpv_connects(const CornerPointModel& model, int64_t a, int64_t b);
+
+/// OPM Flow's multiplier of a connection between model cells a and b of one column that are not logical
+/// neighbours (across pinched-out layers or cells MINPV removed): MULTZ of the upper cell (MULTZ option
+/// TOP; ALL: the smallest MULTZ from it down to the last cell between) x MULTZ- of the lower, x MULTREGT's
+/// and EDITNNC's.
+double column_connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
+
 /// OPM Flow's multiplier of the connection between model cells a and b (natural indices, logical
 /// neighbours or across a fault): m_d(a) m_-d(b), d the direction from a to b by their indices
 /// (I where their i differ, else J where their j differ, else K). Across pinched-out layers of a
-/// column: 0 without PINCH (OPM Flow does not connect them), else MULTZ of the upper cell (MULTZ
-/// option TOP; ALL: the smallest MULTZ from it down to the last pinched cell) x MULTZ- of the lower.
+/// column: 0 without PINCH (OPM Flow does not connect them) and for a pair MINPV connects (minpv_connects:
+/// the mesh's connection without a face carries it), else MULTZ of the upper cell (MULTZ option TOP; ALL:
+/// the smallest MULTZ from it down to the last pinched cell) x MULTZ- of the lower.
 /// Times MULTREGT's region multiplier (region_multiplier) and EDITNNC's (edit_nnc_multiplier).
 double connection_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
 

@@ -14,6 +14,7 @@
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/grids/corner_point_multipliers.hpp"
+#include "meshgen/core/two_point.hpp"
 #include "perforations.hpp"
 #include "transition_assembly.hpp"
 
@@ -120,6 +121,71 @@ void attach_deck_nncs(HybridMesh& out, const CornerPointModel& model) {
   if (missing > 0)
     note += "; " + std::to_string(missing) + " name a cell that is inactive or replaced by near-well cells and connect nothing";
   out.notes.push_back(note + " (docs/corner-point.md, \"NNC and EDITNNC\")");
+}
+
+// OPM Flow's connection of the cells of a column above and below cells its MINPV processing removed
+// (measured against flow 2022.10, docs/corner-point.md, "MINPV"): its corner-point halves from each
+// cell's centre (mean of its 8 corners) to the centre of its own face toward the gap (the upper cell's
+// bottom, the lower cell's top), both with the upper cell's bottom as the area vector, K_zz, harmonic;
+// times the connection's multiplier (column_connection_multiplier). METRIC.
+double minpv_transmissibility(const CornerPointModel& model, int64_t upper, int64_t lower) {
+  auto mean = [](const std::array<Vec3, 8>& q, int first, int count) {
+    Vec3 s{0, 0, 0};
+    for (int i = first; i < first + count; ++i) s = s + q[i];
+    return s / count;
+  };
+  const std::array<Vec3, 8>&u = model.corners[static_cast<size_t>(upper)], &l = model.corners[static_cast<size_t>(lower)];
+  // The vector area of the upper cell's bottom, corners 4, 5, 7, 6 in cyclic order.
+  const Vec3 area = 0.5 * cross(u[7] - u[4], u[6] - u[5]);
+  auto perm = [&](int64_t c) {
+    const size_t i = static_cast<size_t>(c);
+    return Vec3{model.permx[i], model.permy[i], model.permz[i]};
+  };
+  const double hu = opm_half_transmissibility(area, perm(upper), mean(u, 4, 4) - mean(u, 0, 8), 2);
+  const double hl = opm_half_transmissibility(area, perm(lower), mean(l, 0, 4) - mean(l, 0, 8), 2);
+  if (!(hu > 0) || !(hl > 0)) return 0.0;
+  return kDarcyMetric / (1 / hu + 1 / hl) * column_connection_multiplier(model, upper, lower);
+}
+
+// The model's MINPV connections (CornerPointModel::minpv_connections) as connections without a face
+// between the mesh's cells (faces the two cells may share where the removed cells have no thickness
+// carry nothing: connection_multiplier). A refined model connects each child column's two children.
+void attach_minpv_connections(HybridMesh& out, const CornerPointModel& model) {
+  if (model.minpv_connections.empty()) return;
+  PolyMesh& m = out.mesh;
+  const int64_t nxy = int64_t(model.nx) * model.ny;
+  std::map<int64_t, int32_t> mesh_cell;  // natural index of `model` -> mesh cell
+  for (int c = 0; c < m.n_cells(); ++c) {
+    const auto& ijk = m.cell_ijk[c];
+    if (m.cell_region[c] == kReservoir && ijk[0] >= 0) mesh_cell[ijk[0] + int64_t(model.nx) * (ijk[1] + int64_t(model.ny) * ijk[2])] = c;
+  }
+  std::map<int64_t, std::vector<int64_t>> children;  // cell as read -> its cells in `model`
+  for (const auto& [up, low] : model.minpv_connections) children[up];
+  for (int64_t c = 0; c < static_cast<int64_t>(model.corners.size()); ++c)
+    if (auto it = children.find(cell_as_read(model, c)); it != children.end()) it->second.push_back(c);
+  const int64_t parent_nxy = model.parent_cell.empty() ? nxy : int64_t(model.parent_nx) * model.parent_ny;
+  int64_t faces = 0, missing = 0;
+  for (const auto& [up, low] : model.minpv_connections)
+    for (const int64_t cu : children[up]) {
+      const int64_t cl = cu + (low / parent_nxy - up / parent_nxy) * nxy;
+      const auto iu = mesh_cell.find(cu), il = mesh_cell.find(cl);
+      if (iu == mesh_cell.end() || il == mesh_cell.end()) {
+        ++missing;
+        continue;
+      }
+      bool share = false;
+      for (const int32_t* f = m.cell_begin(iu->second); f != m.cell_end(iu->second) && !share; ++f)
+        share = m.face_owner[*f] == il->second || m.face_neighbour[*f] == il->second;
+      faces += share;
+      m.nnc_cells.push_back({iu->second, il->second});
+      m.nnc_trans.push_back(minpv_transmissibility(model, cu, cl));
+    }
+  out.notes.push_back("reservoir: MINPV: " + std::to_string(model.minpv_connections.size()) +
+                      " pairs of cells connected across the removed cells, as connections without a face (" +
+                      std::to_string(faces) + " of them between cells that also touch where the removed cells have no "
+                      "thickness: those faces carry nothing)" +
+                      (missing > 0 ? ", " + std::to_string(missing) + " with a cell replaced by near-well cells" : std::string()) +
+                      " (docs/corner-point.md, \"MINPV\")");
 }
 
 std::string well_names(const CaseSpec& cs, const std::vector<int>& wells) {
@@ -247,6 +313,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   fill_cell_maps(out, maps);
   if (out.build_report.ok) apply_model_multipliers(out, model, &faces, out.cavities.reservoir_active, coords);
   attach_deck_nncs(out, model);
+  attach_minpv_connections(out, model);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   std::vector<int> all_wells(nw);
@@ -283,6 +350,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
   fill_cell_maps(out, TransitionCellMaps{});
   if (out.build_report.ok) apply_model_multipliers(out, model, nullptr, all_present(model), {});
   attach_deck_nncs(out, model);
+  attach_minpv_connections(out, model);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   if (cells.zero_volume_cells > 0)

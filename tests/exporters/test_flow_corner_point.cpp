@@ -329,6 +329,36 @@ TEST(FlowCornerPoint, ModelNncIsCarriedAndMatchesSolverDemo) {
   EXPECT_GT(miss, 1e-3);
 }
 
+// The same MINPV model with a producer and an injector: flow runs the deck (the removed cells inactive,
+// the connections across them NNC records) and matches solver_demo. Fail half: solver_demo without the
+// connections across the removed cells misses flow.
+TEST(FlowCornerPoint, MinpvModelWithWellsMatchesSolverDemo) {
+  REQUIRE_FLOW();
+  TempDir tmp("flow_cpw_minpv");
+  TiltedModel g;
+  g.pinch_k = 5, g.pinch_x = 180;
+  g.keywords = "MINPV\n 120 /\n";
+  CornerPointFlowRun r;
+  run_case(tmp, g, two_wells_yaml(), &r);
+  if (HasFatalFailure()) return;
+  const hm::PolyMesh& mesh = r.out.mesh;
+  ASSERT_GT(mesh.n_nncs(), 0);
+  expect_corner_point_run("tilted, MINPV", tmp, r);
+  hm::PolyMesh plain = mesh;
+  plain.nnc_cells.clear();
+  plain.nnc_trans.clear();
+  const hm::FlowSolution s = hm::solve_tpfa(hm::deck_flow_problem(r.cs, plain, r.out.geometry),
+                                            hm::compute_transmissibilities(plain, r.out.geometry,
+                                                                           hm::deck_transmissibility_options()));
+  double miss = 0;
+  for (size_t c = 0; c < s.pressure.size(); ++c) miss = std::max(miss, std::abs(s.pressure[c] / r.ours.pressure[c] - 1));
+  for (size_t w = 0; w < s.well_rate_m3_per_day.size(); ++w)
+    miss = std::max(miss, std::abs(s.well_rate_m3_per_day[w] / r.ours.well_rate_m3_per_day[w] - 1));
+  std::printf("[ figures  ] fail half: without the %d connections across the removed cells solver_demo differs by %.3g\n",
+              mesh.n_nncs(), miss);
+  EXPECT_GT(miss, 1e-5);
+}
+
 // Pore volumes other than volume x PORO x NTG (MULTPV: an aquifer column x 1000, every seventh cell x 2.5;
 // docs/corner-point.md, "Pore volumes"). With near-well cells the deck's PORV carries them (flow's INIT PORV
 // equals ours, the multiplier included, on every cell; the near-well cells take their model cell's), the
@@ -501,21 +531,30 @@ OwnVsOurs compare_with_flows_own(const hm::CaseSpec& cs, const fs::path& dir, bo
   const std::vector<double>* t[3] = {&conn.tranx, &conn.trany, &conn.tranz};
   const char* keys[3] = {"tranx", "trany", "tranz"};
   const auto& init = run.results["init"];
-  for (int d = 0; d < 3; ++d) {
-    size_t a = 0;
-    for (int32_t g = 0; g < static_cast<int32_t>(L.deck_cell.size()); ++g) {
-      if ((*t[d])[g] != 0) ours[{g, g + step[d]}] += (*t[d])[g];
-      if (L.deck_cell[g] < 0) continue;
-      const double v = init[keys[d]][a++].get<double>();
-      if (v > 0) flow[{g, g + step[d]}] += v;
-    }
-  }
-  for (const auto& r : conn.nnc) ours[{r.a, r.b}] += r.t;
+  std::set<std::pair<int32_t, int32_t>> flow_nnc_pairs;
   for (size_t k = 0; k < init["trannnc"].size(); ++k) {
     const double v = init["trannnc"][k].get<double>();
     const int32_t a = init["nnc1"][k].get<int32_t>() - 1, b = init["nnc2"][k].get<int32_t>() - 1;
-    if (v > 0) flow[{std::min(a, b), std::max(a, b)}] += v;
+    if (v > 0) flow[{std::min(a, b), std::max(a, b)}] += v, flow_nnc_pairs.insert({std::min(a, b), std::max(a, b)});
   }
+  const int32_t n_deck = static_cast<int32_t>(L.deck_cell.size());
+  for (int d = 0; d < 3; ++d) {
+    size_t a = 0;
+    for (int32_t g = 0; g < n_deck; ++g) {
+      if ((*t[d])[g] != 0) ours[{g, g + step[d]}] += (*t[d])[g];
+      if (L.deck_cell[g] < 0) continue;
+      const double v = init[keys[d]][a++].get<double>();
+      if (v <= 0) continue;
+      // flow's INIT TRANZ of a cell is its connection to the next active cell below; across inactive
+      // cells (MINPV's removed cells) that is an NNC record flow also lists in TRANNNC: counted once.
+      int32_t below = g + step[d];
+      if (d == 2)
+        while (below < n_deck && L.deck_cell[below] < 0) below += step[d];
+      if (below != g + step[d] && flow_nnc_pairs.count({g, below})) continue;
+      flow[{g, below}] += v;
+    }
+  }
+  for (const auto& r : conn.nnc) ours[{r.a, r.b}] += r.t;
   for (const auto& [pair, v] : ours) {
     const auto it = flow.find(pair);
     if (it == flow.end()) {
@@ -549,6 +588,81 @@ void print_own_vs_ours(const char* label, const OwnVsOurs& d, int kind = -1) {
 }
 
 }  // namespace
+
+// MINPV as OPM Flow 2022.10 applies it (docs/corner-point.md, "MINPV"): the tilted model's layer 5 thins
+// toward its east side (pinch_x 180: the east column's cells 2.25-0 m thick), MINPV 120 rm3 catches them.
+// Flow, on the model as a user gives it (MINPV in the deck), removes exactly the cells the mesh does not
+// have, and its connection of each upper cell to the cell below the gap (INIT TRANZ) is the mesh's
+// connection without a face, to 1e-6. Our model-only deck (those cells inactive, our NNC records) gives
+// flow the same pairs and values.
+TEST(FlowCornerPoint, MinpvRemovesAndConnectsTheCellsFlowDoes) {
+  REQUIRE_FLOW();
+  TempDir tmp("flow_minpv");
+  TiltedModel g;
+  g.pinch_k = 5, g.pinch_x = 180;
+  std::ofstream(tmp.path / "PLAIN.GRDECL") << g.text();
+  std::ofstream(tmp.path / "M.GRDECL") << g.text() << "MINPV\n 120 /\n";
+  const hm::CaseSpec plain = hm::parse_case("name: cpm\nreservoir: {grdecl: PLAIN.GRDECL}\n", tmp.path.string());
+  const hm::CaseSpec cs = hm::parse_case("name: cpm\nreservoir: {grdecl: M.GRDECL}\n", tmp.path.string());
+  const hm::CornerPointModel& m = *cs.reservoir.corner_point;
+  ASSERT_GT(m.below_minpv, 0);
+  // The user's deck: the model alone with MINPV (our model-only deck of the model without it, MINPV added).
+  {
+    const hm::HybridMesh out = hm::build_hybrid_mesh(plain);
+    const hm::Transmissibilities t = hm::compute_transmissibilities(out.mesh, out.geometry, hm::deck_transmissibility_options());
+    const hm::WriteStatus st = hm::write_eclipse_deck((tmp.path / "user").string(), plain, out.mesh, out.geometry, t, {}, nullptr);
+    ASSERT_TRUE(st.ok) << st.message;
+    std::ofstream(tmp.path / "user" / "CPM_GRID.INC", std::ios::app) << "\nMINPV\n 120 /\n";
+  }
+  const FlowRun user = run_flow(tmp.path / "user", "CPM");
+  ASSERT_EQ(user.flow.exit_code, 0) << user.flow.output.substr(0, 2000);
+  ASSERT_FALSE(user.results.is_null());
+  const auto& porv = user.results["init"]["porv"];
+  const auto& tranz = user.results["init"]["tranz"];
+  const size_t n = m.actnum.size();
+  ASSERT_EQ(porv.size(), n);
+  std::vector<int64_t> active_index(n, -1);
+  int64_t a = 0, removed_by_flow = 0, removed_both = 0;
+  const hm::CornerPointModel& pm = *plain.reservoir.corner_point;
+  for (size_t c = 0; c < n; ++c) {
+    if (porv[c].get<double>() > 0) active_index[c] = a++;
+    const bool flow_removed = pm.actnum[c] && porv[c].get<double>() == 0;
+    removed_by_flow += flow_removed;
+    removed_both += flow_removed && !m.actnum[c];
+  }
+  EXPECT_EQ(removed_by_flow, m.below_minpv);
+  EXPECT_EQ(removed_both, m.below_minpv);
+  // Ours: the mesh's connections without a face across the removed cells, against flow's TRANZ of the upper cell.
+  const hm::HybridMesh out = hm::build_hybrid_mesh(cs);
+  const hm::PolyMesh& mesh = out.mesh;
+  ASSERT_EQ(mesh.n_nncs(), static_cast<int>(m.minpv_connections.size()));
+  double worst = 0;
+  for (int k = 0; k < mesh.n_nncs(); ++k) {
+    const auto& u = mesh.cell_ijk[mesh.nnc_cells[k][0]];
+    const int64_t upper = u[0] + int64_t(m.nx) * (u[1] + int64_t(m.ny) * u[2]);
+    ASSERT_GE(active_index[upper], 0);
+    const double theirs = tranz[active_index[upper]].get<double>();
+    worst = std::max(worst, std::abs(mesh.nnc_trans[k] - theirs) / theirs);
+  }
+  std::printf("[ figures  ] MINPV 120: %lld cells removed (flow: %lld), %d connections across them, ours vs flow's "
+              "TRANZ max rel %.3g\n",
+              static_cast<long long>(m.below_minpv), static_cast<long long>(removed_by_flow), mesh.n_nncs(), worst);
+  EXPECT_GT(mesh.n_nncs(), 0);
+  EXPECT_LT(worst, 1e-6);
+  // Our model-only deck of it: flow connects the same pairs with our values.
+  const OwnVsOurs d = compare_with_flows_own(cs, tmp.path / "ours");
+  size_t nnc_pairs = 0;
+  double worst_pair = 0;
+  for (size_t i = 0; i < d.rel.size(); ++i) {
+    nnc_pairs += d.kind[i] == 3;
+    worst_pair = std::max(worst_pair, std::abs(d.rel[i]));
+  }
+  print_own_vs_ours("tilted, MINPV", d, -1);
+  EXPECT_EQ(nnc_pairs, static_cast<size_t>(mesh.n_nncs()));
+  EXPECT_LT(worst_pair, 1e-6);
+  EXPECT_EQ(d.only_flow, 0u);
+  EXPECT_EQ(d.only_ours, 0u);
+}
 
 // The transmissibilities the deck with near-well cells carries for the model's own connections are the
 // ones flow computes for the model (docs/export-eclipse.md, "A corner-point model"): on the synthetic

@@ -206,7 +206,9 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsNncAndEditnnc) {
     ASSERT_FALSE(ca.empty() || cb.empty());
     EXPECT_EQ(edit_nnc_multiplier(r, ca.front(), cb.back()), mult);
     EXPECT_EQ(edit_nnc_multiplier(r, cb.front(), ca.back()), mult);
-    if (ca.size() > 1) EXPECT_EQ(edit_nnc_multiplier(r, ca.front(), ca.back()), 1.0);
+    if (ca.size() > 1) {
+      EXPECT_EQ(edit_nnc_multiplier(r, ca.front(), ca.back()), 1.0);
+    }
     edited += ca.size() > 1 || cb.size() > 1;
   }
   std::printf("[ figures  ] refined model: %zu EDITNNC pairs, %d of them with a split cell\n", m.edit_nnc.size(), edited);

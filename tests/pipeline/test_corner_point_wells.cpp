@@ -256,6 +256,37 @@ void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
 
 }  // namespace
 
+// A vertical well through cells MINPV removes (layer 6 thinning to 0 at x = 100 m, MINPV 120 rm3 removing
+// its cells under 1.1 m, the column the well is in among them): the removed cells are holes of the model as
+// in OPM Flow; the well meshes soundly (the cavity's walls include the faces toward the holes), and the
+// connections across the removed cells outside the cavity are the mesh's connections without a face.
+TEST(CornerPointWells, WellThroughCellsMinpvRemovesMeshes) {
+  TempDir tmp("cpwells_minpv");
+  TiltedModel g;
+  g.pinch_k = 6, g.pinch_x = 100;
+  g.keywords = "MINPV\n 120 /\n";
+  const CaseSpec cs = case_of(tmp, g, vertical_well(90, 90, 1034, 1046));
+  const CornerPointModel& m = *cs.reservoir.corner_point;
+  const CornerPointModel as_read = read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
+  ASSERT_GT(m.below_minpv, 0);
+  // The well's cell of layer 6 is below MINPV (removed in the model as read) and kept near the well.
+  const size_t well_cell = static_cast<size_t>(4 + m.nx * (4 + m.ny * 6));
+  EXPECT_EQ(as_read.actnum[well_cell], 0);
+  EXPECT_EQ(m.actnum[well_cell], 1);
+  EXPECT_LT(m.minpv_removed.size(), as_read.minpv_removed.size());
+  EXPECT_GT(m.minpv_removed.size(), 0u);
+  HybridMesh out;
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  expect_sound_mesh(cs, out);
+  int connections = 0;
+  for (int k = 0; k < out.mesh.n_nncs(); ++k) connections += out.mesh.nnc_trans[k] > 0;
+  std::printf("[ figures  ] MINPV: %zu cells below it, %zu kept near the well, %zu pairs, %d connections without a "
+              "face in the mesh\n",
+              as_read.minpv_removed.size(), as_read.minpv_removed.size() - m.minpv_removed.size(),
+              m.minpv_connections.size(), connections);
+  EXPECT_GT(connections, 0);
+}
+
 // One vertical well in gently tilted, twisted layers (20 x 20 m cells, 4.5 m layers, 5 degree dip).
 TEST(CornerPointWells, VerticalWellInTiltedLayersMeshes) {
   TempDir tmp("cpwells");

@@ -739,27 +739,105 @@ TEST(CornerPoint, FlowConnectsExactlyTheCellsTheMeshJoins) {
   }
 }
 
-// MINPV: the active cells whose pore volume is below it (OPM Flow removes them) are counted from OPM's
-// pore volumes (here volume x PORO: no NTG, no MULTPV) and named in a note; without MINPV none.
-TEST(CornerPoint, CellsBelowMinpvAreCountedAndNoted) {
+// MINPV removes the active cells whose OPM pore volume is below it, as OPM Flow does (opm_minpv, a port of
+// opm-grid's MinpvProcessor): they are inactive in the model and not cells of the mesh, whose volume is
+// the rest's; a note says how many and how many connections flow makes across them. Without MINPV none.
+TEST(CornerPoint, CellsBelowMinpvAreRemovedAndNoted) {
   for (const double minpv : {0.0, 3000.0}) {
     TempDir tmp;
     const std::string text = (minpv > 0 ? "MINPV\n " + num(minpv) + " /\n" : std::string()) + SyntheticCpg{}.text();
+    const CpgRun plain = mesh_of(tmp, SyntheticCpg{}.text());
     const CpgRun r = mesh_of(tmp, text);
-    const CornerPointModel& m = *r.cs.reservoir.corner_point;
-    int64_t expected = 0;
-    for (size_t c = 0; c < m.actnum.size(); ++c)
-      expected += m.actnum[c] && m.opm_volume[c] * m.poro[c] * m.ntg[c] < minpv;
-    EXPECT_EQ(m.below_minpv, expected) << minpv;
+    const CornerPointModel &m = *r.cs.reservoir.corner_point, &p = *plain.cs.reservoir.corner_point;
+    std::set<int64_t> expected;
+    for (size_t c = 0; c < p.actnum.size(); ++c)
+      if (p.actnum[c] && p.opm_volume[c] * p.poro[c] * p.ntg[c] < minpv) expected.insert(static_cast<int64_t>(c));
+    EXPECT_EQ(m.below_minpv, static_cast<int64_t>(expected.size())) << minpv;
+    EXPECT_EQ(std::set<int64_t>(m.minpv_removed.begin(), m.minpv_removed.end()), expected);
+    double removed_volume = 0;
+    for (const int64_t c : expected) {
+      EXPECT_EQ(m.actnum[static_cast<size_t>(c)], 0) << c;
+      removed_volume += p.opm_volume[static_cast<size_t>(c)];
+    }
+    for (int c = 0; c < r.out.mesh.n_cells(); ++c) {
+      const auto& ijk = r.out.mesh.cell_ijk[c];
+      EXPECT_EQ(expected.count(ijk[0] + int64_t(m.nx) * (ijk[1] + int64_t(m.ny) * ijk[2])), 0u) << c;
+    }
+    // The mesh's volume is the plain model's less the removed cells' (OPM's volumes of the same cells).
+    const double v = total_volume(r.out.geometry), v0 = total_volume(plain.out.geometry);
+    EXPECT_NEAR(v, v0 - removed_volume, 1e-9 * v0);
     bool noted = false;
     for (const std::string& note : r.out.notes) noted = noted || note.find("below the model's MINPV") != std::string::npos;
-    EXPECT_EQ(noted, expected > 0) << minpv;
+    EXPECT_EQ(noted, !expected.empty()) << minpv;
     if (minpv > 0) {
-      EXPECT_GT(expected, 0);
+      EXPECT_FALSE(expected.empty());
     }
-    std::printf("[ figures  ] MINPV %g: %lld active cells below it, %.4g rm3 of %.6g\n", minpv,
-                static_cast<long long>(m.below_minpv), m.below_minpv_pore_volume, m.active_pore_volume);
+    std::printf("[ figures  ] MINPV %g: %lld active cells removed (%.4g rm3 of %.6g), %zu connections across them, "
+                "%d connections without a face in the mesh; volume %.6f = %.6f - %.6f\n",
+                minpv, static_cast<long long>(m.below_minpv), m.below_minpv_pore_volume, m.active_pore_volume,
+                m.minpv_connections.size(), r.out.mesh.n_nncs(), v, v0, removed_volume);
   }
+}
+
+// The connections MINPV makes across its removed cells on the faulted model whose layer 1 pinches out
+// (wedge cells, some touching the cells above and below where they have no thickness): flow, given the
+// model with MINPV as a user gives it, removes the same cells and connects each upper cell to the cell
+// below the gap with our connection's transmissibility (its INIT TRANZ), to 1e-6.
+TEST(CornerPoint, MinpvConnectionsAreFlowsOnAFaultedPinchingModel) {
+  REQUIRE_FLOW();
+  TempDir tmp;
+  const CpgRun plain = mesh_of(tmp, SyntheticCpg{}.text());
+  {
+    const Transmissibilities t = compute_transmissibilities(plain.out.mesh, plain.out.geometry, deck_transmissibility_options());
+    const WriteStatus st = write_eclipse_deck((tmp.path / "user").string(), plain.cs, plain.out.mesh, plain.out.geometry, t, {}, nullptr);
+    ASSERT_TRUE(st.ok) << st.message;
+    std::ofstream(tmp.path / "user" / "CPG_GRID.INC", std::ios::app) << "\nMINPV\n 3000 /\n";
+  }
+  const hmtest::FlowRun run = hmtest::run_flow(tmp.path / "user", "CPG");
+  ASSERT_EQ(run.flow.exit_code, 0) << run.flow.output.substr(0, 2000);
+  ASSERT_FALSE(run.results.is_null());
+  const CpgRun r = mesh_of(tmp, "MINPV\n 3000 /\n" + SyntheticCpg{}.text());
+  const CornerPointModel& m = *r.cs.reservoir.corner_point;
+  const auto& porv = run.results["init"]["porv"];
+  const auto& tranz = run.results["init"]["tranz"];
+  ASSERT_EQ(porv.size(), m.actnum.size());
+  std::vector<int64_t> active_index(m.actnum.size(), -1);
+  int64_t a = 0;
+  for (size_t c = 0; c < m.actnum.size(); ++c)
+    if (porv[c].get<double>() > 0) active_index[c] = a++;
+  for (size_t c = 0; c < m.actnum.size(); ++c) EXPECT_EQ(active_index[c] >= 0, m.actnum[c] != 0) << c;
+  ASSERT_EQ(r.out.mesh.n_nncs(), static_cast<int>(m.minpv_connections.size()));
+  double worst = 0;
+  for (int k = 0; k < r.out.mesh.n_nncs(); ++k) {
+    const auto& u = r.out.mesh.cell_ijk[r.out.mesh.nnc_cells[k][0]];
+    const int64_t upper = u[0] + int64_t(m.nx) * (u[1] + int64_t(m.ny) * u[2]);
+    ASSERT_GE(active_index[upper], 0);
+    const double theirs = tranz[active_index[upper]].get<double>();
+    if (std::getenv("HM_DEBUG_MINPV"))
+      std::printf("upper (%d,%d,%d) lower k %d: ours %.9g flow %.9g; between: volume %.9g\n", u[0], u[1], u[2],
+                  r.out.mesh.cell_ijk[r.out.mesh.nnc_cells[k][1]][2], r.out.mesh.nnc_trans[k], theirs,
+                  m.opm_volume[static_cast<size_t>(upper + m.nx * m.ny)]);
+    worst = std::max(worst, std::abs(r.out.mesh.nnc_trans[k] - theirs) / theirs);
+  }
+  // And flow connects no other pair across removed cells (its TRANZ to the next active cell below a gap).
+  std::set<int64_t> ours_upper;
+  for (int k = 0; k < r.out.mesh.n_nncs(); ++k) {
+    const auto& u = r.out.mesh.cell_ijk[r.out.mesh.nnc_cells[k][0]];
+    ours_upper.insert(u[0] + int64_t(m.nx) * (u[1] + int64_t(m.ny) * u[2]));
+  }
+  const int64_t nxy = int64_t(m.nx) * m.ny;
+  int flow_across = 0;
+  for (int64_t c = 0; c + nxy < static_cast<int64_t>(m.actnum.size()); ++c) {
+    if (active_index[c] < 0 || !(tranz[active_index[c]].get<double>() > 0) || active_index[c + nxy] >= 0) continue;
+    ++flow_across;
+    EXPECT_EQ(ours_upper.count(c), 1u) << "flow connects cell " << c << " across removed cells, the mesh does not";
+  }
+  EXPECT_EQ(flow_across, r.out.mesh.n_nncs());
+  std::printf("[ figures  ] MINPV 3000 on the faulted, pinching model: %lld cells removed (flow: the same), %d "
+              "connections across them (flow: %d), ours vs flow's TRANZ max rel %.3g\n",
+              static_cast<long long>(m.below_minpv), r.out.mesh.n_nncs(), flow_across, worst);
+  EXPECT_GT(r.out.mesh.n_nncs(), 0);
+  EXPECT_LT(worst, 1e-6);
 }
 
 // MULTPV (OPM's pore volume other than volume x PORO x NTG, the mesh's porosity): the cells are counted and
