@@ -597,6 +597,73 @@ void print_own_vs_ours(const char* label, const OwnVsOurs& d, int kind = -1) {
 // have, and its connection of each upper cell to the cell below the gap (INIT TRANZ) is the mesh's
 // connection without a face, to 1e-6. Our model-only deck (those cells inactive, our NNC records) gives
 // flow the same pairs and values.
+// MINPV on `plain`'s model as flow applies it against ours on `cs` (the same model with `minpv_keyword`):
+// flow runs the model-only deck of `plain` with the keyword added (the user's deck); the cells it removes,
+// and its TRANZ from each upper cell to the next active cell below a gap (a connection across removed
+// cells), against the mesh of `cs`. Returns the number of connections compared.
+struct MinpvAgainstFlow {
+  int64_t removed_ours = 0, removed_flow = 0, removed_both = 0;
+  int connections = 0, flow_across = 0, flow_only = 0;
+  double worst = 0;
+};
+MinpvAgainstFlow minpv_against_flow(const fs::path& dir, const hm::CaseSpec& plain, const hm::CaseSpec& cs,
+                                    const std::string& minpv_keyword) {
+  MinpvAgainstFlow r;
+  const std::string name = hm::eclipse_deck_name(plain);
+  {
+    const hm::HybridMesh out = hm::build_hybrid_mesh(plain);
+    const hm::Transmissibilities t = hm::compute_transmissibilities(out.mesh, out.geometry, hm::deck_transmissibility_options());
+    const hm::WriteStatus st = hm::write_eclipse_deck(dir.string(), plain, out.mesh, out.geometry, t, {}, nullptr);
+    EXPECT_TRUE(st.ok) << st.message;
+    std::ofstream(dir / (name + "_GRID.INC"), std::ios::app) << "\n" << minpv_keyword;
+  }
+  const FlowRun user = run_flow(dir, name);
+  EXPECT_EQ(user.flow.exit_code, 0) << user.flow.output.substr(0, 2000);
+  if (user.results.is_null()) return r;
+  const auto& porv = user.results["init"]["porv"];
+  const auto& tranz = user.results["init"]["tranz"];
+  const hm::CornerPointModel &m = *cs.reservoir.corner_point, &pm = *plain.reservoir.corner_point;
+  const size_t n = m.actnum.size();
+  EXPECT_EQ(porv.size(), n);
+  if (porv.size() != n) return r;
+  std::vector<int64_t> active_index(n, -1);
+  int64_t a = 0;
+  for (size_t c = 0; c < n; ++c) {
+    if (porv[c].get<double>() > 0) active_index[c] = a++;
+    const bool flow_removed = pm.actnum[c] && porv[c].get<double>() == 0;
+    r.removed_flow += flow_removed;
+    r.removed_both += flow_removed && !m.actnum[c];
+  }
+  r.removed_ours = static_cast<int64_t>(m.minpv_removed.size());
+  const hm::HybridMesh out = hm::build_hybrid_mesh(cs);
+  const hm::PolyMesh& mesh = out.mesh;
+  std::set<int64_t> ours_upper;
+  for (int k = 0; k < mesh.n_nncs(); ++k) {
+    const auto& u = mesh.cell_ijk[mesh.nnc_cells[k][0]];
+    const int64_t upper = u[0] + int64_t(m.nx) * (u[1] + int64_t(m.ny) * u[2]);
+    ours_upper.insert(upper);
+    EXPECT_GE(active_index[upper], 0);
+    if (active_index[upper] < 0) continue;
+    const double theirs = tranz[active_index[upper]].get<double>();
+    r.worst = std::max(r.worst, std::abs(mesh.nnc_trans[k] - theirs) / theirs);
+    ++r.connections;
+  }
+  const int64_t nxy = int64_t(m.nx) * m.ny;
+  for (int64_t c = 0; c + nxy < static_cast<int64_t>(n); ++c) {
+    if (active_index[c] < 0 || !(tranz[active_index[c]].get<double>() > 0) || active_index[c + nxy] >= 0) continue;
+    ++r.flow_across;
+    r.flow_only += ours_upper.count(c) == 0;
+  }
+  return r;
+}
+
+// MINPV as OPM Flow 2022.10 applies it (docs/corner-point.md, "MINPV"): the tilted model's layer 5 thins
+// toward its east side (pinch_x 180: the east column's cells 2.25-0 m thick), MINPV 120 rm3 catches them.
+// Flow, on the model as a user gives it (MINPV in the deck), removes exactly the cells the mesh does not
+// have, and its connection of each upper cell to the cell below the gap (INIT TRANZ) is the mesh's
+// connection without a face, to 1e-6. Our model-only deck (those cells inactive, our NNC records) gives
+// flow the same pairs and values. With HM_REEK_DECK (a copy of shared/data/reek/REEK_GRID.DATA and its
+// includes, writable) and HM_REEK_MINPV (rm3): the same on Reek, measured and printed.
 TEST(FlowCornerPoint, MinpvRemovesAndConnectsTheCellsFlowDoes) {
   REQUIRE_FLOW();
   TempDir tmp("flow_minpv");
@@ -606,51 +673,18 @@ TEST(FlowCornerPoint, MinpvRemovesAndConnectsTheCellsFlowDoes) {
   std::ofstream(tmp.path / "M.GRDECL") << g.text() << "MINPV\n 120 /\n";
   const hm::CaseSpec plain = hm::parse_case("name: cpm\nreservoir: {grdecl: PLAIN.GRDECL}\n", tmp.path.string());
   const hm::CaseSpec cs = hm::parse_case("name: cpm\nreservoir: {grdecl: M.GRDECL}\n", tmp.path.string());
-  const hm::CornerPointModel& m = *cs.reservoir.corner_point;
-  ASSERT_GT(m.below_minpv, 0);
-  // The user's deck: the model alone with MINPV (our model-only deck of the model without it, MINPV added).
-  {
-    const hm::HybridMesh out = hm::build_hybrid_mesh(plain);
-    const hm::Transmissibilities t = hm::compute_transmissibilities(out.mesh, out.geometry, hm::deck_transmissibility_options());
-    const hm::WriteStatus st = hm::write_eclipse_deck((tmp.path / "user").string(), plain, out.mesh, out.geometry, t, {}, nullptr);
-    ASSERT_TRUE(st.ok) << st.message;
-    std::ofstream(tmp.path / "user" / "CPM_GRID.INC", std::ios::app) << "\nMINPV\n 120 /\n";
-  }
-  const FlowRun user = run_flow(tmp.path / "user", "CPM");
-  ASSERT_EQ(user.flow.exit_code, 0) << user.flow.output.substr(0, 2000);
-  ASSERT_FALSE(user.results.is_null());
-  const auto& porv = user.results["init"]["porv"];
-  const auto& tranz = user.results["init"]["tranz"];
-  const size_t n = m.actnum.size();
-  ASSERT_EQ(porv.size(), n);
-  std::vector<int64_t> active_index(n, -1);
-  int64_t a = 0, removed_by_flow = 0, removed_both = 0;
-  const hm::CornerPointModel& pm = *plain.reservoir.corner_point;
-  for (size_t c = 0; c < n; ++c) {
-    if (porv[c].get<double>() > 0) active_index[c] = a++;
-    const bool flow_removed = pm.actnum[c] && porv[c].get<double>() == 0;
-    removed_by_flow += flow_removed;
-    removed_both += flow_removed && !m.actnum[c];
-  }
-  EXPECT_EQ(removed_by_flow, m.below_minpv);
-  EXPECT_EQ(removed_both, m.below_minpv);
-  // Ours: the mesh's connections without a face across the removed cells, against flow's TRANZ of the upper cell.
-  const hm::HybridMesh out = hm::build_hybrid_mesh(cs);
-  const hm::PolyMesh& mesh = out.mesh;
-  ASSERT_EQ(mesh.n_nncs(), static_cast<int>(m.minpv_connections.size()));
-  double worst = 0;
-  for (int k = 0; k < mesh.n_nncs(); ++k) {
-    const auto& u = mesh.cell_ijk[mesh.nnc_cells[k][0]];
-    const int64_t upper = u[0] + int64_t(m.nx) * (u[1] + int64_t(m.ny) * u[2]);
-    ASSERT_GE(active_index[upper], 0);
-    const double theirs = tranz[active_index[upper]].get<double>();
-    worst = std::max(worst, std::abs(mesh.nnc_trans[k] - theirs) / theirs);
-  }
-  std::printf("[ figures  ] MINPV 120: %lld cells removed (flow: %lld), %d connections across them, ours vs flow's "
-              "TRANZ max rel %.3g\n",
-              static_cast<long long>(m.below_minpv), static_cast<long long>(removed_by_flow), mesh.n_nncs(), worst);
-  EXPECT_GT(mesh.n_nncs(), 0);
-  EXPECT_LT(worst, 1e-6);
+  ASSERT_GT(cs.reservoir.corner_point->below_minpv, 0);
+  const MinpvAgainstFlow f = minpv_against_flow(tmp.path / "user", plain, cs, "MINPV\n 120 /\n");
+  std::printf("[ figures  ] MINPV 120: %lld cells removed (flow: %lld, both %lld), %d connections across them (flow: "
+              "%d, only flow's %d), ours vs flow's TRANZ max rel %.3g\n",
+              static_cast<long long>(f.removed_ours), static_cast<long long>(f.removed_flow),
+              static_cast<long long>(f.removed_both), f.connections, f.flow_across, f.flow_only, f.worst);
+  EXPECT_EQ(f.removed_flow, f.removed_ours);
+  EXPECT_EQ(f.removed_both, f.removed_ours);
+  EXPECT_GT(f.connections, 0);
+  EXPECT_EQ(f.flow_across, f.connections);
+  EXPECT_EQ(f.flow_only, 0);
+  EXPECT_LT(f.worst, 1e-6);
   // Our model-only deck of it: flow connects the same pairs with our values.
   const OwnVsOurs d = compare_with_flows_own(cs, tmp.path / "ours");
   size_t nnc_pairs = 0;
@@ -660,10 +694,24 @@ TEST(FlowCornerPoint, MinpvRemovesAndConnectsTheCellsFlowDoes) {
     worst_pair = std::max(worst_pair, std::abs(d.rel[i]));
   }
   print_own_vs_ours("tilted, MINPV", d, -1);
-  EXPECT_EQ(nnc_pairs, static_cast<size_t>(mesh.n_nncs()));
+  EXPECT_EQ(nnc_pairs, static_cast<size_t>(f.connections));
   EXPECT_LT(worst_pair, 1e-6);
   EXPECT_EQ(d.only_flow, 0u);
   EXPECT_EQ(d.only_ours, 0u);
+
+  const char* reek = std::getenv("HM_REEK_DECK");
+  const char* reek_minpv = std::getenv("HM_REEK_MINPV");
+  if (reek == nullptr || reek_minpv == nullptr) return;
+  const std::string keyword = "MINPV\n " + std::string(reek_minpv) + " /\n";
+  const fs::path data(reek), with = data.parent_path() / "REEK_MINPV.DATA";
+  std::ofstream(with) << hmtest::read_text(data) << "\n" << keyword;
+  const hm::CaseSpec reek_plain = hm::parse_case("name: reek\nreservoir: {grdecl: " + data.string() + "}\n");
+  const hm::CaseSpec reek_cs = hm::parse_case("name: reek\nreservoir: {grdecl: " + with.string() + "}\n");
+  const MinpvAgainstFlow r = minpv_against_flow(tmp.path / "reek", reek_plain, reek_cs, keyword);
+  std::printf("[ figures  ] Reek, MINPV %s: %lld cells removed (flow: %lld, both %lld), %d connections across them "
+              "(flow: %d, only flow's %d), ours vs flow's TRANZ max rel %.3g\n",
+              reek_minpv, static_cast<long long>(r.removed_ours), static_cast<long long>(r.removed_flow),
+              static_cast<long long>(r.removed_both), r.connections, r.flow_across, r.flow_only, r.worst);
 }
 
 // The transmissibilities the deck with near-well cells carries for the model's own connections are the
