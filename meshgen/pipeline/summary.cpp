@@ -25,6 +25,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
                 {"total", h.mesh.n_cells()}};
   j["nodes"] = h.mesh.n_nodes();
   j["faces"] = h.mesh.n_faces();
+  j["connections_without_face"] = h.mesh.n_nncs();  // a model's NNC and MINPV connections
   j["cavities"] = h.cavities.cavities.size();
   if (const auto& m = cs.reservoir.corner_point) {
     const bool refined = !m->parent_cell.empty();

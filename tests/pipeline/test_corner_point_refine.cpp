@@ -235,6 +235,7 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsNncAndEditnnc) {
   EXPECT_TRUE(a_first || std::count(children[1].begin(), children[1].end(), ca) == 1);
   EXPECT_EQ(norm(mesh.cell_fv_center[ca] - mesh.cell_fv_center[cb]), nearest);
   EXPECT_EQ(mesh.nnc_trans[0], 3.0);
+  EXPECT_EQ(make_summary(cs, out)["connections_without_face"].get<int>(), 1);
   std::printf("[ figures  ] NNC between parents of %zu and %zu children, joined %.3f m apart\n", children[0].size(),
               children[1].size(), nearest);
 }
