@@ -92,12 +92,9 @@ void attach_deck_nncs(HybridMesh& out, const CornerPointModel& model) {
   PolyMesh& m = out.mesh;
   std::map<int64_t, std::vector<int32_t>> cells_of;  // cell of the model as read -> its mesh cells
   for (const CornerPointModel::Nnc& e : model.nnc) cells_of[e.a], cells_of[e.b];
-  for (int c = 0; c < m.n_cells(); ++c) {
-    const auto& ijk = m.cell_ijk[c];
-    if (m.cell_region[c] != kReservoir || ijk[0] < 0) continue;
-    const int64_t natural = ijk[0] + int64_t(model.nx) * (ijk[1] + int64_t(model.ny) * ijk[2]);
-    if (auto it = cells_of.find(cell_as_read(model, natural)); it != cells_of.end()) it->second.push_back(c);
-  }
+  for (int c = 0; c < m.n_cells(); ++c)
+    if (const int32_t natural = out.reservoir_cell_of[c]; natural >= 0)
+      if (auto it = cells_of.find(cell_as_read(model, natural)); it != cells_of.end()) it->second.push_back(c);
   int64_t missing = 0, among_children = 0;
   for (const CornerPointModel::Nnc& e : model.nnc) {
     const std::vector<int32_t>&ca = cells_of[e.a], &cb = cells_of[e.b];
@@ -155,10 +152,8 @@ void attach_minpv_connections(HybridMesh& out, const CornerPointModel& model) {
   PolyMesh& m = out.mesh;
   const int64_t nxy = int64_t(model.nx) * model.ny;
   std::map<int64_t, int32_t> mesh_cell;  // natural index of `model` -> mesh cell
-  for (int c = 0; c < m.n_cells(); ++c) {
-    const auto& ijk = m.cell_ijk[c];
-    if (m.cell_region[c] == kReservoir && ijk[0] >= 0) mesh_cell[ijk[0] + int64_t(model.nx) * (ijk[1] + int64_t(model.ny) * ijk[2])] = c;
-  }
+  for (int c = 0; c < m.n_cells(); ++c)
+    if (out.reservoir_cell_of[c] >= 0) mesh_cell[out.reservoir_cell_of[c]] = c;
   std::map<int64_t, std::vector<int64_t>> children;  // cell as read -> its cells in `model`
   for (const auto& [up, low] : model.minpv_connections) children[up];
   for (int64_t c = 0; c < static_cast<int64_t>(model.corners.size()); ++c)
