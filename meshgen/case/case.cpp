@@ -274,6 +274,20 @@ void require_range(double v, double lo, double hi, bool lo_open, const std::stri
   require(v <= hi, path, "must be <= " + fmt(hi) + " " + unit + " (docs/case-format.md, Limits)");
 }
 
+// Why cell c of a model's reservoir cannot be meshed: its rock or pore volume out of range (empty: it can).
+std::string rock_problem(const ReservoirSpec& r, size_t c) {
+  if (!(r.cell_poro[c] > 0 && r.cell_poro[c] <= 1)) return "porosity x NTG must be in (0, 1], got " + fmt(r.cell_poro[c]);
+  if (!r.cell_pore_volume_mult.empty() && !(std::isfinite(r.cell_pore_volume_mult[c]) && r.cell_pore_volume_mult[c] > 0))
+    return "its pore volume in OPM (MULTPV, PORV) is " + fmt(r.cell_pore_volume_mult[c]) +
+           " x volume x PORO x NTG: must be > 0";
+  if (!(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0)) return "permeability must be > 0";
+  for (double k : {r.cell_permx[c], r.cell_permy[c], r.cell_permz[c]})
+    if (!(k >= kMinPermeability && k <= kMaxPermeability))
+      return "permeability must be in [" + fmt(kMinPermeability) + ", " + fmt(kMaxPermeability) + "] mD, got " + fmt(k) +
+             " (docs/case-format.md, Limits)";
+  return {};
+}
+
 // reservoir.grdecl: a model file read by OPM instead of the x/y/z axes and the uniform rock.
 ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir, std::vector<std::string>& notes) {
   for (const char* k : {"x", "y", "z", "permeability", "porosity"})
@@ -307,17 +321,8 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
                        : corner_point_reservoir(shared, f.path("grdecl"));
   for (size_t c = 0; c < r.cell_poro.size(); ++c) {
     if (!model.actnum[c]) continue;  // inactive cells carry no rock
-    const std::string cell = f.path("grdecl") + ": cell " + std::to_string(c);
-    require(r.cell_poro[c] > 0 && r.cell_poro[c] <= 1, cell, "porosity x NTG must be in (0, 1], got " + fmt(r.cell_poro[c]));
-    if (!r.cell_pore_volume_mult.empty())
-      require(std::isfinite(r.cell_pore_volume_mult[c]) && r.cell_pore_volume_mult[c] > 0, cell,
-              "its pore volume in OPM (MULTPV, PORV) is " + fmt(r.cell_pore_volume_mult[c]) +
-                  " x volume x PORO x NTG: must be > 0");
-    require(r.cell_permx[c] > 0 && r.cell_permy[c] > 0 && r.cell_permz[c] > 0, cell, "permeability must be > 0");
-    for (double k : {r.cell_permx[c], r.cell_permy[c], r.cell_permz[c]})
-      require(k >= kMinPermeability && k <= kMaxPermeability, cell,
-              "permeability must be in [" + fmt(kMinPermeability) + ", " + fmt(kMaxPermeability) + "] mD, got " + fmt(k) +
-                  " (docs/case-format.md, Limits)");
+    const std::string problem = rock_problem(r, c);
+    require(problem.empty(), f.path("grdecl") + ": cell " + std::to_string(c), problem);
   }
   for (const auto* axis : {&r.x, &r.y, &r.z})
     for (double v : *axis) require_coordinate(v, f.path("grdecl"));
@@ -378,8 +383,6 @@ void clip_paths_to_model(CaseSpec& cs, const std::vector<WellSpec>& as_given, Su
   }
 }
 
-// A corner-point model with wells: its columns near the wells split to the wells' scale
-// (meshgen/case/corner_point_refine.hpp); the case's reservoir becomes the refined model.
 // The case's reservoir becomes `model` (its axes and per-cell rock as corner_point_reservoir gives them).
 void use_model(ReservoirSpec& r, std::shared_ptr<const CornerPointModel> model) {
   const ReservoirSpec grid = corner_point_reservoir(std::move(model), "reservoir.grdecl");
@@ -394,11 +397,35 @@ void use_model(ReservoirSpec& r, std::shared_ptr<const CornerPointModel> model) 
   r.corner_point = grid.corner_point;
 }
 
-// Cells that MINPV removes near a well stay cells: the near-well cells replace the model's cells there,
-// and a removed cell on a well's path would cut the path (docs/corner-point.md, "MINPV"). Near: a corner
-// of the cell's box within kMinpvKeptRadii drainage radii of the path (sampled every quarter radius).
-// The connections MINPV makes across a kept cell are dropped (the cells connect through it).
+// Whether a cell (its 8 corners' box) lies within kMinpvKeptRadii drainage radii of a well's path, sampled
+// every quarter radius.
 constexpr double kMinpvKeptRadii = 3.0;
+bool near_a_well(const std::array<Vec3, 8>& corners, const std::vector<WellSpec>& wells) {
+  Vec3 lo = corners[0], hi = lo;
+  for (const Vec3& p : corners) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  for (const WellSpec& w : wells) {
+    const double reach = kMinpvKeptRadii * w.drainage_radius, step = w.drainage_radius / 4;
+    for (size_t k = 0; k + 1 < w.trajectory.size(); ++k) {
+      const Vec3 a = w.trajectory[k], b = w.trajectory[k + 1];
+      const int n = 1 + static_cast<int>(norm(b - a) / step);
+      for (int q = 0; q <= n; ++q) {
+        const Vec3 p = a + (b - a) * (double(q) / n);
+        const Vec3 d{std::max({lo.x - p.x, p.x - hi.x, 0.0}), std::max({lo.y - p.y, p.y - hi.y, 0.0}),
+                     std::max({lo.z - p.z, p.z - hi.z, 0.0})};
+        if (norm(d) <= reach) return true;
+      }
+    }
+  }
+  return false;
+}
+
+// Cells that MINPV removes near a well stay cells: the near-well cells replace the model's cells there,
+// and a removed cell on a well's path would cut the path (docs/corner-point.md, "MINPV"); only cells whose
+// rock can be meshed (rock_problem). The connections MINPV makes across a kept cell are dropped (the cells
+// connect through it).
 void keep_minpv_cells_near_wells(CaseSpec& cs) {
   ReservoirSpec& r = cs.reservoir;
   if (!r.corner_point || r.corner_point->minpv_removed.empty() || cs.wells.empty()) return;
@@ -406,28 +433,7 @@ void keep_minpv_cells_near_wells(CaseSpec& cs) {
   std::vector<int64_t> kept;
   for (const int64_t c : m.minpv_removed) {
     const size_t i = static_cast<size_t>(c);
-    if (!(m.poro[i] * m.ntg[i] > 0) || !(m.opm_volume[i] > 0)) continue;  // nothing to mesh
-    Vec3 lo = m.corners[i][0], hi = lo;
-    for (const Vec3& p : m.corners[i]) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-    }
-    bool near = false;
-    for (const WellSpec& w : cs.wells) {
-      const double reach = kMinpvKeptRadii * w.drainage_radius, step = w.drainage_radius / 4;
-      for (size_t k = 0; k + 1 < w.trajectory.size() && !near; ++k) {
-        const Vec3 a = w.trajectory[k], b = w.trajectory[k + 1];
-        const int n = 1 + static_cast<int>(norm(b - a) / step);
-        for (int q = 0; q <= n && !near; ++q) {
-          const Vec3 p = a + (b - a) * (double(q) / n);
-          const Vec3 d{std::max({lo.x - p.x, p.x - hi.x, 0.0}), std::max({lo.y - p.y, p.y - hi.y, 0.0}),
-                       std::max({lo.z - p.z, p.z - hi.z, 0.0})};
-          near = norm(d) <= reach;
-        }
-      }
-      if (near) break;
-    }
-    if (near) kept.push_back(c);
+    if (m.opm_volume[i] > 0 && rock_problem(r, i).empty() && near_a_well(m.corners[i], cs.wells)) kept.push_back(c);
   }
   if (kept.empty()) return;
   auto model = std::make_shared<CornerPointModel>(m);
@@ -450,6 +456,8 @@ void keep_minpv_cells_near_wells(CaseSpec& cs) {
   use_model(r, std::move(model));
 }
 
+// A corner-point model with wells: its columns near the wells split to the wells' scale
+// (meshgen/case/corner_point_refine.hpp); the case's reservoir becomes the refined model.
 void refine_near_wells(CaseSpec& cs) {
   ReservoirSpec& r = cs.reservoir;
   if (!r.corner_point || cs.wells.empty() || r.near_well_cell_size < 0) return;
