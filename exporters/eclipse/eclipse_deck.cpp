@@ -155,7 +155,8 @@ std::string grdecl_text(const ReservoirSpec& res, const PolyMesh& mesh, std::str
   o.eclipse_array("PERMY", ky);
   o.eclipse_array("PERMZ", kz);
   if (mesh.n_nncs() > 0) {
-    o << "-- The model's NNC between the cells above (an EDITNNC of the same pair folded in), T in cP.rm3/day/bar.\n"
+    o << "-- Connections without a face between the cells above (the model's NNC, an EDITNNC of the pair folded in;\n"
+      << "-- connections across the cells its MINPV removes), T in cP.rm3/day/bar.\n"
       << "NNC\n";
     for (int k = 0; k < mesh.n_nncs(); ++k) {
       const auto a = mesh.cell_ijk[mesh.nnc_cells[k][0]], b = mesh.cell_ijk[mesh.nnc_cells[k][1]];
@@ -398,7 +399,8 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     }
     if (model_only && mesh.n_nncs() > 0) {
       // flow computes the model's own connections; the deck's NNC adds the rest, as in the model's deck.
-      o << "-- The model's NNC (an EDITNNC of the same pair folded in, as OPM reads it).\nNNC\n";
+      o << "-- The model's NNC (an EDITNNC of the pair folded in, as OPM reads it) and its connections across\n"
+        << "-- the cells MINPV removes (those ACTNUM 0 above; no MINPV here, so flow removes nothing else).\nNNC\n";
       for (int k = 0; k < mesh.n_nncs(); ++k) {
         const auto a = L.deck_ijk(L.cell_deck_index[mesh.nnc_cells[k][0]]),
                    b = L.deck_ijk(L.cell_deck_index[mesh.nnc_cells[k][1]]);

@@ -247,7 +247,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   const std::vector<int32_t> one{1};
   Block model_field = make_block("Int32", "reservoir_cells_are_model", 1, one);
   model_field.tuples = 1;
-  // Connections without a face (a model's NNC): the pairs' cell ids and their transmissibilities.
+  // Connections without a face (a model's NNC, its MINPV connections): cell ids and transmissibilities.
   const bool has_nnc = m.n_nncs() > 0;
   std::vector<int32_t> nnc_pairs;
   for (const auto& p : m.nnc_cells) nnc_pairs.insert(nnc_pairs.end(), p.begin(), p.end());

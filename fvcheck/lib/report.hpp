@@ -39,7 +39,7 @@ struct FvReport {
   CsrReport structure;                       ///< CSR invariants; when not ok the checks are skipped
   /// Cells the shape checks do not judge: a corner-point model's cells (PolyMesh::reservoir_cells_are_model).
   int64_t model_cells_not_judged = 0;
-  /// Connections without a face (PolyMesh::nnc_cells: a model's NNC); their pairs and values are
+  /// Connections without a face (PolyMesh::nnc_cells: a model's NNC and MINPV connections); their pairs and values are
   /// checked with the structure, they have no geometry to judge.
   int64_t connections_without_face = 0;
   std::vector<CheckResult> checks;           ///< fixed order: convexity, conformity, closure, volume,

@@ -98,7 +98,7 @@ std::string report_html(const FvReport& r) {
   h << "<tr><td class='l'>boundary faces</td><td>" << r.boundary_faces << "</td></tr>";
   h << "<tr><td class='l'>nodes</td><td>" << r.nodes << "</td></tr>";
   if (r.connections_without_face > 0)
-    h << "<tr><td class='l'>connections without a face (NNC)</td><td>" << r.connections_without_face << "</td></tr>";
+    h << "<tr><td class='l'>connections without a face (NNC, MINPV)</td><td>" << r.connections_without_face << "</td></tr>";
   for (const RegionQuality& rq : r.by_region)
     h << "<tr><td class='l'>" << xml_escape(rq.name) << " cells</td><td>" << rq.cells << "</td></tr>";
   h << "</table>\n";
