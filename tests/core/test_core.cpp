@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "meshgen/core/geometry.hpp"
 #include "meshgen/core/mesh_builder.hpp"
@@ -121,6 +122,38 @@ TEST(CsrInvariants, DetectsBrokenPointers) {
   EXPECT_FALSE(check_csr_invariants(broken).ok);
   broken = m;
   broken.cell_faces.pop_back();
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+}
+
+// Connections without a face (PolyMesh::nnc_cells, nnc_trans): two distinct valid cells each, as many
+// values as pairs, finite and >= 0.
+TEST(CsrInvariants, DetectsBadConnectionsWithoutAFace) {
+  MeshBuilder b;
+  for (int x = 0; x < 2; ++x) {  // two unit boxes two metres apart: no face in common
+    int32_t n[8];
+    for (int c = 0; c < 8; ++c) n[c] = b.add_node({2.0 * x + (c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+    b.add_cell(box_faces(n), {});
+  }
+  BuildReport rep;
+  PolyMesh m = b.finish(&rep);
+  ASSERT_TRUE(rep.ok);
+  m.nnc_cells = {{0, 1}};
+  m.nnc_trans = {2.5};
+  EXPECT_TRUE(check_csr_invariants(m).ok);
+  PolyMesh broken = m;
+  broken.nnc_cells[0] = {1, 1};
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+  broken = m;
+  broken.nnc_cells[0] = {0, 2};
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+  broken = m;
+  broken.nnc_trans[0] = std::nan("");
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+  broken = m;
+  broken.nnc_trans[0] = -1;
+  EXPECT_FALSE(check_csr_invariants(broken).ok);
+  broken = m;
+  broken.nnc_trans.clear();
   EXPECT_FALSE(check_csr_invariants(broken).ok);
 }
 

@@ -495,6 +495,40 @@ TEST(VtuReader, StandardCellTypesHaveExactVolumes) {
 }
 
 // ------------------------------------------------------------ reader: malformed input
+// Field data nnc_cells / nnc_trans (connections without a face): read back when valid; a pair that is not
+// two distinct cells of the file, a negative value or one array without the other refused with the reason.
+TEST(VtuReader, ConnectionsWithoutAFaceAreCheckedOnRead) {
+  const std::string grid = make_vtu(two_cubes(), Fmt::Ascii, false, false);
+  auto with = [&](const std::string& cells, const std::string& trans) {
+    std::string field = "<FieldData>";
+    if (!cells.empty())
+      field += "<DataArray type=\"Int32\" Name=\"nnc_cells\" NumberOfComponents=\"2\" NumberOfTuples=\"1\" "
+               "format=\"ascii\">" + cells + "</DataArray>";
+    if (!trans.empty())
+      field += "<DataArray type=\"Float64\" Name=\"nnc_trans\" NumberOfTuples=\"1\" format=\"ascii\">" + trans +
+               "</DataArray>";
+    field += "</FieldData>";
+    std::string t = grid;
+    const size_t p = t.find("<UnstructuredGrid>");
+    t.insert(p + std::string("<UnstructuredGrid>").size(), field);
+    return read_vtu_buffer(t);
+  };
+  const ReadResult ok = with("0 1", "2.5");
+  ASSERT_TRUE(ok.ok) << ok.error;
+  ASSERT_EQ(ok.mesh.n_nncs(), 1);
+  EXPECT_EQ(ok.mesh.nnc_cells[0], (std::array<int32_t, 2>{0, 1}));
+  EXPECT_EQ(ok.mesh.nnc_trans[0], 2.5);
+  for (const auto& [cells, trans, message] :
+       std::vector<std::array<std::string, 3>>{{"1 1", "2.5", "not a pair of two distinct cells"},
+                                               {"0 2", "2.5", "not a pair of two distinct cells"},
+                                               {"0 1", "-1", "not a finite value >= 0"},
+                                               {"0 1", "", "come together"}}) {
+    const ReadResult r = with(cells, trans);
+    EXPECT_FALSE(r.ok) << cells << " " << trans;
+    EXPECT_NE(r.error.find(message), std::string::npos) << r.error;
+  }
+}
+
 TEST(VtuReaderMalformed, ClearErrorsForBrokenFiles) {
   // Every case must fail with a one-line message; the messages of VTK's XML layer are VTK's,
   // the ones about ids and face streams are ours.
