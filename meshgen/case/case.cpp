@@ -23,6 +23,7 @@
 #include "meshgen/case/near_well_layers.hpp"
 #include "meshgen/case/corner_point_path.hpp"
 #include "meshgen/case/corner_point_refine.hpp"
+#include "meshgen/case/corner_point_straighten.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/case/meshed_trajectory.hpp"
 #include "meshgen/case/segment_distance.hpp"
@@ -468,8 +469,32 @@ void refine_near_wells(CaseSpec& cs) {
                         r.near_well_cell_size == 0});
   }
   const ColumnSplits splits = near_well_splits(*r.corner_point, requests);
-  if (!splits.refines()) return;
-  auto refined = std::make_shared<const CornerPointModel>(refined_model(*r.corner_point, splits));
+  std::optional<CornerPointModel> refined_m;
+  if (splits.refines()) refined_m = refined_model(*r.corner_point, splits);
+  if (r.upright_pillars) {
+    std::vector<StraightenRequest> upright;
+    for (const RefinementRequest& q : requests) upright.push_back({q.path, q.reach + 2 * q.cell_size});
+    std::vector<StraightenOutcome> outcomes;
+    CornerPointModel turned = straightened_model(refined_m ? *refined_m : *r.corner_point, upright, &outcomes);
+    bool any = false;
+    for (size_t w = 0; w < outcomes.size(); ++w) {
+      const StraightenOutcome& o = outcomes[w];
+      const std::string well = "wells[" + std::to_string(w) + "] (" + cs.wells[w].name + ")";
+      if (o.straightened)
+        cs.notes.push_back("reservoir: the model's pillars within " + fmt6(upright[w].reach) + " m of " + well +
+                           " lean up to " + fmt6(o.max_lean_deg) + " degrees: " + std::to_string(o.pillars) +
+                           " pillars turned upright, blending back to the model's over " + fmt6(o.blend) +
+                           " m (reservoir.upright_pillars; docs/corner-point.md, \"Upright pillars near wells\")");
+      else if (!o.refused.empty())
+        cs.notes.push_back("reservoir: the model's pillars near " + well + " lean up to " + fmt6(o.max_lean_deg) +
+                           " degrees and are kept as they are: " + o.refused + " (docs/corner-point.md, \"Upright "
+                           "pillars near wells\")");
+      any = any || o.straightened;
+    }
+    if (any) refined_m = std::move(turned);
+  }
+  if (!refined_m) return;
+  auto refined = std::make_shared<const CornerPointModel>(std::move(*refined_m));
   const double cells = double(refined->nx) * refined->ny * refined->nz;
   if (cells > kMaxCells)
     fail("reservoir.near_well_cell_size", "refining the model near the wells gives " + fmt_count(cells) + " cells > " +
@@ -480,13 +505,19 @@ void refine_near_wells(CaseSpec& cs) {
 ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, std::vector<std::string>& notes) {
   const Fields f(n, "reservoir",
                  {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size",
-                  "near_well_layer_aspect"});
+                  "near_well_layer_aspect", "upright_pillars"});
   ReservoirSpec r;
   if (f.get("grdecl")) {
     r = read_grdecl_reservoir(f, base_dir, notes);
     if (auto s = f.get("near_well_cell_size")) r.near_well_cell_size = read_near_well_cell_size(*s, f.path("near_well_cell_size"));
+    if (auto s = f.get("upright_pillars")) {
+      if (!s->IsScalar() || (s->Scalar() != "auto" && s->Scalar() != "off"))
+        fail(f.path("upright_pillars"), "expected auto or off, got " + describe(*s));
+      r.upright_pillars = s->Scalar() == "auto";
+    }
   } else {
     if (f.get("near_well_cell_size")) fail(f.path("near_well_cell_size"), "only with reservoir.grdecl (a corner-point model)");
+    if (f.get("upright_pillars")) fail(f.path("upright_pillars"), "only with reservoir.grdecl (a corner-point model)");
     r.x = read_axis(f.required("x"), f.path("x"));
     r.y = read_axis(f.required("y"), f.path("y"));
     r.z = read_axis(f.required("z"), f.path("z"));
