@@ -482,12 +482,14 @@ void refine_near_wells(CaseSpec& cs) {
       const std::string well = "wells[" + std::to_string(w) + "] (" + cs.wells[w].name + ")";
       if (o.straightened)
         cs.notes.push_back("reservoir: the model's pillars within " + fmt6(upright[w].reach) + " m of " + well +
-                           " lean up to " + fmt6(o.max_lean_deg) + " degrees: " + std::to_string(o.pillars) +
+                           " lean up to " + fmt6(o.max_lean_deg) + " degrees obliquely to the grid (column walls at " +
+                           fmt6(o.wall_angle_deg) + " degrees): " + std::to_string(o.pillars) +
                            " pillars turned upright, blending back to the model's over " + fmt6(o.blend) +
                            " m (reservoir.upright_pillars; docs/corner-point.md, \"Upright pillars near wells\")");
       else if (!o.refused.empty())
         cs.notes.push_back("reservoir: the model's pillars near " + well + " lean up to " + fmt6(o.max_lean_deg) +
-                           " degrees and are kept as they are: " + o.refused + " (docs/corner-point.md, \"Upright "
+                           " degrees obliquely to the grid (column walls at " + fmt6(o.wall_angle_deg) +
+                           " degrees) and are kept as they are: " + o.refused + " (docs/corner-point.md, \"Upright "
                            "pillars near wells\")");
       any = any || o.straightened;
     }

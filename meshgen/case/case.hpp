@@ -47,8 +47,8 @@ struct ReservoirSpec {
   /// drainage radius), < 0 = off. After load_case, `corner_point` is the refined model.
   double near_well_cell_size = 0;
   /// `reservoir.upright_pillars` (corner-point models with wells): auto (true) turns the model's
-  /// pillars near a well upright where they lean more than kStraightenLeanAbove
-  /// (meshgen/case/corner_point_straighten.hpp); off keeps them.
+  /// pillars near a well upright where they lean obliquely to the grid (kStraightenWallAngleBelow,
+  /// meshgen/case/corner_point_straighten.hpp); off keeps them.
   bool upright_pillars = true;
   /// `reservoir.near_well_layer_aspect` (metric: permeability): layers near the wells are split so
   /// that their cells there are, in the permeability frame, at most this many times taller than

@@ -152,14 +152,34 @@ CornerPointModel straightened_model(const CornerPointModel& m, const std::vector
     // The middle of the path's depth range inside the model's.
     lo = std::clamp(lo, zmin, zmax), hi = std::clamp(hi, zmin, zmax);
     pivot[r] = 0.5 * (lo + hi);
-    double max_lean = 0;
-    for (int p = 0; p < np; ++p)
-      if (plan_distance_to_path(position(p, pivot[r]), req.path) <= req.reach) {
-        const auto l = lean_of(m, p);
-        max_lean = std::max(max_lean, std::hypot(l[0], l[1]));
+    // The lean of the pillars within reach, or of the nearest one where none is (coarse columns).
+    double max_lean = 0, nearest = std::numeric_limits<double>::infinity(), nearest_lean = 0;
+    for (int p = 0; p < np; ++p) {
+      const auto l = lean_of(m, p);
+      const double d = plan_distance_to_path(position(p, pivot[r]), req.path);
+      if (d <= req.reach) max_lean = std::max(max_lean, std::hypot(l[0], l[1]));
+      if (d < nearest) nearest = d, nearest_lean = std::hypot(l[0], l[1]);
+    }
+    if (nearest > req.reach) max_lean = nearest_lean;
+    // The sharpest angle between a column's i-wall and j-wall (planes through a pillar and its next
+    // pillar along j, resp. along i) among the pillars within reach: 90 degrees for vertical pillars
+    // or pillars leaning along a grid axis.
+    double sharpest = 90;
+    for (int J = 0; J < m.ny; ++J)
+      for (int I = 0; I < m.nx; ++I) {
+        const int p = pillar_id(m, I, J);
+        const Vec3 x = position(p, pivot[r]);
+        if (plan_distance_to_path(x, req.path) > req.reach) continue;
+        const Vec3 a = pillar_point(m, p, pivot[r] + 1) - x;
+        const Vec3 ei = position(pillar_id(m, I + 1, J), pivot[r]) - x, ej = position(pillar_id(m, I, J + 1), pivot[r]) - x;
+        const Vec3 ni = cross(a, ej), nj = cross(a, ei);
+        const double c = std::abs(dot(ni, nj)) / (norm(ni) * norm(nj));
+        sharpest = std::min(sharpest, std::acos(std::min(1.0, c)) / kDegree);
       }
+
     out[r].max_lean_deg = std::atan(max_lean) / kDegree;
-    if (out[r].max_lean_deg <= kStraightenLeanAbove) continue;
+    out[r].wall_angle_deg = sharpest;
+    if (!(sharpest < kStraightenWallAngleBelow)) continue;
     // The depth range the turned pillars span: the model's cells within the region (the region
     // from the range near the path first, then from that region's own range).
     out[r].blend = 0;

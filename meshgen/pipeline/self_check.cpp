@@ -86,6 +86,8 @@ SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildR
     SelfCheckFailure f;
     f.check = r.name;
     f.violations = r.violations;
+    f.worst = r.worst;
+    if (r.id_kind == IdKind::Face && !r.worst_ids.empty()) f.neighbour = mesh.face_neighbour[r.worst_ids[0]];
     // worst_ids are the worst values, violating or not: the first `violations` of them violate.
     for (size_t i = 0; i < r.worst_ids.size() && static_cast<int64_t>(i) < r.violations; ++i) {
       const int32_t id = r.worst_ids[i];
@@ -104,6 +106,10 @@ SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildR
     const SelfCheckFailure& f = out.failures[i];
     os << (i ? "; " : " ") << f.check << " (" << f.violations << (f.check == "orthogonality" || f.check == "planarity" ? " faces" : " cells");
     for (size_t k = 0; k < f.cells.size() && k < 3; ++k) os << (k ? ", " : ": cell ") << cell_text(mesh, f.cells[k], cell_cavity);
+    if (f.check == "orthogonality" || f.check == "planarity") {
+      os << "; worst " << f.worst << " degrees, ";
+      os << (f.neighbour >= 0 ? "toward cell " + cell_text(mesh, f.neighbour, cell_cavity) : std::string("a boundary face"));
+    }
     os << ")";
     for (int32_t c : f.cells) {
       if (mesh.cell_region[c] == kWell && mesh.cell_radial[c].well >= 0) wells.insert(mesh.cell_radial[c].well);

@@ -18,6 +18,8 @@ struct SelfCheckFailure {
   std::string check;           ///< fvcheck's check name ("convexity", ...), "structure" or "finite"
   int64_t violations = 0;      ///< cells (or faces, for the per-face checks) that fail it
   std::vector<int32_t> cells;  ///< up to 10 failing cells, worst first (a face's owner for per-face checks)
+  double worst = 0;            ///< the check's worst value (fvcheck's meaning: degrees for orthogonality)
+  int32_t neighbour = -1;      ///< per-face checks: the worst face's other cell (-1: a boundary face)
 };
 
 struct SelfCheck {

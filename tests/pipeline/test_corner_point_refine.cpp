@@ -363,28 +363,6 @@ TEST(NearWellRefinement, LeanSweep) {
     }
 }
 
-// The limit found on Reek (docs/corner-point.md, "Near-well refinement", measured): pillars leaning
-// 56 degrees toward an azimuth 20 degrees off the grid's i axis (Reek's around OP_1) shear the cells
-// obliquely; the refined cavity's walls are staircases whose wall triangles hold a vertex of the next
-// step in their diametral spheres. The transition refuses them with the reason; never a bad mesh.
-// When this starts to mesh, the test fails: make it assert a sound mesh instead.
-TEST(NearWellRefinement, ObliquelyShearedCellsAreRefusedWithTheReason) {
-  TempDir tmp("cprefine");
-  hmtest::LayeredModel g;
-  g.pillar_deg = 56;
-  g.pillar_azimuth_deg = 20;
-  std::ofstream(tmp.path / "M.GRDECL") << g.text();
-  std::ofstream(tmp.path / "c.yaml") << well_case("M.GRDECL", "", 5);
-  const CaseSpec cs = load_case((tmp.path / "c.yaml").string());
-  try {
-    build_hybrid_mesh(cs);
-    ADD_FAILURE() << "meshed: the oblique-shear limit is lifted, assert the mesh's soundness here";
-  } catch (const MeshingError& e) {
-    EXPECT_EQ(e.stage, "transition");
-    EXPECT_NE(std::string(e.what()).find("not Delaunay admissible"), std::string::npos) << e.what();
-  }
-}
-
 // Reek (../shared/data/reek): a vertical well in column (8, 52), layers 6-9, where the model's pillars
 // are nearly vertical (its south-west), drainage radius 5 m. Without refinement it is refused
 // (100-160 m x 3 m faces); refined, it meshes soundly: the self-check passes, every face conforms and
