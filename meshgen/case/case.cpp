@@ -471,9 +471,10 @@ void refine_near_wells(CaseSpec& cs) {
   const ColumnSplits splits = near_well_splits(*r.corner_point, requests);
   std::optional<CornerPointModel> refined_m;
   if (splits.refines()) refined_m = refined_model(*r.corner_point, splits);
-  if (r.upright_pillars) {
+  if (r.upright_pillars != ReservoirSpec::Upright::Off) {
     std::vector<StraightenRequest> upright;
-    for (const RefinementRequest& q : requests) upright.push_back({q.path, q.reach + 2 * q.cell_size});
+    for (const RefinementRequest& q : requests)
+      upright.push_back({q.path, q.reach + 2 * q.cell_size, r.upright_pillars == ReservoirSpec::Upright::On});
     std::vector<StraightenOutcome> outcomes;
     CornerPointModel turned = straightened_model(refined_m ? *refined_m : *r.corner_point, upright, &outcomes);
     bool any = false;
@@ -513,9 +514,9 @@ ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, s
     r = read_grdecl_reservoir(f, base_dir, notes);
     if (auto s = f.get("near_well_cell_size")) r.near_well_cell_size = read_near_well_cell_size(*s, f.path("near_well_cell_size"));
     if (auto s = f.get("upright_pillars")) {
-      if (!s->IsScalar() || (s->Scalar() != "auto" && s->Scalar() != "off"))
-        fail(f.path("upright_pillars"), "expected auto or off, got " + describe(*s));
-      r.upright_pillars = s->Scalar() == "auto";
+      const std::string v = s->IsScalar() ? s->Scalar() : "";
+      if (v != "auto" && v != "on" && v != "off") fail(f.path("upright_pillars"), "expected auto, on or off, got " + describe(*s));
+      r.upright_pillars = v == "on" ? ReservoirSpec::Upright::On : v == "off" ? ReservoirSpec::Upright::Off : ReservoirSpec::Upright::Auto;
     }
   } else {
     if (f.get("near_well_cell_size")) fail(f.path("near_well_cell_size"), "only with reservoir.grdecl (a corner-point model)");

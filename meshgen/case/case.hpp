@@ -46,10 +46,10 @@ struct ReservoirSpec {
   /// near a well are split to (meshgen/case/corner_point_refine.hpp); 0 = auto (each well's
   /// drainage radius), < 0 = off. After load_case, `corner_point` is the refined model.
   double near_well_cell_size = 0;
-  /// `reservoir.upright_pillars` (corner-point models with wells): auto (true) turns the model's
-  /// pillars near a well upright where they lean obliquely to the grid (kStraightenWallAngleBelow,
-  /// meshgen/case/corner_point_straighten.hpp); off keeps them.
-  bool upright_pillars = true;
+  /// `reservoir.upright_pillars` (corner-point models with wells): auto turns the model's pillars
+  /// near a well upright where they lean obliquely to the grid (kStraightenWallAngleBelow,
+  /// meshgen/case/corner_point_straighten.hpp), on wherever they lean, off keeps them.
+  enum class Upright { Off, Auto, On } upright_pillars = Upright::Auto;
   /// `reservoir.near_well_layer_aspect` (metric: permeability): layers near the wells are split so
   /// that their cells there are, in the permeability frame, at most this many times taller than
   /// wide (meshgen/case/near_well_layers.hpp); 0 = off. After load_case, `z` is the split grid's.

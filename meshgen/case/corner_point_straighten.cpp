@@ -179,7 +179,7 @@ CornerPointModel straightened_model(const CornerPointModel& m, const std::vector
 
     out[r].max_lean_deg = std::atan(max_lean) / kDegree;
     out[r].wall_angle_deg = sharpest;
-    if (!(sharpest < kStraightenWallAngleBelow)) continue;
+    if (req.any_lean ? !(out[r].max_lean_deg > kUprightMinLean) : !(sharpest < kStraightenWallAngleBelow)) continue;
     // The depth range the turned pillars span: the model's cells within the region (the region
     // from the range near the path first, then from that region's own range).
     out[r].blend = 0;

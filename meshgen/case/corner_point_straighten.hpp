@@ -21,7 +21,13 @@ namespace hm {
 struct StraightenRequest {
   std::vector<Vec3> path;
   double reach = 0;
+  /// Turn wherever the pillars within reach lean more than kUprightMinLean, obliquely or not
+  /// (`upright_pillars: on`); else only where they lean obliquely (kStraightenWallAngleBelow).
+  bool any_lean = false;
 };
+
+/// With any_lean: pillars leaning less than this (degrees) are left as they are.
+constexpr double kUprightMinLean = 1.0;
 
 /// Beyond `reach` a pillar's lean falls back to the model's over a distance that keeps two
 /// neighbouring pillars, turned by different amounts, from moving toward or away from each other by

@@ -67,7 +67,7 @@ SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildR
   SelfCheck out;
   const CsrReport csr = check_csr_invariants(mesh);
   if (!csr.ok) {
-    out.failures.push_back({"structure", 1, {}});
+    out.failures.push_back({"structure", 1, {}, 0, false, -1, {}});
     out.message = "self-check: the mesh arrays are inconsistent: " + (csr.problems.empty() ? "?" : csr.problems[0]);
     return out;
   }
@@ -87,7 +87,10 @@ SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildR
     f.check = r.name;
     f.violations = r.violations;
     f.worst = r.worst;
-    if (r.id_kind == IdKind::Face && !r.worst_ids.empty()) f.neighbour = mesh.face_neighbour[r.worst_ids[0]];
+    for (const auto& [name, n] : r.counts)
+      if (n > 0) f.counts.push_back({name, n});
+    f.per_face = r.id_kind == IdKind::Face;
+    if (f.per_face && !r.worst_ids.empty()) f.neighbour = mesh.face_neighbour[r.worst_ids[0]];
     // worst_ids are the worst values, violating or not: the first `violations` of them violate.
     for (size_t i = 0; i < r.worst_ids.size() && static_cast<int64_t>(i) < r.violations; ++i) {
       const int32_t id = r.worst_ids[i];
@@ -106,9 +109,12 @@ SelfCheck self_check(const PolyMesh& mesh, const MeshGeometry& geo, const BuildR
     const SelfCheckFailure& f = out.failures[i];
     os << (i ? "; " : " ") << f.check << " (" << f.violations << (f.check == "orthogonality" || f.check == "planarity" ? " faces" : " cells");
     for (size_t k = 0; k < f.cells.size() && k < 3; ++k) os << (k ? ", " : ": cell ") << cell_text(mesh, f.cells[k], cell_cavity);
+    if (f.check == "conformity")
+      for (const auto& [name, n] : f.counts) os << "; " << name << " " << n;
     if (f.check == "orthogonality" || f.check == "planarity") {
-      os << "; worst " << f.worst << " degrees, ";
-      os << (f.neighbour >= 0 ? "toward cell " + cell_text(mesh, f.neighbour, cell_cavity) : std::string("a boundary face"));
+      os << "; worst " << f.worst << " degrees";
+      if (f.per_face)
+        os << ", " << (f.neighbour >= 0 ? "toward cell " + cell_text(mesh, f.neighbour, cell_cavity) : std::string("a boundary face"));
     }
     os << ")";
     for (int32_t c : f.cells) {

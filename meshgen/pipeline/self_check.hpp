@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fvcheck/lib/checks.hpp"
@@ -19,7 +20,9 @@ struct SelfCheckFailure {
   int64_t violations = 0;      ///< cells (or faces, for the per-face checks) that fail it
   std::vector<int32_t> cells;  ///< up to 10 failing cells, worst first (a face's owner for per-face checks)
   double worst = 0;            ///< the check's worst value (fvcheck's meaning: degrees for orthogonality)
-  int32_t neighbour = -1;      ///< per-face checks: the worst face's other cell (-1: a boundary face)
+  bool per_face = false;       ///< the check named faces (else cells: a corner-point model's near-well cells judged alone)
+  int32_t neighbour = -1;      ///< per_face: the worst face's other cell (-1: a boundary face)
+  std::vector<std::pair<std::string, int64_t>> counts;  ///< the check's non-zero named sub-counts
 };
 
 struct SelfCheck {

@@ -277,6 +277,19 @@ TEST(FlowMeshgen, ReekWellsExampleSteadyDeckMatchesSolverDemo) {
                 "--linear-solver-max-iter=2000", "--eclipse-steady");
 }
 
+// examples/reek_own_wells.yaml: Reek's OP_1, OP_3, WI_1 (pillars turned upright near OP_1 and WI_1) and
+// the horizontal producer HZ1; the steady-state deck as for reek_wells above (docs/export-eclipse.md).
+TEST(FlowMeshgen, ReekOwnWellsExampleSteadyDeckMatchesSolverDemo) {
+  REQUIRE_FLOW_E2E();
+  if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: ~1.5M cells in flow)";
+  const fs::path reek = fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek";
+  if (!fs::exists(reek / "REEK_GRID.DATA")) GTEST_SKIP() << "no " << reek;
+  const fs::path d = fresh_dir("flow_reek_own_wells");
+  const RemoveAtExit cleanup{d};
+  run_case_file(fs::path(HM_SOURCE_DIR) / "examples" / "reek_own_wells.yaml", "reek_own_wells", d, false, 1e-6,
+                "--linear-solver-max-iter=2000", "--eclipse-steady");
+}
+
 TEST(FlowMeshgen, UnwritableExportDirectoryExitsTwoAndLeavesNoDeck) {
   const fs::path d = fresh_dir("flow_unwritable");
   const RemoveAtExit cleanup{d};

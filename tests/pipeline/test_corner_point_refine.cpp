@@ -477,7 +477,7 @@ TEST(NearWellRefinement, ReekWellMeshesWhereverItsEndIsRounded) {
   EXPECT_EQ(cells[0], cells[1]);
 }
 
-// examples/reek_wells.yaml in Reek as read: OP_3's vertical path crosses exactly the cells Reek's
+// examples/reek_wells.yaml and reek_own_wells.yaml in Reek as read: OP_3's vertical path crosses exactly the cells Reek's
 // COMPDAT lists for it (reek_history.sch: (28, 46) for K 1-12 and (28, 45) for K 12-14, 1-based),
 // in order, and HZ1 runs 600 m through layer 8's cells (17..21, 54) (1-based), the one layer the
 // issue asks for. Cells located as the mesh has them (CornerPointLocator: winding number of the
@@ -551,4 +551,18 @@ TEST(NearWellRefinement, ReekWellsExampleFollowsTheCompdatCells) {
     columns.insert(ijk[0]);
   }
   EXPECT_EQ(columns, (std::set<int>{17, 18, 19, 20, 21}));
+
+  // examples/reek_own_wells.yaml: OP_1 through (29, 28) K 1-14; WI_1 through (15, 36) K 1-6 and (14, 36)
+  // K 6-14 (its COMPDAT lists both (15, 36, 5) and (14, 36, 5); a vertical line switches columns one
+  // layer lower, in layer 6); OP_3 and HZ1 as above.
+  std::ifstream own_file(fs::path(HM_SOURCE_DIR) / "examples" / "reek_own_wells.yaml");
+  const std::string own((std::istreambuf_iterator<char>(own_file)), std::istreambuf_iterator<char>());
+  std::vector<std::array<int, 3>> op1, wi1;
+  for (int k = 1; k <= 14; ++k) op1.push_back({29, 28, k});
+  for (int k = 1; k <= 6; ++k) wi1.push_back({15, 36, k});
+  for (int k = 6; k <= 14; ++k) wi1.push_back({14, 36, k});
+  EXPECT_EQ(cells_along(example_trajectory(own, "OP_1"), &length), op1);
+  EXPECT_EQ(cells_along(example_trajectory(own, "WI_1"), &length), wi1);
+  EXPECT_EQ(cells_along(example_trajectory(own, "OP_3"), &length), compdat);
+  EXPECT_EQ(example_trajectory(own, "HZ1"), example_trajectory(text, "HZ1"));
 }

@@ -238,7 +238,7 @@ TEST(UprightPillars, CaseKeyIsChecked) {
     return std::string();
   };
   EXPECT_EQ(error_of("name: m\nreservoir: {grdecl: M.GRDECL, upright_pillars: yes}\n"),
-            "reservoir.upright_pillars: expected auto or off, got 'yes'");
+            "reservoir.upright_pillars: expected auto, on or off, got 'yes'");
   EXPECT_EQ(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], upright_pillars: auto}\n"),
             "reservoir.upright_pillars: only with reservoir.grdecl (a corner-point model)");
 }
