@@ -153,6 +153,32 @@ TEST(UprightPillars, LayersKeptPillarsUprightRockFromTheCellBelowTheCentre) {
               turned, (m.nx + 1) * (m.ny + 1), vertical, outcome[0].blend, checked, worst);
 }
 
+// Where the model sits does not matter: the model and the well moved by UTM-sized offsets turn the same
+// pillars to the same lines (to rounding of the coordinates) and give every cell the same rock.
+TEST(UprightPillars, TranslatedModelTurnsTheSamePillars) {
+  TempDir tmp("upright_shift");
+  std::ofstream(tmp.path / "M.GRDECL") << oblique_model().text();
+  const CornerPointModel model = read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
+  const CornerPointModel m = refined_model(model, near_well_splits(model, {{{kWellTop, kWellBottom}, 5, 17.5, true}}));
+  const Vec3 shift{456510.608, 5926880.031, 1500};
+  std::vector<StraightenOutcome> here, there;
+  const CornerPointModel a = straightened_model(m, {{{kWellTop, kWellBottom}, 27.5}}, &here);
+  const CornerPointModel b =
+      straightened_model(translated_model(m, shift), {{{kWellTop + shift, kWellBottom + shift}, 27.5}}, &there);
+  ASSERT_TRUE(here[0].straightened && there[0].straightened);
+  EXPECT_EQ(here[0].pillars, there[0].pillars);
+  EXPECT_NEAR(here[0].blend, there[0].blend, 1e-6);
+  double worst = 0;
+  for (size_t i = 0; i < a.coord.size(); ++i) worst = std::max(worst, std::abs(a.coord[i] + shift[static_cast<int>(i % 3)] - b.coord[i]));
+  for (size_t i = 0; i < a.zcorn.size(); ++i) worst = std::max(worst, std::abs(a.zcorn[i] + shift.z - b.zcorn[i]));
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_EQ(a.parent_cell, b.parent_cell);
+  EXPECT_EQ(a.permx, b.permx);
+  EXPECT_EQ(a.actnum, b.actnum);
+  std::printf("[ figures  ] moved by (456510.608, 5926880.031, 1500): %d pillars turned both ways, coordinates within %.1e m\n",
+              there[0].pillars, worst);
+}
+
 // A fault in the region (ZCORN not continuous across a column edge) keeps the model as it is, and the
 // outcome says why; pillars leaning along a grid axis (i-walls and j-walls at right angles) are not
 // turned at all, however steep.
