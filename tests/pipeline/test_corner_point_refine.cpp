@@ -116,6 +116,49 @@ TEST(NearWellRefinement, ChildrenTileTheirParents) {
   EXPECT_EQ(on_model_pillars, 8 * m.nx * m.ny * m.nz);  // each parent's 8 corners, once each
 }
 
+// A scissor fault between two columns: where the throw passes through zero between the model's pillars,
+// the children's pillars on the fault line get the same depth from both sides mathematically, and their
+// two interpolations differ by a rounding (1701.9647499999999 against 1701.96475 here, at t = 1/4). The
+// refined model has one depth there (else the mesh has two nodes 2e-13 m apart and a face hanging
+// between them: Reek's OP_2, docs/corner-point.md), and every other depth on such a pillar is either
+// the same on both sides or a real throw.
+TEST(NearWellRefinement, ScissorFaultGivesOneDepthWhereTheThrowVanishes) {
+  TempDir tmp("cprefine_scissor");
+  std::ostringstream o;
+  o.precision(17);
+  o << "SPECGRID\n 2 1 1 1 F /\nCOORD\n";
+  for (int J = 0; J <= 1; ++J)
+    for (int I = 0; I <= 2; ++I) o << 100 * I << " " << 100 * J << " 1600 " << 100 * I << " " << 100 * J << " 1800\n";
+  o << "/\nZCORN\n";
+  // top (c = 0) then bottom (+3 m); per j-side b: cell i = 0 (I = 0, 1), cell i = 1 (I = 1, 2)
+  const double left[2][2] = {{1700.0, 1700.85}, {1705.0, 1705.309}}, right[2][2] = {{1700.893, 1700.9}, {1705.18, 1705.2}};
+  for (int c = 0; c < 2; ++c)
+    for (int b = 0; b < 2; ++b) o << left[b][0] + 3 * c << " " << left[b][1] + 3 * c << " " << right[b][0] + 3 * c << " " << right[b][1] + 3 * c << "\n";
+  o << "/\nPERMX\n2*100 /\nPORO\n2*0.2 /\n";
+  std::ofstream(tmp.path / "S.GRDECL") << o.str();
+  const CornerPointModel m = read_corner_point_model((tmp.path / "S.GRDECL").string(), "reservoir.grdecl");
+  const CornerPointModel r = refined_model(m, ColumnSplits{{1, 1}, {4}});
+  ASSERT_EQ(r.ny, 4);
+  // Pillar (1, 1) of the refined grid, t = 1/4 along the fault line: the left column's (+i, +j) corner and
+  // the right column's (-i, +j) corner, top and bottom.
+  for (int side : {0, 4}) {
+    const double a = r.zcorn[zcorn_index(r, 0, 0, 0, side | 3)], b = r.zcorn[zcorn_index(r, 1, 0, 0, side | 2)];
+    EXPECT_EQ(a, b) << (side ? "bottom" : "top");
+    EXPECT_NEAR(a, side ? 1704.96475 : 1701.96475, 1e-9);
+  }
+  for (int J = 1; J < r.ny; ++J)
+    for (int k = 0; k < 2; ++k) {
+      const double a = r.zcorn[zcorn_index(r, 0, J - 1, 0, 4 * k | 3)], b = r.zcorn[zcorn_index(r, 1, J - 1, 0, 4 * k | 2)];
+      EXPECT_TRUE(a == b || std::abs(a - b) > 1e-6) << "J " << J << ": " << a << " against " << b;
+    }
+  // The refined model's mesh conforms: one node where the throw vanishes.
+  CaseSpec cs;
+  cs.name = "s";
+  cs.reservoir = corner_point_reservoir(std::make_shared<const CornerPointModel>(r), "reservoir.grdecl");
+  const HybridMesh out = build_hybrid_mesh(cs);
+  EXPECT_TRUE(out.self_check.ok()) << out.self_check.message;
+}
+
 // MULTREGT (OPM's region multipliers) reaches a refined model's connections through the children's
 // parents: between children of two model cells the model's multiplier, within one cell none.
 TEST(NearWellRefinement, ChildrenKeepTheModelsRegionMultipliers) {
