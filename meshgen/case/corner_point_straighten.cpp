@@ -122,12 +122,192 @@ std::string walk_reason(Walk w) {
   }
 }
 
-// One request's turned pillars and re-gridded cells, checked; nothing when refused.
-struct Regrid {
-  std::map<int, std::array<double, 6>> coord;                 // pillar -> new COORD line
-  std::map<size_t, std::array<double, 8>> zcorn;              // cell -> new depths
-  std::map<size_t, size_t> source;                            // cell -> model cell its centre lies in
+// Where a request turns the pillars: the pivot depth and each pillar's weight (1 within reach,
+// 0 beyond the blend; empty when the pillars are left as they are).
+struct Plan {
+  double pivot = 0;
+  std::vector<double> weight;
 };
+
+// The lean of the pillars within reach (or of the nearest one where none is: coarse columns) and
+// the sharpest angle between a column's i-wall and j-wall there (planes through a pillar and its
+// next pillar along j, resp. along i): 90 degrees for vertical pillars or pillars leaning along a
+// grid axis.
+void measure_lean(const CornerPointModel& m, const StraightenRequest& req, double pivot, StraightenOutcome& out) {
+  double max_lean = 0, nearest = std::numeric_limits<double>::infinity(), nearest_lean = 0, sharpest = 90;
+  for (int J = 0; J <= m.ny; ++J)
+    for (int I = 0; I <= m.nx; ++I) {
+      const int p = pillar_id(m, I, J);
+      const auto l = lean_of(m, p);
+      const Vec3 x = pillar_point(m, p, pivot);
+      const double d = plan_distance_to_path(x, req.path);
+      if (d < nearest) nearest = d, nearest_lean = std::hypot(l[0], l[1]);
+      if (d > req.reach) continue;
+      max_lean = std::max(max_lean, std::hypot(l[0], l[1]));
+      if (I == m.nx || J == m.ny) continue;
+      const Vec3 a = pillar_point(m, p, pivot + 1) - x;
+      const Vec3 ni = cross(a, pillar_point(m, pillar_id(m, I, J + 1), pivot) - x);
+      const Vec3 nj = cross(a, pillar_point(m, pillar_id(m, I + 1, J), pivot) - x);
+      sharpest = std::min(sharpest, std::acos(std::min(1.0, std::abs(dot(ni, nj)) / (norm(ni) * norm(nj)))) / kDegree);
+    }
+  out.max_lean_deg = std::atan(nearest > req.reach ? nearest_lean : max_lean) / kDegree;
+  out.wall_angle_deg = sharpest;
+}
+
+// The blend: lean x dz / kStraightenShearPerWidth, dz the largest depth distance from the pivot to a
+// corner of the region's cells (the region from the range near the path first, then from that
+// region's own range).
+double blend_length(const CornerPointModel& m, const StraightenRequest& req, double pivot, double lean_deg) {
+  double blend = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    double top = pivot, bottom = pivot;
+    for (int J = 0; J < m.ny; ++J)
+      for (int I = 0; I < m.nx; ++I) {
+        if (plan_distance_to_path(pillar_point(m, pillar_id(m, I, J), pivot), req.path) > req.reach + blend) continue;
+        for (int k = 0; k < m.nz; ++k)
+          for (int q = 0; q < 8; ++q) {
+            const double z = m.zcorn[zcorn_index(m, I, J, k, q)];
+            top = std::min(top, z), bottom = std::max(bottom, z);
+          }
+      }
+    blend = std::tan(lean_deg * kDegree) * std::max(pivot - top, bottom - pivot) / kStraightenShearPerWidth;
+  }
+  return blend;
+}
+
+Plan plan_request(const CornerPointModel& m, const StraightenRequest& req, double zmin, double zmax, StraightenOutcome& out) {
+  Plan plan;
+  if (req.path.empty()) return plan;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Vec3& x : req.path) lo = std::min(lo, x.z), hi = std::max(hi, x.z);
+  // The middle of the path's depth range inside the model's.
+  plan.pivot = 0.5 * (std::clamp(lo, zmin, zmax) + std::clamp(hi, zmin, zmax));
+  measure_lean(m, req, plan.pivot, out);
+  const bool turn = req.any_lean ? out.max_lean_deg > kUprightMinLean : out.wall_angle_deg < kStraightenWallAngleBelow;
+  if (!turn) return plan;
+  out.blend = blend_length(m, req, plan.pivot, out.max_lean_deg);
+  plan.weight.assign((m.nx + 1) * (m.ny + 1), 0.0);
+  for (size_t p = 0; p < plan.weight.size(); ++p) {
+    const double d = plan_distance_to_path(pillar_point(m, static_cast<int>(p), plan.pivot), req.path);
+    plan.weight[p] = d <= req.reach ? 1.0 : std::max(0.0, 1.0 - (d - req.reach) / out.blend);
+  }
+  return plan;
+}
+
+// One request's turned pillars and re-gridded cells; `refused` says why not.
+struct Regrid {
+  std::map<int, std::array<double, 6>> coord;     // pillar -> new COORD line
+  std::map<std::array<int, 3>, double> depth;     // (pillar, k, side) -> depth on the turned pillar
+  std::map<size_t, std::array<double, 8>> zcorn;  // cell -> new depths
+  std::map<size_t, size_t> source;                // cell -> model cell its centre lies in
+  std::string refused;
+};
+
+// Turned pillars: through their point at the pivot depth, lean scaled by 1 - weight.
+void turn_pillars(const CornerPointModel& m, const Plan& plan, Regrid& g) {
+  for (size_t p = 0; p < plan.weight.size(); ++p) {
+    const double* a = &m.coord[6 * p];
+    if (!(plan.weight[p] > 0) || a[5] == a[2]) continue;
+    const auto l = lean_of(m, static_cast<int>(p));
+    const Vec3 x0 = pillar_point(m, static_cast<int>(p), plan.pivot);
+    const double f = 1.0 - plan.weight[p];
+    g.coord[static_cast<int>(p)] = {x0.x + f * l[0] * (a[2] - plan.pivot), x0.y + f * l[1] * (a[2] - plan.pivot), a[2],
+                                    x0.x + f * l[0] * (a[5] - plan.pivot), x0.y + f * l[1] * (a[5] - plan.pivot), a[5]};
+  }
+}
+
+// Each turned pillar's depth on each layer's top and bottom surface, once per pillar so that every
+// cell around it has the same corner: a fixed point of "the surface's depth below the pillar's
+// point at this depth". The cells around the pillar must agree on its corner (no fault along it).
+void layer_depths(const CornerPointModel& m, Regrid& g) {
+  for (const auto& [p, line] : g.coord) {
+    const int pi = p % (m.nx + 1), pj = p / (m.nx + 1);
+    for (int k = 0; k < m.nz; ++k)
+      for (int side : {0, 4}) {
+        std::optional<double> z0;
+        for (int a = 0; a < 4; ++a) {
+          const int I = pi - 1 + (a & 1), J = pj - 1 + (a >> 1);
+          if (I < 0 || J < 0 || I >= m.nx || J >= m.ny) continue;
+          const double zc = m.zcorn[zcorn_index(m, I, J, k, side | (a & 1 ? 0 : 1) | (a & 2 ? 0 : 2))];
+          if (z0 && *z0 != zc) return void(g.refused = walk_reason(Walk::Fault));
+          z0 = zc;
+        }
+        int I = std::min(pi, m.nx - 1), J = std::min(pj, m.ny - 1);
+        double z = *z0;
+        bool converged = false;
+        for (int it = 0; it < 100 && !converged; ++it) {
+          const double u = (z - line[2]) / (line[5] - line[2]);
+          double zn = 0;
+          const Walk w = surface_depth(m, k, side, line[0] + u * (line[3] - line[0]), line[1] + u * (line[4] - line[1]), I, J, zn);
+          if (w != Walk::Found) return void(g.refused = walk_reason(w));
+          converged = std::abs(zn - z) <= 1e-12 * (1.0 + std::abs(zn));
+          z = zn;
+        }
+        if (!converged) return void(g.refused = walk_reason(Walk::Lost));
+        g.depth[{p, k, side}] = z;
+      }
+  }
+}
+
+// Cells with a turned pillar: their depths, and the model cell their centre lies in. x and y
+// multipliers act on the model's faces, which the re-gridded cells no longer follow: refused.
+void regrid_cells(const CornerPointModel& m, Regrid& g) {
+  auto point = [&](int p, double z) {
+    const auto it = g.coord.find(p);
+    if (it == g.coord.end()) return pillar_point(m, p, z);
+    const auto& l = it->second;
+    const double u = (z - l[2]) / (l[5] - l[2]);
+    return Vec3{l[0] + u * (l[3] - l[0]), l[1] + u * (l[4] - l[1]), z};
+  };
+  for (int k = 0; k < m.nz; ++k)
+    for (int J = 0; J < m.ny; ++J)
+      for (int I = 0; I < m.nx; ++I) {
+        std::array<double, 8> zc;
+        bool any = false;
+        Vec3 centre{0, 0, 0};
+        for (int q = 0; q < 8; ++q) {
+          const int p = pillar_id(m, I + (q & 1), J + ((q >> 1) & 1));
+          const auto it = g.depth.find({p, k, q & 4});
+          any = any || it != g.depth.end();
+          zc[q] = it != g.depth.end() ? it->second : m.zcorn[zcorn_index(m, I, J, k, q)];
+          centre += point(p, zc[q]) / 8.0;
+        }
+        if (!any) continue;
+        for (int q = 0; q < 4; ++q)
+          if (zc[q] > zc[q | 4]) return void(g.refused = "a turned pillar meets a layer's top below its bottom");
+        int si = I, sj = J;
+        if (const Walk w = locate_column(m, centre, si, sj); w != Walk::Found) return void(g.refused = walk_reason(w));
+        const size_t c = cell_id(m, I, J, k), s = cell_id(m, si, sj, k);
+        for (int d = 0; d < 4; ++d)
+          if (!m.trans_mult[d].empty() && (m.trans_mult[d][c] != 1.0 || m.trans_mult[d][s] != 1.0))
+            return void(g.refused = "an x or y transmissibility multiplier (MULTX..MULTY-, FAULTS) acts in its region");
+        g.zcorn[c] = zc;
+        g.source[c] = s;
+      }
+}
+
+// The re-gridding written into `res`: COORD, ZCORN, corners on turned pillars (the others stay bit
+// for bit as the cells beside have them), and each cell's rock and parent from its source cell.
+void apply_regrid(const CornerPointModel& m, const Regrid& g, CornerPointModel& res) {
+  for (const auto& [p, line] : g.coord) std::copy(line.begin(), line.end(), &res.coord[6 * size_t(p)]);
+  for (const auto& [c, zc] : g.zcorn) {
+    const int I = static_cast<int>(c % m.nx), J = static_cast<int>((c / m.nx) % m.ny), k = static_cast<int>(c / (size_t(m.nx) * m.ny));
+    for (int q = 0; q < 8; ++q) {
+      const int p = pillar_id(m, I + (q & 1), J + ((q >> 1) & 1));
+      res.zcorn[zcorn_index(m, I, J, k, q)] = zc[q];
+      if (g.coord.count(p)) res.corners[c][q] = pillar_point(res, p, zc[q]);
+    }
+  }
+  for (const auto& [c, s] : g.source) {
+    res.actnum[c] = m.actnum[s];
+    res.permx[c] = m.permx[s], res.permy[c] = m.permy[s], res.permz[c] = m.permz[s];
+    res.poro[c] = m.poro[s], res.ntg[c] = m.ntg[s];
+    res.parent_cell[c] = m.parent_cell.empty() ? static_cast<int32_t>(s) : m.parent_cell[s];
+    if (!m.pore_volume_mult.empty()) res.pore_volume_mult[c] = m.pore_volume_mult[s];
+    for (int d = 4; d < 6; ++d)
+      if (!m.trans_mult[d].empty()) res.trans_mult[d][c] = m.trans_mult[d][s];
+  }
+}
 
 }  // namespace
 
@@ -136,208 +316,43 @@ CornerPointModel straightened_model(const CornerPointModel& m, const std::vector
   std::vector<StraightenOutcome> out(requests.size());
   double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
   for (double z : m.zcorn) zmin = std::min(zmin, z), zmax = std::max(zmax, z);
-
-  // Per request: the pivot depth, the blend length and each pillar's weight (1 within reach).
-  const int np = (m.nx + 1) * (m.ny + 1);
-  std::vector<std::vector<double>> weight(requests.size());
-  std::vector<double> pivot(requests.size(), 0);
-  std::vector<int> owner(np, -1);
-  std::vector<char> overlapping(requests.size(), 0);
-  auto position = [&](int p, double z0) { return pillar_point(m, p, z0); };
+  std::vector<Plan> plans;
+  std::vector<int> owner((m.nx + 1) * (m.ny + 1), -1);
   for (size_t r = 0; r < requests.size(); ++r) {
-    const StraightenRequest& req = requests[r];
-    if (req.path.empty()) continue;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const Vec3& x : req.path) lo = std::min(lo, x.z), hi = std::max(hi, x.z);
-    // The middle of the path's depth range inside the model's.
-    lo = std::clamp(lo, zmin, zmax), hi = std::clamp(hi, zmin, zmax);
-    pivot[r] = 0.5 * (lo + hi);
-    // The lean of the pillars within reach, or of the nearest one where none is (coarse columns).
-    double max_lean = 0, nearest = std::numeric_limits<double>::infinity(), nearest_lean = 0;
-    for (int p = 0; p < np; ++p) {
-      const auto l = lean_of(m, p);
-      const double d = plan_distance_to_path(position(p, pivot[r]), req.path);
-      if (d <= req.reach) max_lean = std::max(max_lean, std::hypot(l[0], l[1]));
-      if (d < nearest) nearest = d, nearest_lean = std::hypot(l[0], l[1]);
-    }
-    if (nearest > req.reach) max_lean = nearest_lean;
-    // The sharpest angle between a column's i-wall and j-wall (planes through a pillar and its next
-    // pillar along j, resp. along i) among the pillars within reach: 90 degrees for vertical pillars
-    // or pillars leaning along a grid axis.
-    double sharpest = 90;
-    for (int J = 0; J < m.ny; ++J)
-      for (int I = 0; I < m.nx; ++I) {
-        const int p = pillar_id(m, I, J);
-        const Vec3 x = position(p, pivot[r]);
-        if (plan_distance_to_path(x, req.path) > req.reach) continue;
-        const Vec3 a = pillar_point(m, p, pivot[r] + 1) - x;
-        const Vec3 ei = position(pillar_id(m, I + 1, J), pivot[r]) - x, ej = position(pillar_id(m, I, J + 1), pivot[r]) - x;
-        const Vec3 ni = cross(a, ej), nj = cross(a, ei);
-        const double c = std::abs(dot(ni, nj)) / (norm(ni) * norm(nj));
-        sharpest = std::min(sharpest, std::acos(std::min(1.0, c)) / kDegree);
-      }
-
-    out[r].max_lean_deg = std::atan(max_lean) / kDegree;
-    out[r].wall_angle_deg = sharpest;
-    if (req.any_lean ? !(out[r].max_lean_deg > kUprightMinLean) : !(sharpest < kStraightenWallAngleBelow)) continue;
-    // The depth range the turned pillars span: the model's cells within the region (the region
-    // from the range near the path first, then from that region's own range).
-    out[r].blend = 0;
-    for (int pass = 0; pass < 2; ++pass) {
-      double top = pivot[r], bottom = pivot[r];
-      for (int J = 0; J < m.ny; ++J)
-        for (int I = 0; I < m.nx; ++I) {
-          const int p = pillar_id(m, I, J);
-          if (plan_distance_to_path(position(p, pivot[r]), req.path) > req.reach + out[r].blend) continue;
-          for (int k = 0; k < m.nz; ++k)
-            for (int q = 0; q < 8; ++q) {
-              const double z = m.zcorn[zcorn_index(m, I, J, k, q)];
-              top = std::min(top, z), bottom = std::max(bottom, z);
-            }
-        }
-      out[r].blend = max_lean * std::max(pivot[r] - top, bottom - pivot[r]) / kStraightenShearPerWidth;
-    }
-    weight[r].assign(np, 0.0);
-    for (int p = 0; p < np; ++p) {
-      const double d = plan_distance_to_path(position(p, pivot[r]), req.path);
-      const double w = d <= req.reach ? 1.0 : std::max(0.0, 1.0 - (d - req.reach) / out[r].blend);
-      if (!(w > 0)) continue;
-      weight[r][p] = w;
-      if (owner[p] >= 0) overlapping[r] = overlapping[owner[p]] = 1;
+    plans.push_back(plan_request(m, requests[r], zmin, zmax, out[r]));
+    for (size_t p = 0; p < plans[r].weight.size(); ++p) {
+      if (!(plans[r].weight[p] > 0)) continue;
+      if (owner[p] >= 0) out[r].refused = out[owner[p]].refused = "its region overlaps another well's";
       owner[p] = static_cast<int>(r);
     }
   }
-
-  CornerPointModel res = m;
-  if (res.parent_cell.empty()) {
-    res.parent_cell.resize(m.corners.size());
-    for (size_t c = 0; c < m.corners.size(); ++c) res.parent_cell[c] = static_cast<int32_t>(c);
-    res.parent_nx = m.nx, res.parent_ny = m.ny;
-  }
-  std::vector<size_t> changed;
+  std::optional<CornerPointModel> res;
   for (size_t r = 0; r < requests.size(); ++r) {
-    if (weight[r].empty()) continue;
-    if (overlapping[r]) {
-      out[r].refused = "its region overlaps another well's";
-      continue;
-    }
+    if (plans[r].weight.empty() || !out[r].refused.empty()) continue;
     Regrid g;
-    std::string refused;
-    // Turned pillars: through their point at the pivot depth, lean scaled by 1 - weight.
-    for (int p = 0; p < np; ++p) {
-      if (!(weight[r][p] > 0)) continue;
-      const double* a = &m.coord[6 * size_t(p)];
-      if (a[5] == a[2]) continue;
-      const auto l = lean_of(m, p);
-      const Vec3 x0 = position(p, pivot[r]);
-      const double f = 1.0 - weight[r][p];
-      g.coord[p] = {x0.x + f * l[0] * (a[2] - pivot[r]), x0.y + f * l[1] * (a[2] - pivot[r]), a[2],
-                    x0.x + f * l[0] * (a[5] - pivot[r]), x0.y + f * l[1] * (a[5] - pivot[r]), a[5]};
-    }
-    // Each turned pillar's depth on each layer's top and bottom surface, once per pillar so that
-    // every cell around it has the same corner.
-    std::map<std::array<int, 3>, double> depth;  // (pillar, k, side) -> z
-    for (const auto& [p, line] : g.coord) {
-      if (!refused.empty()) break;
-      const int pi = p % (m.nx + 1), pj = p / (m.nx + 1);
-      for (int k = 0; k < m.nz && refused.empty(); ++k)
-        for (int side : {0, 4}) {
-          // The cells around the pillar must agree on its corner (no fault along it).
-          std::optional<double> z0;
-          for (int a = 0; a < 4 && refused.empty(); ++a) {
-            const int I = pi - 1 + (a & 1), J = pj - 1 + (a >> 1);
-            if (I < 0 || J < 0 || I >= m.nx || J >= m.ny) continue;
-            const double zc = m.zcorn[zcorn_index(m, I, J, k, side | (a & 1 ? 0 : 1) | (a & 2 ? 0 : 2))];
-            if (z0 && *z0 != zc) refused = walk_reason(Walk::Fault);
-            z0 = zc;
-          }
-          if (!refused.empty()) break;
-          int I = std::min(pi, m.nx - 1), J = std::min(pj, m.ny - 1);
-          double z = *z0;
-          bool converged = false;
-          for (int it = 0; it < 100 && !converged; ++it) {
-            const double u = (z - line[2]) / (line[5] - line[2]);
-            const double x = line[0] + u * (line[3] - line[0]), y = line[1] + u * (line[4] - line[1]);
-            double zn = 0;
-            const Walk w = surface_depth(m, k, side, x, y, I, J, zn);
-            if (w != Walk::Found) {
-              refused = walk_reason(w);
-              break;
-            }
-            converged = std::abs(zn - z) <= 1e-12 * (1.0 + std::abs(zn));
-            z = zn;
-          }
-          if (refused.empty() && !converged) refused = walk_reason(Walk::Lost);
-          depth[{p, k, side}] = z;
-        }
-    }
-    // Cells with a turned pillar: new depths, and the model cell their centre lies in.
-    CornerPointModel turned = m;
-    for (const auto& [p, line] : g.coord) std::copy(line.begin(), line.end(), &turned.coord[6 * size_t(p)]);
-    for (int k = 0; k < m.nz && refused.empty(); ++k)
-      for (int J = 0; J < m.ny && refused.empty(); ++J)
-        for (int I = 0; I < m.nx && refused.empty(); ++I) {
-          std::array<double, 8> zc;
-          bool any = false;
-          for (int q = 0; q < 8; ++q) {
-            const int p = pillar_id(m, I + (q & 1), J + ((q >> 1) & 1));
-            const auto it = depth.find({p, k, q & 4});
-            any = any || it != depth.end();
-            zc[q] = it != depth.end() ? it->second : m.zcorn[zcorn_index(m, I, J, k, q)];
-          }
-          if (!any) continue;
-          for (int q = 0; q < 4; ++q)
-            if (zc[q] > zc[q | 4]) refused = "a turned pillar meets a layer's top below its bottom";
-          const size_t c = cell_id(m, I, J, k);
-          g.zcorn[c] = zc;
-          Vec3 centre{0, 0, 0};
-          for (int q = 0; q < 8; ++q) centre += pillar_point(turned, pillar_id(m, I + (q & 1), J + ((q >> 1) & 1)), zc[q]);
-          centre = centre / 8.0;
-          int si = I, sj = J;
-          const Walk w = locate_column(m, centre, si, sj);
-          if (w != Walk::Found) refused = walk_reason(w);
-          g.source[c] = cell_id(m, si, sj, k);
-        }
-    // x and y multipliers act on the model's faces, which the re-gridded cells no longer follow.
-    for (const auto& [c, s] : g.source)
-      for (int d = 0; d < 4 && refused.empty(); ++d)
-        if (!m.trans_mult[d].empty() && (m.trans_mult[d][c] != 1.0 || m.trans_mult[d][s] != 1.0))
-          refused = "an x or y transmissibility multiplier (MULTX..MULTY-, FAULTS) acts in its region";
-    if (!refused.empty()) {
-      out[r].refused = refused;
+    turn_pillars(m, plans[r], g);
+    layer_depths(m, g);
+    if (g.refused.empty()) regrid_cells(m, g);
+    if (!g.refused.empty()) {
+      out[r].refused = g.refused;
       continue;
     }
-    for (const auto& [p, line] : g.coord) std::copy(line.begin(), line.end(), &res.coord[6 * size_t(p)]);
-    for (const auto& [c, zc] : g.zcorn) {
-      changed.push_back(c);
-      const int I = static_cast<int>(c % m.nx), J = static_cast<int>((c / m.nx) % m.ny), k = static_cast<int>(c / (size_t(m.nx) * m.ny));
-      for (int q = 0; q < 8; ++q) res.zcorn[zcorn_index(m, I, J, k, q)] = zc[q];
+    if (!res) {
+      res = m;
+      if (res->parent_cell.empty()) {
+        res->parent_cell.resize(m.corners.size());
+        for (size_t c = 0; c < m.corners.size(); ++c) res->parent_cell[c] = static_cast<int32_t>(c);
+        res->parent_nx = m.nx, res->parent_ny = m.ny;
+      }
+      res->opm_volume.clear();
     }
-    for (const auto& [c, s] : g.source) {
-      res.actnum[c] = m.actnum[s];
-      res.permx[c] = m.permx[s], res.permy[c] = m.permy[s], res.permz[c] = m.permz[s];
-      res.poro[c] = m.poro[s], res.ntg[c] = m.ntg[s];
-      res.parent_cell[c] = m.parent_cell.empty() ? static_cast<int32_t>(s) : m.parent_cell[s];
-      if (!m.pore_volume_mult.empty()) res.pore_volume_mult[c] = m.pore_volume_mult[s];
-      for (int d = 4; d < 6; ++d)
-        if (!m.trans_mult[d].empty()) res.trans_mult[d][c] = m.trans_mult[d][s];
-    }
+    apply_regrid(m, g, *res);
     out[r].straightened = true;
     out[r].pillars = static_cast<int>(g.coord.size());
   }
-  // The re-gridded cells' corners from the new COORD and ZCORN, as OPM places them.
-  // Corners on pillars not turned stay as they were (bit for bit, as the cells beside have them).
-  for (const size_t c : changed) {
-    const int I = static_cast<int>(c % m.nx), J = static_cast<int>((c / m.nx) % m.ny), k = static_cast<int>(c / (size_t(m.nx) * m.ny));
-    for (int q = 0; q < 8; ++q) {
-      const int p = pillar_id(m, I + (q & 1), J + ((q >> 1) & 1));
-      if (std::equal(&m.coord[6 * size_t(p)], &m.coord[6 * size_t(p)] + 6, &res.coord[6 * size_t(p)])) continue;
-      res.corners[c][q] = pillar_point(res, p, res.zcorn[zcorn_index(m, I, J, k, q)]);
-    }
-  }
-  if (!changed.empty()) res.opm_volume.clear();
   if (outcomes) *outcomes = std::move(out);
-  return changed.empty() ? m : res;
+  if (!res) return m;
+  return std::move(*res);
 }
 
 }  // namespace hm
