@@ -261,33 +261,32 @@ TEST(FlowMeshgen, ReekProducerAndInjectorDeckMatchesSolverDemo) {
   run_case_file(d / "reek2.yaml", "reek, producer and injector", d, false, 1e-6, "--linear-solver-max-iter=2000");
 }
 
-// examples/reek_wells.yaml: Reek's well OP_3 (from its COMPDAT cells), a 600 m horizontal producer in
-// layer 8 and an injector, the model refined near all three (805,822 cells). The default deck's transient
-// takes flow ~30 steps of ~2 min here (docs/corner-point.md, "Reek's own wells"); the steady-state deck
-// (meshgen --eclipse-steady: one long step, flow with the options its first line names) plus
-// --linear-solver-max-iter=2000 is one step (~7 min of flow, ~8 min of solver_demo).
-TEST(FlowMeshgen, ReekWellsExampleSteadyDeckMatchesSolverDemo) {
-  REQUIRE_FLOW_E2E();
-  if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: ~0.8M cells in flow)";
+// A shipped Reek example's steady-state deck (meshgen --eclipse-steady: one long step, flow with the
+// options its first line names, plus --linear-solver-max-iter=2000) against solver_demo. HM_LONG_TESTS=1.
+void run_reek_example_steady(const std::string& example) {
+  if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: 0.8-1.3M cells in flow)";
   const fs::path reek = fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek";
   if (!fs::exists(reek / "REEK_GRID.DATA")) GTEST_SKIP() << "no " << reek;
-  const fs::path d = fresh_dir("flow_reek_wells");
+  const fs::path d = fresh_dir("flow_" + example);
   const RemoveAtExit cleanup{d};
-  run_case_file(fs::path(HM_SOURCE_DIR) / "examples" / "reek_wells.yaml", "reek_wells", d, false, 1e-6,
+  run_case_file(fs::path(HM_SOURCE_DIR) / "examples" / (example + ".yaml"), example, d, false, 1e-6,
                 "--linear-solver-max-iter=2000", "--eclipse-steady");
 }
 
+// examples/reek_wells.yaml: Reek's well OP_3 (from its COMPDAT cells), a 600 m horizontal producer in
+// layer 8 and an injector, the model refined near all three (805,822 cells). The default deck's transient
+// takes flow ~30 steps of ~2 min here (docs/corner-point.md, "Reek's own wells"); the steady-state deck
+// is one step (~7 min of flow, ~8 min of solver_demo).
+TEST(FlowMeshgen, ReekWellsExampleSteadyDeckMatchesSolverDemo) {
+  REQUIRE_FLOW_E2E();
+  run_reek_example_steady("reek_wells");
+}
+
 // examples/reek_own_wells.yaml: Reek's OP_1, OP_3, WI_1 (pillars turned upright near OP_1 and WI_1) and
-// the horizontal producer HZ1; the steady-state deck as for reek_wells above (docs/export-eclipse.md).
+// the horizontal producer HZ1 (1,302,879 cells).
 TEST(FlowMeshgen, ReekOwnWellsExampleSteadyDeckMatchesSolverDemo) {
   REQUIRE_FLOW_E2E();
-  if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: ~1.5M cells in flow)";
-  const fs::path reek = fs::path(HM_SOURCE_DIR) / ".." / "shared" / "data" / "reek";
-  if (!fs::exists(reek / "REEK_GRID.DATA")) GTEST_SKIP() << "no " << reek;
-  const fs::path d = fresh_dir("flow_reek_own_wells");
-  const RemoveAtExit cleanup{d};
-  run_case_file(fs::path(HM_SOURCE_DIR) / "examples" / "reek_own_wells.yaml", "reek_own_wells", d, false, 1e-6,
-                "--linear-solver-max-iter=2000", "--eclipse-steady");
+  run_reek_example_steady("reek_own_wells");
 }
 
 TEST(FlowMeshgen, UnwritableExportDirectoryExitsTwoAndLeavesNoDeck) {

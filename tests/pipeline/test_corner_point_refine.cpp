@@ -372,6 +372,10 @@ TEST(NearWellRefinement, CaseKeyIsChecked) {
     return std::string();
   };
   EXPECT_EQ(error_of(well_case("M.GRDECL", ", near_well_cell_size: -2", 10)), "reservoir.near_well_cell_size: must be > 0");
+  EXPECT_EQ(error_of(well_case("M.GRDECL", ", upright_pillars: yes", 10)),
+            "reservoir.upright_pillars: expected auto, on or off, got 'yes'");
+  EXPECT_EQ(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], upright_pillars: auto}\n"),
+            "reservoir.upright_pillars: only with reservoir.grdecl (a corner-point model)");
   EXPECT_NE(error_of(well_case("M.GRDECL", ", near_well_cell_size: fine", 10)).find("expected auto, off or a size"),
             std::string::npos);
   EXPECT_NE(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], near_well_cell_size: 3}\n")

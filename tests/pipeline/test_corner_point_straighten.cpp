@@ -250,21 +250,3 @@ TEST(UprightPillars, ObliquelyShearedCellsMeshWithUprightPillars) {
   std::printf("[ figures  ] 56 deg at 20 deg, R = 5 m, upright pillars: %d cells (%d transition)\n", out.mesh.n_cells(),
               transition);
 }
-
-TEST(UprightPillars, CaseKeyIsChecked) {
-  TempDir tmp("upright_key");
-  std::ofstream(tmp.path / "M.GRDECL") << oblique_model().text();
-  auto error_of = [&](const std::string& text) {
-    std::ofstream(tmp.path / "c.yaml") << text;
-    try {
-      load_case((tmp.path / "c.yaml").string());
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
-  EXPECT_EQ(error_of("name: m\nreservoir: {grdecl: M.GRDECL, upright_pillars: yes}\n"),
-            "reservoir.upright_pillars: expected auto, on or off, got 'yes'");
-  EXPECT_EQ(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], upright_pillars: auto}\n"),
-            "reservoir.upright_pillars: only with reservoir.grdecl (a corner-point model)");
-}
