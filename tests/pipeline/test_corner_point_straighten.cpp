@@ -73,7 +73,7 @@ const Vec3 kWellTop{350, 350, 1080}, kWellBottom{350, 350, 1092};
 
 }  // namespace
 
-TEST(UprightPillars, LayersKeptPillarsUprightRockFromTheCellBelowTheCentre) {
+TEST(UprightPillars, LayersKeptPillarsUprightRockFromTheCellHoldingTheCentre) {
   TempDir tmp("upright");
   const hmtest::LayeredModel g = oblique_model();
   std::ofstream(tmp.path / "M.GRDECL") << g.text();
