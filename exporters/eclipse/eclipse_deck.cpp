@@ -499,7 +499,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       warnings.push_back("fluid compressibility raised to 1e-8 /bar in PVTW (flow needs Cw > 0)");
     TextOut o;
     o << "-- " << name << ": single-phase steady-state deck written by HybridMesh (docs/export-eclipse.md).\n";
-    if (options.schedule == EclipseSchedule::SingleStep) {
+    if (options.schedule == EclipseSchedule::Steady) {
       o << "-- Run: flow";
       for (const std::string& a : flow_steady_state_options()) o << ' ' << a;
       o << ' ' << name << ".DATA\n\n";
@@ -535,9 +535,12 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
       << "SCHEDULE\n\n"
       << "RPTRST\n'BASIC=2' /\n\n"
       << "INCLUDE\n" << quoted(sched_inc) << " /\n\n";
-    if (options.schedule == EclipseSchedule::SingleStep) {
-      o << "-- One long step (run flow with the options above): backward Euler then gives the steady state.\n"
-        << "TSTEP\n" << options.tstep_days << " /\n\nEND\n";
+    if (options.schedule == EclipseSchedule::Steady) {
+      o << "-- Long steps (run flow with the options above): backward Euler then gives the steady state;\n"
+        << "-- the second removes the accumulation the first leaves (docs/export-eclipse.md).\n"
+        << "TSTEP\n";
+      for (int s = 0; s < kSteadyReportSteps; ++s) o << options.tstep_days / kSteadyReportSteps << ' ';
+      o << "/\n\nEND\n";
     } else {
       o << "-- Run as typed: flow 2022.10 reads no time-step keyword without options (TUNING, NEXTSTEP need\n"
         << "-- --enable-tuning); it starts at min(1 day, report step), grows at most 3x per step, at most 365 days.\n"
@@ -575,7 +578,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     info->warnings = warnings;
     info->relaxation_time_days = relaxation;
     info->first_step_days = first_step;
-    info->end_days = options.schedule == EclipseSchedule::SingleStep ? options.tstep_days : end_days;
+    info->end_days = options.schedule == EclipseSchedule::Steady ? options.tstep_days : end_days;
   }
   return {};
 }

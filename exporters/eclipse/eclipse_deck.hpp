@@ -28,11 +28,17 @@ enum class EclipseSchedule {
   /// flow's own time stepping (x3 per step, at most 365 days) carries the transient to its
   /// steady state. end = end_days, or automatically max(1, kAsTypedRelaxationTimes x eclipse_relaxation_time_days).
   AsTyped,
-  /// One report step of tstep_days, for `flow` with flow_steady_state_options() (optional).
-  SingleStep,
+  /// kSteadyReportSteps long report steps (tstep_days in all), for `flow` with
+  /// flow_steady_state_options() (optional): a steady-state solve.
+  Steady,
 };
 
 constexpr double kOneSecondInDays = 1.0 / 86400;
+/// Steady: the number of equal report steps. One backward-Euler step leaves the accumulation
+/// PV (b(p) - b(p_init)) / dt in the balance (on Reek a net production of 1e-6 of the rates); the
+/// second starts at that state and leaves a term smaller by the step's damping, below flow's
+/// float32 output (docs/export-eclipse.md, "Compressible water").
+constexpr int kSteadyReportSteps = 2;
 /// AsTyped runs this many estimated relaxation times. The estimate is a lower bound of the
 /// slowest mode: on three_wells 40 of them ended 1.7e-6 (relative) short of the steady state
 /// that 500 days give, 100 of them 1.2e-7 (docs/export-eclipse.md).
@@ -49,9 +55,9 @@ struct EclipseDeckOptions {
   double first_step_days = 0;
   /// AsTyped: the end of the run (days); 0 = automatic (see EclipseSchedule::AsTyped).
   double end_days = 0;
-  /// SingleStep: length of the single report step (days). Long enough that the compressible
-  /// accumulation left after one backward-Euler step is negligible: the run is a steady-state
-  /// solve. The run starts on 1 Jan 1900 and flow's dates end in 2262: at most ~131,000 days.
+  /// Steady: the length of the run (days), in kSteadyReportSteps equal report steps. Long enough
+  /// that the compressible accumulation left after the steps is negligible: the run is a
+  /// steady-state solve. The run starts on 1 Jan 1900 and flow's dates end in 2262: at most ~131,000 days.
   double tstep_days = 1.0e5;
   /// Thickness (m) of the thin boxes that carry the non-reservoir cells. Their depth (centre)
   /// is exact; the thickness only decides how many fit in one column.
@@ -156,7 +162,7 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
 /// ACTNUM 1 where the mesh has the reservoir cell, 0 where the cavity replaced it.
 WriteStatus write_reservoir_grdecl(const std::string& path, const ReservoirSpec& reservoir, const PolyMesh& mesh);
 
-/// Command-line options for `flow` that make the one-step deck (EclipseSchedule::SingleStep) a
+/// Command-line options for `flow` that make the steady deck (EclipseSchedule::Steady) a
 /// steady-state solve and make it converge to the accuracy of its float32 output
 /// (docs/export-eclipse.md explains each). Optional: the default deck runs as typed.
 std::vector<std::string> flow_steady_state_options();

@@ -35,7 +35,7 @@ int usage(const std::string& why) {
             << "  --quiet: no progress lines on stderr (shown only on a terminal, for stages over 2 s)\n"
             << "  mesh.vtu, summary.json and cavity_K.obj are always written; --export adds\n"
             << "  OUTDIR/eclipse/NAME.DATA (OPM Flow deck + GRDECL) and OUTDIR/openfoam/ (polyMesh case).\n"
-            << "  --eclipse-steady: the deck is one long step, a steady-state solve for flow with the options its first\n"
+            << "  --eclipse-steady: the deck is two long steps, a steady-state solve for flow with the options its first\n"
             << "  line names (default: a transient that flow runs as typed; docs/export-eclipse.md).\n"
             << "  --png: pictures beside mesh.vtu (VTK, off-screen; re-runs under xvfb-run without an X display):\n"
             << "  well_K_region.png and well_K_qs.png (a cut along well K's trajectory), overview.png;\n"
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
         start = comma + 1;
       }
     } else if (a == "--eclipse-steady") {
-      deck_opts.schedule = hm::EclipseSchedule::SingleStep;
+      deck_opts.schedule = hm::EclipseSchedule::Steady;
     } else if (a == "--png") {
       pictures = true;
     } else if (a == "--png-size") {

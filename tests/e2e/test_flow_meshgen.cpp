@@ -179,7 +179,7 @@ TEST(FlowMeshgen, ThreeWellsAsShippedDeckMatchesSolverDemo) { run_example("three
 // Wells through the reservoir boundary (issue 12): a producer and an injector each, so that the
 // solution is not hydrostatic; flow matches solver_demo to 1e-6.
 TEST(FlowMeshgen, VerticalThroughDeckMatchesSolverDemo) { run_example("vertical_through", false, 1e-6); }
-// The same case as the steady-state deck (meshgen --eclipse-steady): one long step, flow with the
+// The same case as the steady-state deck (meshgen --eclipse-steady): two long steps, flow with the
 // options the deck's first line names.
 TEST(FlowMeshgen, VerticalThroughSteadyDeckMatchesSolverDemo) {
   REQUIRE_FLOW_E2E();
@@ -261,7 +261,7 @@ TEST(FlowMeshgen, ReekProducerAndInjectorDeckMatchesSolverDemo) {
   run_case_file(d / "reek2.yaml", "reek, producer and injector", d, false, 1e-6, "--linear-solver-max-iter=2000");
 }
 
-// A shipped Reek example's steady-state deck (meshgen --eclipse-steady: one long step, flow with the
+// A shipped Reek example's steady-state deck (meshgen --eclipse-steady: two long steps, flow with the
 // options its first line names, plus --linear-solver-max-iter=2000) against solver_demo. HM_LONG_TESTS=1.
 void run_reek_example_steady(const std::string& example) {
   if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: 0.8-1.3M cells in flow)";
@@ -276,7 +276,7 @@ void run_reek_example_steady(const std::string& example) {
 // examples/reek_wells.yaml: Reek's well OP_3 (from its COMPDAT cells), a 600 m horizontal producer in
 // layer 8 and an injector, the model refined near all three (805,822 cells). The default deck's transient
 // takes flow ~30 steps of ~2 min here (docs/corner-point.md, "Reek's own wells"); the steady-state deck
-// is one step (~7 min of flow, ~8 min of solver_demo).
+// is two long steps (~7 min of flow, ~8 min of solver_demo).
 TEST(FlowMeshgen, ReekWellsExampleSteadyDeckMatchesSolverDemo) {
   REQUIRE_FLOW_E2E();
   run_reek_example_steady("reek_wells");

@@ -31,7 +31,7 @@ inline double children_cpu_seconds() {
 
 enum class FlowInvocation {
   AsTyped,      ///< `flow NAME.DATA`: no options (the default deck, EclipseSchedule::AsTyped)
-  WithOptions,  ///< `flow <flow_steady_state_options()> NAME.DATA` (for EclipseSchedule::SingleStep)
+  WithOptions,  ///< `flow <flow_steady_state_options()> NAME.DATA` (for EclipseSchedule::Steady)
 };
 
 /// Runs flow on dir/NAME.DATA (output in dir/out; --output-dir only chooses where flow writes),

@@ -423,8 +423,8 @@ namespace {
 
 // The deck's SCHEDULE (issue 16): as typed, WTEST then `TSTEP first (end - first)` with end =
 // max(1, kAsTypedRelaxationTimes relaxation times), first = clamp(tau / 2, 1 s, 1 day); a compressible case relaxes
-// slower and runs longer; the one-step
-// deck for the optional flow options is unchanged; bad step lengths are refused.
+// slower and runs longer; the steady
+// deck for the optional flow options is two long steps; bad step lengths are refused.
 std::string schedule_of(const std::string& data) { return data.substr(data.find("SCHEDULE")); }
 
 TEST(EclipseDeck, AsTypedScheduleRunsAHundredRelaxationTimes) {
@@ -460,14 +460,14 @@ TEST(EclipseDeck, AsTypedScheduleRunsAHundredRelaxationTimes) {
   EXPECT_EQ(winfo.first_step_days, std::clamp(0.5 * winfo.relaxation_time_days, hm::kOneSecondInDays, 1.0));
   EXPECT_GT(winfo.first_step_days, 0.01);
 
-  // The one-step deck: one TSTEP of tstep_days, no WTEST, the options in its first lines.
+  // The steady deck: tstep_days in two report steps, no WTEST, the options in its first lines.
   hm::EclipseDeckOptions single;
-  single.schedule = hm::EclipseSchedule::SingleStep;
+  single.schedule = hm::EclipseSchedule::Steady;
   TempDir tmp3("deck_sched_single");
   hm::EclipseDeckInfo sinfo;
   ASSERT_TRUE(hm::write_eclipse_deck(tmp3.str(), fx.cs, fx.mesh, fx.geo, fx.trans, single, &sinfo).ok);
   const std::string sdata = read_text(sinfo.data_file);
-  EXPECT_NE(schedule_of(sdata).find("TSTEP\n1e+05 /"), std::string::npos) << schedule_of(sdata);
+  EXPECT_NE(schedule_of(sdata).find("TSTEP\n50000 50000 /"), std::string::npos) << schedule_of(sdata);
   EXPECT_EQ(schedule_of(sdata).find("WTEST"), std::string::npos);
   EXPECT_NE(sdata.find("-- Run: flow --enable-adaptive-time-stepping=false"), std::string::npos);
   EXPECT_EQ(sinfo.end_days, 1e5);

@@ -64,9 +64,9 @@ TEST(FlowDeck, BoxWithTwoVerticalWellsAndGravityMatchesOurSolve) {
   EXPECT_EQ(c.dropped_by_flow, c.expected_dropped);
 }
 
-// The optional path: the one-step deck (EclipseSchedule::SingleStep) run with
+// The optional path: the steady deck (EclipseSchedule::Steady) run with
 // flow_steady_state_options() agrees just as well (docs/export-eclipse.md).
-TEST(FlowDeck, SingleStepDeckWithTheOptionsMatchesOurSolve) {
+TEST(FlowDeck, SteadyDeckWithTheOptionsMatchesOurSolve) {
   REQUIRE_FLOW();
   const hm::CaseSpec cs = two_well_box();
   hm::BuildReport rep;
@@ -77,7 +77,7 @@ TEST(FlowDeck, SingleStepDeckWithTheOptionsMatchesOurSolve) {
   const TpfaSolution ours = reference_tpfa_solve(cs, mesh, trans);
   TempDir tmp("flow_box_single");
   hm::EclipseDeckOptions opt;
-  opt.schedule = hm::EclipseSchedule::SingleStep;
+  opt.schedule = hm::EclipseSchedule::Steady;
   hm::EclipseDeckInfo info;
   ASSERT_TRUE(hm::write_eclipse_deck(tmp.str(), cs, mesh, geo, trans, opt, &info).ok);
   EXPECT_EQ(info.end_days, opt.tstep_days);
@@ -87,7 +87,7 @@ TEST(FlowDeck, SingleStepDeckWithTheOptionsMatchesOurSolve) {
   const hm::EclipseConnections conn = hm::make_eclipse_connections(mesh, info.layout, trans);
   const FlowComparison c = compare_flow(cs, mesh, geo, info, ours, conn, run.results);
   ASSERT_TRUE(c.problem.empty()) << c.problem;
-  report("two-well box, one-step deck with the options", c, run);
+  report("two-well box, steady deck with the options", c, run);
   EXPECT_LT(c.max_rel_pressure, 1e-5);
   EXPECT_LT(c.max_rel_rate, 1e-5);
 }

@@ -124,12 +124,12 @@ void run_example(const hm::CaseSpec& cs, const std::string& label, ExampleRun* r
   for (const std::string& w : r->info.warnings) std::printf("[ warning  ] %s\n", w.c_str());
   dump_ours_if_kept(tmp.path, cs, r->info.layout, r->ours);
   r->run = run_flow(tmp.path, hm::eclipse_deck_name(cs));  // as typed: no options
-  // Measurement aid (issue 16): HM_FLOW_COMPARE_TUNED=1 also runs the one-step deck with the
+  // Measurement aid (issue 16): HM_FLOW_COMPARE_TUNED=1 also runs the steady deck with the
   // optional flow options, right after, and prints both runs' times and Newton iterations.
   if (std::getenv("HM_FLOW_COMPARE_TUNED") != nullptr) {
     TempDir tuned_dir("flow_tuned_" + label);
     hm::EclipseDeckOptions single;
-    single.schedule = hm::EclipseSchedule::SingleStep;
+    single.schedule = hm::EclipseSchedule::Steady;
     hm::EclipseDeckInfo tuned_info;
     ASSERT_TRUE(hm::write_eclipse_deck(tuned_dir.str(), cs, mesh, geo, trans, single, &tuned_info).ok);
     const FlowRun tuned = run_flow(tuned_dir.path, hm::eclipse_deck_name(cs), FlowInvocation::WithOptions);
