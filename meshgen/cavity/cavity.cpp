@@ -101,6 +101,18 @@ struct EdgeKey {
 
 double box_polyline_distance(Vec3 lo, Vec3 hi, const std::vector<Vec3>& line) { return box_polyline_dist(lo, hi, line); }
 
+bool box_polyline_within(Vec3 lo, Vec3 hi, const std::vector<Vec3>& line, double reach) {
+  for (size_t s = 0; s + 1 < line.size(); ++s) {
+    const Vec3 a = line[s], b = line[s + 1];
+    // Apart by more than reach along one axis: every point of the segment is farther than reach.
+    bool apart = false;
+    for (int k = 0; k < 3 && !apart; ++k)
+      apart = lo[k] - std::max(a[k], b[k]) > reach || std::min(a[k], b[k]) - hi[k] > reach;
+    if (!apart && box_segment_dist(lo, hi, a, b) <= reach) return true;
+  }
+  return false;
+}
+
 WellSurfaces well_surfaces(const std::vector<WellBlock>& blocks, const std::vector<std::vector<int32_t>>& well_node_ids) {
   WellSurfaces out;
   std::set<int32_t> verts;
@@ -157,15 +169,8 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
   for (size_t w = 0; w < blocks.size(); ++w) {
     const std::vector<Vec3>& traj = blocks[w].trajectory;  // the meshed part
     const double reach = dil * blocks[w].radii.back();     // the block's drainage radius (meshed_trajectory.hpp)
-    Vec3 lo = traj[0], hi = traj[0];
-    for (Vec3 p : traj)
-      for (int a = 0; a < 3; ++a) { lo[a] = std::min(lo[a], p[a]); hi[a] = std::max(hi[a], p[a]); }
-    for (int c = 0; c < nc; ++c) {
-      const Vec3 clo = grid.cell_lo(c), chi = grid.cell_hi(c);
-      bool far = false;
-      for (int a = 0; a < 3; ++a) far = far || clo[a] > hi[a] + reach || chi[a] < lo[a] - reach;
-      if (!far && box_polyline_dist(clo, chi, traj) <= reach) active[c] = 0;
-    }
+    for (int c = 0; c < nc; ++c)
+      if (box_polyline_within(grid.cell_lo(c), grid.cell_hi(c), traj, reach)) active[c] = 0;
   }
   for (int32_t c : extra_deactivated)
     if (c >= 0 && c < nc) active[c] = 0;

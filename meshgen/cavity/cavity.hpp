@@ -89,6 +89,9 @@ CavitySet build_cavities(const CaseSpec& cs, const ReservoirGrid& grid, const st
 
 /// Distance from the axis-aligned box [lo, hi] to a polyline.
 double box_polyline_distance(Vec3 lo, Vec3 hi, const std::vector<Vec3>& line);
+/// box_polyline_distance(lo, hi, line) <= reach, without the distance to the segments that are
+/// farther than reach along one axis (most of a model's cells).
+bool box_polyline_within(Vec3 lo, Vec3 hi, const std::vector<Vec3>& line, double reach);
 
 /// Makes the boundary of the deactivated set (active[c] == 0) a 2-manifold in the grid's index
 /// space: around every lattice node the deactivated and the active cells of its 2x2x2

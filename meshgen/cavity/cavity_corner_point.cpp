@@ -131,7 +131,7 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
   for (const WellBlock& b : blocks) {
     const double reach = dil * b.radii.back();
     for (int c = 0; c < nc; ++c)
-      if (cells.meshed[c] && box_polyline_distance(lo[c], hi[c], b.trajectory) <= reach) active[c] = 0;
+      if (cells.meshed[c] && box_polyline_within(lo[c], hi[c], b.trajectory, reach)) active[c] = 0;
   }
   for (int32_t c : extra_deactivated)
     if (c >= 0 && c < nc) active[c] = 0;
