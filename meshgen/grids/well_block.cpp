@@ -820,15 +820,24 @@ std::vector<Vec3> meshed_axis(const WellBlock& block) {
   return axis;
 }
 
-std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder) {
+std::vector<int32_t> add_well_block_nodes(const WellBlock& block, MeshBuilder& builder) {
   std::vector<int32_t> ids(block.nodes.size());
   for (size_t i = 0; i < block.nodes.size(); ++i) ids[i] = builder.add_node(block.nodes[i]);
+  return ids;
+}
+
+void add_well_block_cells(const WellBlock& block, const std::vector<int32_t>& ids, MeshBuilder& builder) {
   for (size_t c = 0; c < block.cell_faces.size(); ++c) {
     std::vector<CellFace> faces = block.cell_faces[c];
     for (CellFace& f : faces)
       for (int32_t& v : f.nodes) v = ids[v];
     builder.add_cell(faces, block.cell_attrs[c]);
   }
+}
+
+std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder) {
+  std::vector<int32_t> ids = add_well_block_nodes(block, builder);
+  add_well_block_cells(block, ids, builder);
   return ids;
 }
 

@@ -83,6 +83,9 @@ std::vector<Vec3> meshed_axis(const WellBlock& block);
 
 /// Adds the block's nodes and cells to the builder; returns the builder id of each local node.
 std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder);
+/// The two halves of add_well_block: the nodes (their builder ids), then the cells on those ids.
+std::vector<int32_t> add_well_block_nodes(const WellBlock& block, MeshBuilder& builder);
+void add_well_block_cells(const WellBlock& block, const std::vector<int32_t>& ids, MeshBuilder& builder);
 
 /// L* such that the block's volume is (outer - inner polygon area) x L* and the wellbore
 /// hole's is (inner polygon area) x L*: the trajectory length, less 2 t per bend, plus

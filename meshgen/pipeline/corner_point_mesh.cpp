@@ -8,12 +8,15 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "hybrid_mesh.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/grids/corner_point_multipliers.hpp"
+#include "meshgen/core/parallel.hpp"
+#include "meshgen/core/progress.hpp"
 #include "meshgen/core/two_point.hpp"
 #include "perforations.hpp"
 #include "transition_assembly.hpp"
@@ -190,8 +193,8 @@ std::string well_names(const CaseSpec& cs, const std::vector<int>& wells) {
 }
 
 // Wells in the model: blocks, cavities (enlarged where a transition asks, at most
-// kMaxEnlargements times), transitions; then the mesh is assembled again from the start with the
-// same node ids (the radial cells' rock needs the cavities' model cells).
+// kMaxEnlargements times), transitions; then the cells are added to the builder that holds the
+// nodes (the radial cells' rock needs the cavities' model cells).
 HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions& opts) {
   const CornerPointModel& model = *input.reservoir.corner_point;
   CaseSpec cs = input;
@@ -213,20 +216,14 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   }
   stage.mark("well_blocks");
 
-  // Nodes: the model's, then each block's (the same ids in both builders).
-  auto add_nodes = [&](MeshBuilder& b, CornerPointCellFaces& faces, std::vector<std::vector<int32_t>>& well_nodes,
-                       const std::vector<WellBlock>& blocks) {
-    faces = corner_point_cell_faces(model, all_present(model), b);
-    well_nodes.clear();
-    for (const WellBlock& blk : blocks) well_nodes.push_back(add_well_block(blk, b));
-  };
-  MeshBuilder scratch;
-  CornerPointCellFaces faces;
+  // Nodes: the model's, then each block's.
+  MeshBuilder builder;
+  const CornerPointCellFaces faces = corner_point_cell_faces(model, all_present(model), builder);
   std::vector<std::vector<int32_t>> well_nodes;
-  add_nodes(scratch, faces, well_nodes, out.blocks);
-  std::vector<Vec3> coords(scratch.n_nodes());
-  for (int32_t i = 0; i < scratch.n_nodes(); ++i) coords[i] = scratch.node(i);
-  const int32_t base = scratch.n_nodes();
+  for (const WellBlock& blk : out.blocks) well_nodes.push_back(add_well_block_nodes(blk, builder));
+  std::vector<Vec3> coords(builder.n_nodes());
+  for (int32_t i = 0; i < builder.n_nodes(); ++i) coords[i] = builder.node(i);
+  const int32_t base = builder.n_nodes();
 
   TransitionOptions topts;
   topts.optimize = opts.optimize && cs.transition.optimize;
@@ -236,6 +233,17 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   std::vector<int32_t> extra;
   std::string asked_by;  // the latest refusal that enlarged a cavity
   std::vector<TransitionCells> transitions;
+  // Transitions of a round's cavities are built concurrently (at most opts.threads); a cavity that
+  // an enlargement left as it was (same wells, cells and faces) keeps the transition it had. Every
+  // refusal of a round enlarges its cavity at once; results are taken in cavity order, so the mesh
+  // does not depend on scheduling or on opts.threads.
+  struct Built {
+    std::vector<int> wells;
+    std::vector<int32_t> deactivated;
+    size_t faces = 0;
+    TransitionCells cells;
+  };
+  std::vector<Built> cache;
   for (int round = 0;; ++round) {
     try {
       out.cavities = build_corner_point_cavities(cs, model, faces, out.blocks, well_nodes, coords, extra);
@@ -253,29 +261,56 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
                                " in the corner-point model: boundary is not a closed 2-manifold: " + problems[0]);
     }
     if (!opts.build_transition) break;
-    transitions.clear();
-    bool refused = false;
-    for (int k = 0; k < nk && !refused; ++k) {
+    std::vector<std::optional<TransitionOutcome>> outcomes(nk);
+    std::vector<int> to_build;
+    for (int k = 0; k < nk; ++k) {
       const Cavity& cav = out.cavities.cavities[k];
-      ++out.transition_builds;
-      TransitionOutcome o = try_build_transition(cav, coords, out.grid, out.blocks, base, topts);
-      if (o.ok()) {
-        transitions.push_back(std::move(o.cells));
+      for (Built& b : cache)
+        if (!b.wells.empty() && b.wells == cav.wells && b.deactivated == cav.deactivated_cells && b.faces == cav.faces.size()) {
+          outcomes[k] = TransitionOutcome{std::move(b.cells), std::nullopt};
+          b.wells.clear();  // used
+          break;
+        }
+      if (!outcomes[k]) to_build.push_back(k), ++out.transition_builds;
+    }
+    Progress progress(topts.optimize ? "transition meshes + optimisation (cavities)" : "transition meshes (cavities)",
+                      static_cast<int64_t>(to_build.size()));
+    parallel_ranges(
+        static_cast<int64_t>(to_build.size()),
+        [&](int64_t begin, int64_t end) {
+          for (int64_t i = begin; i < end; ++i) {
+            const int k = to_build[i];
+            outcomes[k] = try_build_transition(out.cavities.cavities[k], coords, out.grid, out.blocks, base, topts);
+            progress.advance();
+          }
+        },
+        1);
+    bool refused = false;
+    for (int k = 0; k < nk; ++k) refused = refused || !outcomes[k]->ok();
+    if (!refused) {
+      transitions.clear();
+      for (int k = 0; k < nk; ++k) transitions.push_back(std::move(outcomes[k]->cells));
+      break;
+    }
+    cache.clear();
+    for (int k = 0; k < nk; ++k) {
+      const Cavity& cav = out.cavities.cavities[k];
+      if (outcomes[k]->ok()) {
+        cache.push_back({cav.wells, cav.deactivated_cells, cav.faces.size(), std::move(outcomes[k]->cells)});
         continue;
       }
-      refused = true;
-      if (round >= kMaxEnlargements || o.refusal->cells_to_deactivate.empty())
+      const TransitionRefusal& r = *outcomes[k]->refusal;
+      if (round >= kMaxEnlargements || r.cells_to_deactivate.empty())
         throw MeshingError("transition", cav.wells,
                            "transition of the cavity of " + well_names(cs, cav.wells) + " in the corner-point model: " +
-                               o.refusal->reason + (round > 0 ? " (after " + std::to_string(round) + " cavity enlargements)" : "") +
+                               r.reason + (round > 0 ? " (after " + std::to_string(round) + " cavity enlargements)" : "") +
                                " (docs/corner-point.md)");
-      extra.insert(extra.end(), o.refusal->cells_to_deactivate.begin(), o.refusal->cells_to_deactivate.end());
-      asked_by = o.refusal->reason;
-      out.notes.push_back("cavity: " + std::to_string(o.refusal->cells_to_deactivate.size()) +
+      extra.insert(extra.end(), r.cells_to_deactivate.begin(), r.cells_to_deactivate.end());
+      asked_by = r.reason;
+      out.notes.push_back("cavity: " + std::to_string(r.cells_to_deactivate.size()) +
                           " model cells deactivated so that the transition of " + well_names(cs, cav.wells) +
-                          " can be built (" + o.refusal->reason + ")");
+                          " can be built (" + r.reason + ")");
     }
-    if (!refused) break;
   }
   if (!model.parent_cell.empty())
     out.notes.push_back("reservoir: the model's columns near the wells are refined (reservoir.near_well_cell_size): " +
@@ -299,8 +334,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   for (WellBlock& b : out.blocks)
     for (CellAttributes& at : b.cell_attrs) set_rock(at);
 
-  MeshBuilder builder;
-  add_nodes(builder, faces, well_nodes, out.blocks);
+  for (size_t w = 0; w < out.blocks.size(); ++w) add_well_block_cells(out.blocks[w], well_nodes[w], builder);
   add_corner_point_cells(model, faces, cs.reservoir, out.cavities.reservoir_active, builder);
   stage.mark("reservoir_cells");
   const TransitionCellMaps maps = add_transition_cells(transitions, set_rock, builder, out.transition_reports);
