@@ -15,8 +15,6 @@
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/grids/corner_point_multipliers.hpp"
-#include "meshgen/core/parallel.hpp"
-#include "meshgen/core/progress.hpp"
 #include "meshgen/core/two_point.hpp"
 #include "perforations.hpp"
 #include "transition_assembly.hpp"
@@ -273,23 +271,9 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
         }
       if (!outcomes[k]) to_build.push_back(k), ++out.transition_builds;
     }
-    Progress progress(topts.optimize ? "transition meshes + optimisation (cavities)" : "transition meshes (cavities)",
-                      static_cast<int64_t>(to_build.size()));
-    parallel_ranges(
-        static_cast<int64_t>(to_build.size()),
-        [&](int64_t begin, int64_t end) {
-          for (int64_t i = begin; i < end; ++i) {
-            const int k = to_build[i];
-            outcomes[k] = try_build_transition(out.cavities.cavities[k], coords, out.grid, out.blocks, base, topts);
-            progress.advance();
-          }
-        },
-        1);
-    bool refused = false;
-    for (int k = 0; k < nk; ++k) refused = refused || !outcomes[k]->ok();
-    if (!refused) {
-      transitions.clear();
-      for (int k = 0; k < nk; ++k) transitions.push_back(std::move(outcomes[k]->cells));
+    build_transitions(to_build, out.cavities.cavities, coords, out.grid, out.blocks, base, topts, opts.threads, outcomes);
+    if (auto all = all_transitions(outcomes)) {
+      transitions = std::move(*all);
       break;
     }
     cache.clear();

@@ -6,8 +6,6 @@
 #include <set>
 #include <stdexcept>
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "meshgen/core/progress.hpp"
 #include "perforations.hpp"
@@ -296,21 +294,9 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
         to_build.push_back(k);
       }
     }
-    Progress progress(topts.optimize ? "transition meshes + optimisation (cavities)" : "transition meshes (cavities)",
-                      static_cast<int64_t>(to_build.size()));
-    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
-    arena.execute([&] {
-      tbb::parallel_for(size_t(0), to_build.size(), [&](size_t i) {
-        const int k = to_build[i];
-        outcomes[k] = try_build_transition(out.cavities.cavities[k], coords, out.grid, out.blocks, base, topts);
-        progress.advance();
-      });
-    });
-    bool refused = false;
-    for (int k = 0; k < nk; ++k) refused = refused || !outcomes[k]->ok();
-    if (!refused) {
-      transitions.clear();
-      for (int k = 0; k < nk; ++k) transitions.push_back(std::move(outcomes[k]->cells));
+    build_transitions(to_build, out.cavities.cavities, coords, out.grid, out.blocks, base, topts, opts.threads, outcomes);
+    if (auto all = all_transitions(outcomes)) {
+      transitions = std::move(*all);
       break;
     }
     cache.clear();

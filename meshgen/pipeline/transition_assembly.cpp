@@ -1,6 +1,35 @@
 #include "transition_assembly.hpp"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "meshgen/core/progress.hpp"
+
 namespace hm {
+
+void build_transitions(const std::vector<int>& to_build, const std::vector<Cavity>& cavities,
+                       const std::vector<Vec3>& coords, const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                       int32_t base, const TransitionOptions& options, int threads,
+                       std::vector<std::optional<TransitionOutcome>>& outcomes) {
+  Progress progress(options.optimize ? "transition meshes + optimisation (cavities)" : "transition meshes (cavities)",
+                    static_cast<int64_t>(to_build.size()));
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), to_build.size(), [&](size_t i) {
+      const int k = to_build[i];
+      outcomes[k] = try_build_transition(cavities[k], coords, grid, blocks, base, options);
+      progress.advance();
+    });
+  });
+}
+
+std::optional<std::vector<TransitionCells>> all_transitions(std::vector<std::optional<TransitionOutcome>>& outcomes) {
+  for (const auto& o : outcomes)
+    if (!o->ok()) return std::nullopt;
+  std::vector<TransitionCells> cells;
+  for (auto& o : outcomes) cells.push_back(std::move(o->cells));
+  return cells;
+}
 
 TransitionCellMaps add_transition_cells(const std::vector<TransitionCells>& transitions,
                                         const std::function<void(CellAttributes&)>& set_rock, MeshBuilder& builder,

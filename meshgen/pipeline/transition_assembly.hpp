@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "hybrid_mesh.hpp"
@@ -15,6 +16,16 @@ struct TransitionCellMaps {
   std::vector<int32_t> cavity;
   std::vector<double> h_ref;
 };
+
+/// outcomes[k] = try_build_transition of cavity k for every k in `to_build`, concurrently (at most
+/// `threads`, <= 0: every core), with a progress line; the outcomes do not depend on scheduling.
+void build_transitions(const std::vector<int>& to_build, const std::vector<Cavity>& cavities,
+                       const std::vector<Vec3>& coords, const ReservoirGrid& grid, const std::vector<WellBlock>& blocks,
+                       int32_t base, const TransitionOptions& options, int threads,
+                       std::vector<std::optional<TransitionOutcome>>& outcomes);
+
+/// Every cavity's cells in cavity order (moved out of `outcomes`) when none was refused, else nothing.
+std::optional<std::vector<TransitionCells>> all_transitions(std::vector<std::optional<TransitionOutcome>>& outcomes);
 
 /// Adds every cavity's new nodes (renumbered cavity by cavity from the builder's next id) and cells
 /// (region kTransition, FV centre = site, rock from `set_rock`), and appends each cavity's report.

@@ -422,6 +422,25 @@ fs::path reek_deck() {
   return deck;
 }
 
+// The case meshed as meshgen does it (in the local frame: the model's min corner in plan at the
+// origin); a failure is the test's.
+HybridMesh mesh_in_local_frame(const CaseSpec& cs) {
+  try {
+    return build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << e.what();
+    return {};
+  }
+}
+
+// The mesh's volume over the (refined) model's minus the wellbore hole of well 0.
+double volume_over_model_minus_hole(const CaseSpec& cs, const HybridMesh& out) {
+  double v = 0, v0 = 0;
+  for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
+  for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
+  return v / (v0 - exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors));
+}
+
 // Reek's well SW1: a vertical well in column (8, 52) (0-based (7, 51)), from the top face centre of
 // layer 6 to the bottom face centre of layer 9, in map coordinates as a user gives a well.
 struct ReekSteepWell {
@@ -460,20 +479,12 @@ TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
   EXPECT_THROW(build_hybrid_mesh(load_case((tmp.path / "off.yaml").string())), InputError);
   std::ofstream(tmp.path / "reek.yaml") << text("");
   const CaseSpec cs = load_case((tmp.path / "reek.yaml").string());
-  HybridMesh out;
-  try {
-    // As meshgen does: in the local frame (the model's min corner in plan at the origin).
-    out = build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
-  } catch (const std::exception& e) {
-    FAIL() << e.what();
-  }
+  const HybridMesh out = mesh_in_local_frame(cs);
+  ASSERT_FALSE(out.blocks.empty());
   ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
   EXPECT_TRUE(out.build_report.ok);
-  double v = 0, v0 = 0;
-  for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
-  for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
-  const double hole = exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors);
-  EXPECT_NEAR(v / (v0 - hole), 1.0, 1e-9);
+  const double volume = volume_over_model_minus_hole(cs, out);
+  EXPECT_NEAR(volume, 1.0, 1e-9);
   const nlohmann::json summary = make_summary(cs, out);
   EXPECT_EQ(summary["corner_point"]["model"], nlohmann::json::array({40, 64, 14}));
   EXPECT_EQ(summary["corner_point"]["meshed"],
@@ -483,7 +494,7 @@ TEST(NearWellRefinement, ReekWellWhereThePillarsAreSteepMeshes) {
   std::printf("[ figures  ] Reek, well in column (8, 52), R = %g m: model 40 x 64 refined to %d x %d, %d cells (%d "
               "transition), volume rel. %.1e\n",
               radius, cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny, out.mesh.n_cells(), transition,
-              v / (v0 - hole) - 1);
+              volume - 1);
 }
 
 // The same well at R = 10 m (its cavity reaches the model's bottom; the flat end cap lies 4.5 mm above
@@ -504,17 +515,11 @@ TEST(NearWellRefinement, ReekWellMeshesWhereverItsEndIsRounded) {
     std::ofstream(tmp.path / name) << well.case_text(deck, radius);
     const CaseSpec cs = load_case((tmp.path / name).string());
     ASSERT_EQ(cs.wells[0].trajectory.back().z, well.bottom.z) << "the case file does not carry the end depth exactly";
-    HybridMesh out;
-    try {
-      out = build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
-    } catch (const std::exception& e) {
-      FAIL() << "end depth " << (ulps ? "1738.5255 + 1 ulp" : "1738.5255") << ": " << e.what();
-    }
+    SCOPED_TRACE(ulps ? "end depth 1738.5255 + 1 ulp" : "end depth 1738.5255");
+    const HybridMesh out = mesh_in_local_frame(cs);
+    ASSERT_FALSE(out.blocks.empty());
     ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
-    double v = 0, v0 = 0;
-    for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
-    for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
-    EXPECT_NEAR(v / (v0 - exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors)), 1.0, 1e-9);
+    EXPECT_NEAR(volume_over_model_minus_hole(cs, out), 1.0, 1e-9);
     cells.push_back(out.mesh.n_cells());
     std::printf("[ figures  ] Reek SW1, R = 10 m, end depth %s: %d cells, %d sliver removals\n",
                 ulps ? "1738.5255 + 1 ulp" : "1738.5255", out.mesh.n_cells(),
@@ -643,17 +648,10 @@ TEST(NearWellRefinement, ReekOp2MeshesWithItsPillarsTurnedUpright) {
   bool turned = false;
   for (const std::string& n : cs.notes) turned = turned || n.find("pillars turned upright") != std::string::npos;
   EXPECT_TRUE(turned);
-  HybridMesh out;
-  try {
-    out = build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
-  } catch (const std::exception& e) {
-    FAIL() << e.what();
-  }
+  const HybridMesh out = mesh_in_local_frame(cs);
+  ASSERT_FALSE(out.blocks.empty());
   ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
-  double v = 0, v0 = 0;
-  for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
-  for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
-  EXPECT_NEAR(v / (v0 - exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors)), 1.0, 1e-9);
+  EXPECT_NEAR(volume_over_model_minus_hole(cs, out), 1.0, 1e-9);
   std::printf("[ figures  ] Reek OP_2, R = %g m: %d cells, model refined to %d x %d\n", radius, out.mesh.n_cells(),
               cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny);
 }
