@@ -6,7 +6,6 @@
 #include <set>
 #include <stdexcept>
 
-
 #include "meshgen/core/progress.hpp"
 #include "perforations.hpp"
 #include "transition_assembly.hpp"
