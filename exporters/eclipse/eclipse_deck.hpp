@@ -125,6 +125,33 @@ struct EclipseConnections {
 EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseLayout& layout,
                                             const Transmissibilities& trans);
 
+/// Flow's test of a logical neighbour in the deck: natural indices a < b differing by 1, NX or
+/// NX*NY (a pair across a row's end included, as in flow).
+bool flow_logical_neighbours(const EclipseLayout& layout, int32_t a, int32_t b);
+
+/// The connections OPM Flow leaves out of the deck's equation.
+struct FlowDroppedConnections {
+  int pairs = 0;          ///< deck cell pairs set to 0
+  int model_pairs = 0;    ///< of them, pairs of two model cells (the user's own, e.g. across a sealing fault)
+  double sum = 0;         ///< their summed |T| before (cP.rm3/day/bar)
+};
+
+/// Sets to 0 in `trans` (faces and NNCs) every pair of deck cells that flow does not connect:
+/// not logical neighbours, summed transmissibility below kFlowNncThreshold
+/// (`removeSmallNonCartesianTransmissibilities_`; flow applies it to the user's own deck too).
+/// A solve with the result is the deck's equation; the deck written with it lists none of them.
+FlowDroppedConnections drop_connections_flow_ignores(const PolyMesh& mesh, const EclipseLayout& layout,
+                                                     Transmissibilities* trans);
+
+/// "N connections below flow's threshold (M between model cells, sum S) are not connected, as in flow".
+std::string describe(const FlowDroppedConnections& dropped);
+
+/// The same on the layout write_eclipse_deck makes of (reservoir, mesh, options). False, `trans`
+/// untouched and `error` set, when the mesh has no deck layout (no deck can be written).
+bool drop_connections_flow_ignores(const ReservoirSpec& reservoir, const PolyMesh& mesh,
+                                   const EclipseDeckOptions& options, Transmissibilities* trans,
+                                   FlowDroppedConnections* dropped, std::string* error);
+
 /// What write_eclipse_deck wrote.
 struct EclipseDeckInfo {
   std::string data_file;              ///< dir/NAME.DATA

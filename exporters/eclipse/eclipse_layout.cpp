@@ -245,10 +245,8 @@ EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseL
     else
       out.nnc.push_back(r);
   }
-  // Flow's test: index difference not 1, NX or NX*NY (it keeps small logical-neighbour connections).
-  const int32_t nxd = L.deck_nx, nxy = L.deck_nx * L.ny;
   for (const auto& r : out.nnc) {
-    if (r.b - r.a == 1 || r.b - r.a == nxd || r.b - r.a == nxy) continue;
+    if (flow_logical_neighbours(L, r.a, r.b)) continue;
     if (std::abs(r.t) < kFlowNncThreshold) {
       ++out.below_flow_threshold;
       out.below_flow_threshold_sum += std::abs(r.t);
@@ -257,6 +255,63 @@ EclipseConnections make_eclipse_connections(const PolyMesh& mesh, const EclipseL
     }
   }
   return out;
+}
+
+bool flow_logical_neighbours(const EclipseLayout& L, int32_t a, int32_t b) {
+  const int32_t d = std::abs(b - a);
+  return d == 1 || d == L.deck_nx || d == L.deck_nx * L.ny;
+}
+
+FlowDroppedConnections drop_connections_flow_ignores(const PolyMesh& mesh, const EclipseLayout& L,
+                                                     Transmissibilities* trans) {
+  // Every face and NNC joining deck cells that are not logical neighbours, by deck pair: its T is
+  // face[index] (index >= 0) or nnc[-1 - index].
+  struct Link {
+    int32_t a, b, index;
+  };
+  std::vector<Link> links;
+  auto add = [&](int32_t c0, int32_t c1, int32_t index) {
+    const int32_t a = L.cell_deck_index[c0], b = L.cell_deck_index[c1];
+    if (!flow_logical_neighbours(L, a, b)) links.push_back({std::min(a, b), std::max(a, b), index});
+  };
+  for (int32_t f = 0; f < mesh.n_faces(); ++f)
+    if (mesh.face_neighbour[f] >= 0 && trans->face[f] != 0) add(mesh.face_owner[f], mesh.face_neighbour[f], f);
+  for (int32_t i = 0; i < mesh.n_nncs(); ++i)
+    if (trans->nnc[i] != 0) add(mesh.nnc_cells[i][0], mesh.nnc_cells[i][1], -1 - i);
+  std::sort(links.begin(), links.end(), [](const Link& x, const Link& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  auto t_of = [&](const Link& l) -> double& { return l.index >= 0 ? trans->face[l.index] : trans->nnc[-1 - l.index]; };
+  FlowDroppedConnections out;
+  for (size_t begin = 0, end = 0; begin < links.size(); begin = end) {
+    double t = 0;
+    for (end = begin; end < links.size() && links[end].a == links[begin].a && links[end].b == links[begin].b; ++end)
+      t += t_of(links[end]);
+    // Flow's test is signed: a negative pair is dropped too (write_eclipse_deck refuses those first).
+    if (!(t < kFlowNncThreshold)) continue;
+    ++out.pairs;
+    out.sum += std::abs(t);
+    const int32_t c0 = L.deck_cell[links[begin].a], c1 = L.deck_cell[links[begin].b];
+    if (mesh.cell_region[c0] == kReservoir && mesh.cell_region[c1] == kReservoir) ++out.model_pairs;
+    for (size_t k = begin; k < end; ++k) t_of(links[k]) = 0;
+  }
+  return out;
+}
+
+std::string describe(const FlowDroppedConnections& d) {
+  std::ostringstream s;
+  s << d.pairs << " connections between cells that are not logical neighbours have T < " << kFlowNncThreshold
+    << " cP.rm3/day/bar (" << d.model_pairs << " of them between model cells, sum " << d.sum
+    << "): not connected, as OPM Flow does";
+  return s.str();
+}
+
+bool drop_connections_flow_ignores(const ReservoirSpec& reservoir, const PolyMesh& mesh,
+                                   const EclipseDeckOptions& options, Transmissibilities* trans,
+                                   FlowDroppedConnections* dropped, std::string* error) {
+  EclipseLayout layout;
+  if (!make_eclipse_layout(reservoir, mesh, options, &layout, error)) return false;
+  const FlowDroppedConnections d = drop_connections_flow_ignores(mesh, layout, trans);
+  if (dropped) *dropped = d;
+  return true;
 }
 
 }  // namespace hm

@@ -169,6 +169,13 @@ int main(int argc, char** argv) {
     written.push_back(p.string());
   }
   if (export_eclipse) {
+    // Flow leaves out connections below its threshold; the deck does not carry them, and solver_demo
+    // drops the same ones (a mesh without a deck layout is refused by write_eclipse_deck below).
+    hm::FlowDroppedConnections dropped;
+    std::string no_layout;
+    if (hm::drop_connections_flow_ignores(cs.reservoir, result.mesh, deck_opts, &*trans, &dropped, &no_layout) &&
+        dropped.pairs > 0)
+      std::cout << "  eclipse: " << hm::describe(dropped) << "\n";
     hm::EclipseDeckInfo info;
     const hm::WriteStatus st =
         hm::write_eclipse_deck((out / "eclipse").string(), cs, result.mesh, result.geometry, *trans, deck_opts, &info);

@@ -119,8 +119,11 @@ std::vector<std::string> export_mesh(Mesh& m, const std::string& out_dir, const 
     hm::EclipseDeckInfo info;
     // The deck's transmissibilities, as meshgen --export eclipse writes them and solver_demo solves with
     // (on a corner-point model's cells OPM's form; `transmissibilities` above stays the checker's).
-    const hm::Transmissibilities deck_trans =
+    hm::Transmissibilities deck_trans =
         hm::compute_transmissibilities(r.mesh, r.geometry, hm::deck_transmissibility_options());
+    hm::FlowDroppedConnections dropped;
+    std::string no_layout;  // write_eclipse_deck below says why
+    hm::drop_connections_flow_ignores(m.cs.reservoir, r.mesh, {}, &deck_trans, &dropped, &no_layout);
     need(hm::write_eclipse_deck(dir + "eclipse", m.cs, r.mesh, r.geometry, deck_trans, {}, &info));
     written.push_back(info.data_file);
   }

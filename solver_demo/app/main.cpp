@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "exporters/eclipse/eclipse_deck.hpp"
 #include "exporters/vtu/vtu_reader.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
@@ -95,8 +96,16 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mes
   if (const int rc = guarded([&] {
         if (mesh_file.empty()) mesh = hm::build_hybrid_mesh(cs);
         const hm::FlowProblem pb = hm::deck_flow_problem(cs, mesh.mesh, mesh.geometry);
-        // The transmissibilities of the exported deck (docs/export-eclipse.md, "A corner-point model").
-        sol = hm::solve_tpfa(pb, hm::compute_transmissibilities(mesh.mesh, mesh.geometry, hm::deck_transmissibility_options()));
+        // The transmissibilities of the exported deck (docs/export-eclipse.md, "A corner-point model"),
+        // without the connections flow leaves out of it: the deck's equation.
+        hm::Transmissibilities trans =
+            hm::compute_transmissibilities(mesh.mesh, mesh.geometry, hm::deck_transmissibility_options());
+        hm::FlowDroppedConnections dropped;
+        std::string no_layout;
+        if (hm::drop_connections_flow_ignores(cs.reservoir, mesh.mesh, {}, &trans, &dropped, &no_layout) &&
+            dropped.pairs > 0)
+          std::cout << "solver_demo: " << hm::describe(dropped) << "\n";
+        sol = hm::solve_tpfa(pb, trans);
       }))
     return rc;
 

@@ -2,6 +2,7 @@
 // (Running flow on the deck: test_flow_deck.cpp.)
 #include <gtest/gtest.h>
 
+#include <map>
 #include <numeric>
 
 #include "exporter_test_support.hpp"
@@ -240,6 +241,57 @@ TEST(EclipseConnections, EveryInteriorFaceIsCarriedExactlyOnce) {
     const bool b_res = fx.mesh.cell_region[L.deck_cell[r.b]] == hm::kReservoir;
     EXPECT_FALSE(a_res && b_res);
   }
+}
+
+// Flow's rule (removeSmallNonCartesianTransmissibilities_): a pair of deck cells that are not logical
+// neighbours whose summed T is below 1e-6 (or negative) is not connected; logical neighbours keep any
+// T. drop_connections_flow_ignores zeroes exactly those pairs, all their faces.
+TEST(EclipseConnections, PairsFlowLeavesOutAreZeroedAndNoOthers) {
+  Fixture fx;
+  hm::EclipseLayout L;
+  std::string error;
+  ASSERT_TRUE(hm::make_eclipse_layout(fx.cs.reservoir, fx.mesh, {}, &L, &error)) << error;
+  // Interior faces by deck pair.
+  std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> faces_of;
+  for (int32_t f = 0; f < fx.mesh.n_faces(); ++f) {
+    if (fx.mesh.face_neighbour[f] < 0) continue;
+    const int32_t a = L.cell_deck_index[fx.mesh.face_owner[f]], b = L.cell_deck_index[fx.mesh.face_neighbour[f]];
+    faces_of[{std::min(a, b), std::max(a, b)}].push_back(f);
+  }
+  std::vector<std::pair<int32_t, int32_t>> far, near;
+  for (const auto& [pair, faces] : faces_of)
+    (hm::flow_logical_neighbours(L, pair.first, pair.second) ? near : far).push_back(pair);
+  ASSERT_GE(far.size(), 3u);
+  ASSERT_GE(near.size(), 1u);
+  hm::Transmissibilities t = fx.trans;
+  auto set_pair = [&](std::pair<int32_t, int32_t> pair, double total) {
+    const auto& faces = faces_of[pair];
+    for (int32_t f : faces) t.face[f] = total / static_cast<double>(faces.size());
+  };
+  set_pair(far[0], 0.4 * hm::kFlowNncThreshold);   // dropped
+  set_pair(far[1], -3.0);                          // dropped (flow's test is signed)
+  set_pair(far[2], 2.0 * hm::kFlowNncThreshold);   // kept
+  set_pair(near[0], 0.1 * hm::kFlowNncThreshold);  // kept: logical neighbours
+  const hm::Transmissibilities before = t;
+  EXPECT_EQ(hm::make_eclipse_connections(fx.mesh, L, t).below_flow_threshold, 1);
+  const hm::FlowDroppedConnections d = hm::drop_connections_flow_ignores(fx.mesh, L, &t);
+  EXPECT_EQ(d.pairs, 2);
+  EXPECT_EQ(d.model_pairs, 0);
+  EXPECT_NEAR(d.sum, 3.0 + 0.4 * hm::kFlowNncThreshold, 1e-12);
+  for (int32_t f = 0; f < fx.mesh.n_faces(); ++f) {
+    const int32_t a = L.cell_deck_index[fx.mesh.face_owner[f]];
+    const int32_t b = fx.mesh.face_neighbour[f] < 0 ? -1 : L.cell_deck_index[fx.mesh.face_neighbour[f]];
+    const std::pair<int32_t, int32_t> pair{std::min(a, b), std::max(a, b)};
+    if (b >= 0 && (pair == far[0] || pair == far[1]))
+      EXPECT_EQ(t.face[f], 0.0) << "face " << f;
+    else
+      EXPECT_EQ(t.face[f], before.face[f]) << "face " << f;
+  }
+  const hm::EclipseConnections after = hm::make_eclipse_connections(fx.mesh, L, t);
+  EXPECT_EQ(after.below_flow_threshold, 0);
+  EXPECT_EQ(after.negative_nnc, 0);
+  // Applied twice, nothing more goes.
+  EXPECT_EQ(hm::drop_connections_flow_ignores(fx.mesh, L, &t).pairs, 0);
 }
 
 TEST(EclipseDeck, WritesOurNumbersBitForBit) {

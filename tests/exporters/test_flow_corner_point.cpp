@@ -54,6 +54,10 @@ void run_case(const TempDir& tmp, const TiltedModel& model, const std::string& w
   }
   const hm::PolyMesh& mesh = r->out.mesh;
   r->trans = hm::compute_transmissibilities(mesh, r->out.geometry, hm::deck_transmissibility_options());
+  // The deck's equation: without the connections flow leaves out (none of them is then in the deck).
+  std::string no_layout;
+  hm::FlowDroppedConnections dropped;
+  ASSERT_TRUE(hm::drop_connections_flow_ignores(r->cs.reservoir, mesh, {}, &r->trans, &dropped, &no_layout)) << no_layout;
   r->ours = hm::solve_tpfa(hm::deck_flow_problem(r->cs, mesh, r->out.geometry), r->trans);
   const fs::path deck = tmp.path / "deck";
   const hm::WriteStatus st = hm::write_eclipse_deck(deck.string(), r->cs, mesh, r->out.geometry, r->trans, {}, &r->info);
@@ -69,6 +73,7 @@ void run_case(const TempDir& tmp, const TiltedModel& model, const std::string& w
   const hm::EclipseConnections conn = hm::make_eclipse_connections(mesh, r->info.layout, r->trans);
   r->c = compare_flow(r->cs, mesh, r->out.geometry, r->info, ours, conn, r->run.results);
   ASSERT_TRUE(r->c.problem.empty()) << r->c.problem;
+  EXPECT_EQ(r->c.dropped_by_flow, 0u) << "flow left out connections the deck carries";
 }
 
 // OPM's deck parser reads some 17-digit decimals one ulp off (measured: "51.449999999999996", the
