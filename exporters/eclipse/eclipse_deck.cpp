@@ -506,6 +506,13 @@ WriteStatus write_eclipse_deck(const std::string& dir, const CaseSpec& cs, const
     } else {
       o << "-- Run: flow " << name << ".DATA   (no options needed)\n\n";
     }
+    if (L.corner_point) {
+      warnings.push_back("corner-point model: if flow stops with 'Convergence failure for linear solver', run it with "
+                         "--linear-solver-max-iter=5000 (the deck's first lines say why)");
+      o << "-- On a large corner-point model flow's default linear solver (ILU0, 200 iterations) can stop with\n"
+        << "-- 'Convergence failure for linear solver' (refined Reek, 1e5-1.6e6 cells, Cw 1e-8): then add\n"
+        << "-- --linear-solver-max-iter=5000 (docs/export-eclipse.md, \"Reek with a well\").\n\n";
+    }
     o
       << "RUNSPEC\n\nTITLE\n" << name << "\n\n"
       << "DIMENS\n" << L.deck_nx << ' ' << L.ny << ' ' << L.nz << " /\n\n"
