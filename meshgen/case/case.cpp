@@ -466,35 +466,48 @@ void refine_near_wells(CaseSpec& cs) {
   for (const WellSpec& w : cs.wells) {
     const double size = r.near_well_cell_size > 0 ? r.near_well_cell_size : w.drainage_radius;
     requests.push_back({w.trajectory, size, cs.transition.dilation * w.drainage_radius + 2 * size,
-                        r.near_well_cell_size == 0});
+                        r.near_well_cell_size == 0, r.near_well_grading});
   }
-  const ColumnSplits splits = near_well_splits(*r.corner_point, requests);
+  std::vector<StraightenRequest> upright;
+  for (const RefinementRequest& q : requests)
+    upright.push_back({q.path, q.reach + 2 * q.cell_size, r.upright_pillars == ReservoirSpec::Upright::On});
   std::optional<CornerPointModel> refined_m;
-  if (splits.refines()) refined_m = refined_model(*r.corner_point, splits);
-  if (r.upright_pillars != ReservoirSpec::Upright::Off) {
-    std::vector<StraightenRequest> upright;
-    for (const RefinementRequest& q : requests)
-      upright.push_back({q.path, q.reach + 2 * q.cell_size, r.upright_pillars == ReservoirSpec::Upright::On});
-    std::vector<StraightenOutcome> outcomes;
+  std::vector<StraightenOutcome> outcomes;
+  auto refine_and_turn = [&] {
+    refined_m.reset();
+    const ColumnSplits splits = near_well_splits(*r.corner_point, requests);
+    if (splits.refines()) refined_m = refined_model(*r.corner_point, splits);
+    outcomes.clear();
+    if (r.upright_pillars == ReservoirSpec::Upright::Off) return;
     CornerPointModel turned = straightened_model(refined_m ? *refined_m : *r.corner_point, upright, &outcomes);
-    bool any = false;
-    for (size_t w = 0; w < outcomes.size(); ++w) {
-      const StraightenOutcome& o = outcomes[w];
-      const std::string well = "wells[" + std::to_string(w) + "] (" + cs.wells[w].name + ")";
-      if (o.straightened)
-        cs.notes.push_back("reservoir: the model's pillars within " + fmt6(upright[w].reach) + " m of " + well +
-                           " lean up to " + fmt6(o.max_lean_deg) + " degrees obliquely to the grid (column walls at " +
-                           fmt6(o.wall_angle_deg) + " degrees): " + std::to_string(o.pillars) +
-                           " pillars turned upright, blending back to the model's over " + fmt6(o.blend) +
-                           " m (reservoir.upright_pillars; docs/corner-point.md, \"Upright pillars near wells\")");
-      else if (!o.refused.empty())
-        cs.notes.push_back("reservoir: the model's pillars near " + well + " lean up to " + fmt6(o.max_lean_deg) +
-                           " degrees obliquely to the grid (column walls at " + fmt6(o.wall_angle_deg) +
-                           " degrees) and are kept as they are: " + o.refused + " (docs/corner-point.md, \"Upright "
-                           "pillars near wells\")");
-      any = any || o.straightened;
-    }
-    if (any) refined_m = std::move(turned);
+    if (std::any_of(outcomes.begin(), outcomes.end(), [](const StraightenOutcome& o) { return o.straightened; }))
+      refined_m = std::move(turned);
+  };
+  refine_and_turn();
+  // Where the pillars lean obliquely (turned upright, or refused) the columns are split into equal
+  // children: graded ones failed there (Reek's OP_2, whose turn graded children also refuse;
+  // docs/corner-point.md, "Graded children").
+  bool regrade = false;
+  for (size_t w = 0; w < outcomes.size(); ++w) {
+    const bool oblique = outcomes[w].straightened || outcomes[w].wall_angle_deg < kStraightenWallAngleBelow;
+    if (oblique && requests[w].graded) requests[w].graded = false, regrade = true;
+  }
+  if (regrade) refine_and_turn();
+  for (size_t w = 0; w < outcomes.size(); ++w) {
+    const StraightenOutcome& o = outcomes[w];
+    const std::string well = "wells[" + std::to_string(w) + "] (" + cs.wells[w].name + ")";
+    if (o.straightened)
+      cs.notes.push_back("reservoir: the model's pillars within " + fmt6(upright[w].reach) + " m of " + well +
+                         " lean up to " + fmt6(o.max_lean_deg) + " degrees obliquely to the grid (column walls at " +
+                         fmt6(o.wall_angle_deg) + " degrees): " + std::to_string(o.pillars) +
+                         " pillars turned upright, blending back to the model's over " + fmt6(o.blend) +
+                         " m, the columns there split into equal children (reservoir.upright_pillars; docs/corner-point.md, "
+                         "\"Upright pillars near wells\")");
+    else if (!o.refused.empty())
+      cs.notes.push_back("reservoir: the model's pillars near " + well + " lean up to " + fmt6(o.max_lean_deg) +
+                         " degrees obliquely to the grid (column walls at " + fmt6(o.wall_angle_deg) +
+                         " degrees) and are kept as they are: " + o.refused + " (docs/corner-point.md, \"Upright "
+                         "pillars near wells\")");
   }
   if (!refined_m) return;
   auto refined = std::make_shared<const CornerPointModel>(std::move(*refined_m));
@@ -508,7 +521,7 @@ void refine_near_wells(CaseSpec& cs) {
 ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, std::vector<std::string>& notes) {
   const Fields f(n, "reservoir",
                  {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size",
-                  "near_well_layer_aspect", "upright_pillars"});
+                  "near_well_layer_aspect", "upright_pillars", "near_well_grading"});
   ReservoirSpec r;
   if (f.get("grdecl")) {
     r = read_grdecl_reservoir(f, base_dir, notes);
@@ -518,9 +531,15 @@ ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, s
       if (v != "auto" && v != "on" && v != "off") fail(f.path("upright_pillars"), "expected auto, on or off, got " + describe(*s));
       r.upright_pillars = v == "on" ? ReservoirSpec::Upright::On : v == "off" ? ReservoirSpec::Upright::Off : ReservoirSpec::Upright::Auto;
     }
+    if (auto s = f.get("near_well_grading")) {
+      const std::string v = s->IsScalar() ? s->Scalar() : "";
+      if (v != "on" && v != "off") fail(f.path("near_well_grading"), "expected on or off, got " + describe(*s));
+      r.near_well_grading = v == "on";
+    }
   } else {
     if (f.get("near_well_cell_size")) fail(f.path("near_well_cell_size"), "only with reservoir.grdecl (a corner-point model)");
     if (f.get("upright_pillars")) fail(f.path("upright_pillars"), "only with reservoir.grdecl (a corner-point model)");
+    if (f.get("near_well_grading")) fail(f.path("near_well_grading"), "only with reservoir.grdecl (a corner-point model)");
     r.x = read_axis(f.required("x"), f.path("x"));
     r.y = read_axis(f.required("y"), f.path("y"));
     r.z = read_axis(f.required("z"), f.path("z"));

@@ -46,6 +46,10 @@ struct ReservoirSpec {
   /// near a well are split to (meshgen/case/corner_point_refine.hpp); 0 = auto (each well's
   /// drainage radius), < 0 = off. After load_case, `corner_point` is the refined model.
   double near_well_cell_size = 0;
+  /// `reservoir.near_well_grading` (with the refinement): on, a split column's children grow away
+  /// from the well's path (the target size within reach, coarser toward the column's sides); off,
+  /// equal widths across the column, all of the finest size it needs.
+  bool near_well_grading = true;
   /// `reservoir.upright_pillars` (corner-point models with wells): auto turns the model's pillars
   /// near a well upright where they lean obliquely to the grid (kStraightenWallAngleBelow,
   /// meshgen/case/corner_point_straighten.hpp), on wherever they lean, off keeps them.

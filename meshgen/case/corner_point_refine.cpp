@@ -85,11 +85,52 @@ double layer_thickness(const CornerPointModel& m, int i, int j, double s, double
   return 0;
 }
 
-// Children of a slice `width` wide at distance `d` from the path, for near-well cells of `size`.
-int children(double width, double d, double size, const RefinementRequest& r) {
-  if (!(width > kRefineWiderThan * size)) return 1;
-  const double target = size + kRefinementGrowth * std::max(0.0, d - r.reach);
-  return std::max(1, static_cast<int>(std::lround(width / target)));
+// What one path point asks of one slice: children of `size` within `reach` of it, growing beyond.
+// Its distance from parameter s across the slice is d + |s - s_ref| width (s_ref: the point's own
+// parameter when the slice holds it, d = 0; else the slice's end nearer to it, d its distance).
+struct SliceRequest {
+  double width, d, s_ref, size, reach;
+  bool graded;
+  // The target child width at s, as a parameter across the slice.
+  double target(double s) const {
+    const double dist = d + std::abs(s - s_ref) * width;
+    return (size + kRefinementGrowth * std::max(0.0, dist - reach)) / width;
+  }
+};
+
+// Resolution of the equidistribution: the smallest target is a few hundredths of a wide slice.
+constexpr int kSliceSamples = 512;
+
+// Children's bounds across one slice: sizes following the smallest target of `asks`, by
+// equidistribution of the integral of 1 / target; {0, 1} when nothing asks. If an ask that is not
+// graded splits the slice, equal children, as many as the largest ask needs where it is nearest.
+std::vector<double> slice_bounds(const std::vector<SliceRequest>& asks) {
+  if (asks.empty()) return {0.0, 1.0};
+  auto equal_children = [](const SliceRequest& q) { return static_cast<int>(std::lround(1.0 / q.target(q.s_ref))); };
+  if (std::any_of(asks.begin(), asks.end(), [&](const SliceRequest& q) { return !q.graded && equal_children(q) > 1; })) {
+    int n = 1;
+    for (const SliceRequest& q : asks) n = std::max(n, equal_children(q));
+    std::vector<double> bounds;
+    for (int a = 0; a < n; ++a) bounds.push_back(double(a) / n);
+    bounds.push_back(1.0);
+    return bounds;
+  }
+  std::vector<double> cumulative(kSliceSamples + 1, 0.0);
+  for (int a = 0; a < kSliceSamples; ++a) {
+    const double s = (a + 0.5) / kSliceSamples;
+    double target = std::numeric_limits<double>::infinity();
+    for (const SliceRequest& q : asks) target = std::min(target, q.target(s));
+    cumulative[a + 1] = cumulative[a] + 1.0 / (target * kSliceSamples);
+  }
+  const int n = std::max(1, static_cast<int>(std::lround(cumulative.back())));
+  std::vector<double> bounds{0.0};
+  for (int k = 1, a = 0; k < n; ++k) {
+    const double level = cumulative.back() * k / n;
+    while (cumulative[a + 1] < level) ++a;
+    bounds.push_back((a + (level - cumulative[a]) / (cumulative[a + 1] - cumulative[a])) / kSliceSamples);
+  }
+  bounds.push_back(1.0);
+  return bounds;
 }
 
 // A new pillar on a model column edge gets its depths from the parents on either side, each
@@ -148,7 +189,7 @@ bool ColumnSplits::refines() const {
 }
 
 ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<RefinementRequest>& wells) {
-  ColumnSplits out{std::vector<int>(m.nx, 1), std::vector<int>(m.ny, 1)};
+  std::vector<std::vector<SliceRequest>> ask_i(m.nx), ask_j(m.ny);
   for (const RefinementRequest& r : wells) {
     if (!(r.cell_size > 0)) continue;
     for (const Vec3& x : sample_path(r.path, 0.5 * r.cell_size)) {
@@ -161,19 +202,29 @@ ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<Refin
       double size = r.cell_size;
       if (const double h = layer_thickness(m, ip, jp, s, t, x.z); r.limit_by_layer && h > 0)
         size = std::min(size, kCellsPerLayerThickness * h);
-      // Slices along i in the row of x (at its t), then along j in its column (at its s).
-      for (int i = 0; i < m.nx; ++i) {
-        const Vec3 lo = column_point(m, i, jp, 0, t, x.z), hi = column_point(m, i, jp, 1, t, x.z);
-        const double d = i == ip ? 0.0 : plan_distance(x, i > ip ? lo : hi);
-        out.i[i] = std::max(out.i[i], children(plan_distance(lo, hi), d, size, r));
-      }
-      for (int j = 0; j < m.ny; ++j) {
-        const Vec3 lo = column_point(m, ip, j, s, 0, x.z), hi = column_point(m, ip, j, s, 1, x.z);
-        const double d = j == jp ? 0.0 : plan_distance(x, j > jp ? lo : hi);
-        out.j[j] = std::max(out.j[j], children(plan_distance(lo, hi), d, size, r));
-      }
+      // Slices along i in the row of x (at its t), then along j in its column (at its s); a slice
+      // no wider than kRefineWiderThan sizes is left whole.
+      auto ask = [&](std::vector<SliceRequest>& asks, int slice, int holder, double at, Vec3 lo, Vec3 hi) {
+        const double width = plan_distance(lo, hi);
+        if (!(width > kRefineWiderThan * size)) return;
+        if (slice == holder)
+          asks.push_back({width, 0.0, at, size, r.reach, r.graded});
+        else if (slice > holder)
+          asks.push_back({width, plan_distance(x, lo), 0.0, size, r.reach, r.graded});
+        else
+          asks.push_back({width, plan_distance(x, hi), 1.0, size, r.reach, r.graded});
+      };
+      for (int i = 0; i < m.nx; ++i)
+        ask(ask_i[i], i, ip, s, column_point(m, i, jp, 0, t, x.z), column_point(m, i, jp, 1, t, x.z));
+      for (int j = 0; j < m.ny; ++j)
+        ask(ask_j[j], j, jp, t, column_point(m, ip, j, s, 0, x.z), column_point(m, ip, j, s, 1, x.z));
     }
   }
+  ColumnSplits out;
+  for (const auto& asks : ask_i) out.i_bounds.push_back(slice_bounds(asks));
+  for (const auto& asks : ask_j) out.j_bounds.push_back(slice_bounds(asks));
+  for (const auto& b : out.i_bounds) out.i.push_back(static_cast<int>(b.size()) - 1);
+  for (const auto& b : out.j_bounds) out.j.push_back(static_cast<int>(b.size()) - 1);
   return out;
 }
 
@@ -182,14 +233,18 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   struct Slot {
     int parent;
     int child, of;
+    double s0, s1;  // the child's ends, as parameters across its parent
   };
-  auto slots = [](const std::vector<int>& n) {
+  auto slots = [](const std::vector<int>& n, const std::vector<std::vector<double>>& bounds) {
     std::vector<Slot> v;
     for (int p = 0; p < static_cast<int>(n.size()); ++p)
-      for (int a = 0; a < n[p]; ++a) v.push_back({p, a, n[p]});
+      for (int a = 0; a < n[p]; ++a) {
+        const bool given = !bounds.empty();
+        v.push_back({p, a, n[p], given ? bounds[p][a] : double(a) / n[p], given ? bounds[p][a + 1] : double(a + 1) / n[p]});
+      }
     return v;
   };
-  const std::vector<Slot> si = slots(splits.i), sj = slots(splits.j);
+  const std::vector<Slot> si = slots(splits.i, splits.i_bounds), sj = slots(splits.j, splits.j_bounds);
   CornerPointModel r;
   r.nx = static_cast<int>(si.size());
   r.ny = static_cast<int>(sj.size());
@@ -211,10 +266,10 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   r.minpv_connections = m.minpv_connections;
   r.minpv_removed = m.minpv_removed;
 
-  // Pillars: pillar line I lies in model slice si[I].parent at s = child / of (the last line at s = 1).
+  // Pillars: pillar line I lies in model slice si[I].parent at its child's start (the last line at s = 1).
   auto line = [](const std::vector<Slot>& sl, int I, int& parent, double& s) {
     if (I < static_cast<int>(sl.size())) {
-      parent = sl[I].parent, s = double(sl[I].child) / sl[I].of;
+      parent = sl[I].parent, s = sl[I].s0;
     } else {
       parent = sl.back().parent, s = 1.0;
     }
@@ -249,8 +304,8 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
         const int pc = i + m.nx * (j + m.ny * k);
         r.parent_cell[c] = m.parent_cell.empty() ? pc : m.parent_cell[pc];
         for (int q = 0; q < 8; ++q) {
-          const double s = double(si[I].child + (q & 1)) / si[I].of;
-          const double t = double(sj[J].child + ((q >> 1) & 1)) / sj[J].of;
+          const double s = q & 1 ? si[I].s1 : si[I].s0;
+          const double t = (q >> 1) & 1 ? sj[J].s1 : sj[J].s0;
           const int side = q & 4;
           const auto w = bilinear_weights(s, t);
           double z = 0;

@@ -17,6 +17,10 @@ namespace hm {
 /// Children per model column along i (size nx) and along j (size ny), each >= 1.
 struct ColumnSplits {
   std::vector<int> i, j;
+  /// Where the children of each slice end, as parameters across it: empty for children of equal
+  /// widths, else one list per slice of i[p] + 1 (j[p] + 1) increasing values from exactly 0 to
+  /// exactly 1.
+  std::vector<std::vector<double>> i_bounds, j_bounds;
   bool refines() const;
 };
 
@@ -28,6 +32,9 @@ struct RefinementRequest {
   double reach = 0;
   /// Also no wider than kCellsPerLayerThickness x the thickness of the layer the path is in (auto).
   bool limit_by_layer = false;
+  /// Children that grow away from the path across a slice; false: a slice this well asks for is
+  /// split into equal children, as many as the largest ask on it needs where it is nearest.
+  bool graded = true;
 };
 
 /// A column or row wider than this many target cell sizes is split (Gabriel repair handles the
@@ -43,14 +50,17 @@ constexpr double kCellsPerLayerThickness = 1.5;
 /// model columns.
 constexpr double kRefinementGrowth = 1.0;
 
-/// How many children each model column and row gets: a slice (all columns of one i, or of one j)
-/// whose width near a well's path exceeds kRefineWiderThan x cell_size is split into children of
-/// about the target size at its distance from the path (cell_size within reach, growing beyond).
-/// Path points outside the model's columns in plan ask nothing.
+/// How each model column and row is split: a slice (all columns of one i, or of one j) whose width
+/// near a well's path exceeds kRefineWiderThan x cell_size is split into children of about the
+/// target size where each lies: cell_size within reach of the path, growing by kRefinementGrowth
+/// per metre beyond, so that a wide column holding a well has fine children near it and coarser
+/// ones toward its sides (the target's smallest value over all wells and path points; children's
+/// widths follow it by equidistribution). A slice asked for by a well that is not `graded` gets
+/// equal children instead. Path points outside the model's columns in plan ask nothing.
 ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<RefinementRequest>& wells);
 
-/// The model with column i split into splits.i[i] and row j into splits.j[j] children of equal
-/// parametric width. New pillars interpolate the model's pillars bilinearly (top and bottom
+/// The model with column i split into splits.i[i] and row j into splits.j[j] children, of equal
+/// parametric width or at splits.i_bounds / j_bounds. New pillars interpolate the model's pillars bilinearly (top and bottom
 /// points); a child's ZCORN interpolate its parent's 4 depths on the same side bilinearly, so a
 /// child's corners on the model's pillars are its parent's (bit for bit). Rock, ACTNUM and the
 /// z multipliers are the parent's; an x (y) multiplier stays on the children along the parent's

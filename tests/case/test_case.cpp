@@ -309,7 +309,7 @@ TEST(CaseErrors, UnknownKeyAtEveryLevel) {
             "wellz: unknown key (expected one of: name, metric, reservoir, wells, transition, fluid)");
   EXPECT_EQ(error_of(with(kBase, "  porosity: 0.2\n", "  porosity: 0.2\n  poro: 0.2\n")),
             "reservoir.poro: unknown key (expected one of: x, y, z, grdecl, permeability, porosity, initial_pressure, near_well_cell_size, "
-            "near_well_layer_aspect, upright_pillars)");
+            "near_well_layer_aspect, upright_pillars, near_well_grading)");
   EXPECT_EQ(error_of(with(kBase, "    bhp: 250\n", "    bhp: 250\n    skin: 0\n")),
             "wells[1].skin: unknown key (expected one of: name, type, trajectory, survey, radius, drainage_radius, rings, "
             "sectors, segment_length, bhp, end_caps, perforations)");

@@ -74,7 +74,7 @@ TEST(NearWellRefinement, ChildrenTileTheirParents) {
   m.trans_mult[0][marked] = 0.5;
   m.trans_mult[3][marked] = 0.25;
   m.trans_mult[4][marked] = 0.125;
-  const ColumnSplits splits{{1, 3, 2, 4, 1, 1}, {2, 1, 3, 1, 1}};
+  const ColumnSplits splits{{1, 3, 2, 4, 1, 1}, {2, 1, 3, 1, 1}, {}, {}};
   const CornerPointModel r = refined_model(m, splits);
   ASSERT_EQ(r.nx, 12);
   ASSERT_EQ(r.ny, 8);
@@ -137,7 +137,7 @@ TEST(NearWellRefinement, ScissorFaultGivesOneDepthWhereTheThrowVanishes) {
   o << "/\nPERMX\n2*100 /\nPORO\n2*0.2 /\n";
   std::ofstream(tmp.path / "S.GRDECL") << o.str();
   const CornerPointModel m = read_corner_point_model((tmp.path / "S.GRDECL").string(), "reservoir.grdecl");
-  const CornerPointModel r = refined_model(m, ColumnSplits{{1, 1}, {4}});
+  const CornerPointModel r = refined_model(m, ColumnSplits{{1, 1}, {4}, {}, {}});
   ASSERT_EQ(r.ny, 4);
   // Pillar (1, 1) of the refined grid, t = 1/4 along the fault line: the left column's (+i, +j) corner and
   // the right column's (-i, +j) corner, top and bottom.
@@ -171,7 +171,7 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsRegionMultipliers) {
   ASSERT_TRUE(m.region_mult);
   ASSERT_EQ(m.multregt_records.size(), 2u);
   ASSERT_EQ(m.region_arrays.count("MULTNUM"), 1u);
-  const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}});
+  const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}, {}, {}});
   std::map<double, int> seen;
   const int64_t step[3] = {1, r.nx, static_cast<int64_t>(r.nx) * r.ny};
   for (int64_t a = 0; a < static_cast<int64_t>(r.corners.size()); ++a) {
@@ -204,7 +204,7 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsPoreVolumeMultipliers) {
     if (multpv) g.keywords = hmtest::pore_volume_keywords(g);
     std::ofstream(tmp.path / "M.GRDECL") << g.text();
     const CornerPointModel m = read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
-    const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}});
+    const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}, {}, {}});
     ASSERT_EQ(r.pore_volume_mult.empty(), !multpv);
     if (!multpv) continue;
     ASSERT_EQ(r.pore_volume_mult.size(), r.corners.size());
@@ -295,9 +295,45 @@ TEST(NearWellRefinement, SplitsFollowTheWellWhereverTheModelSits) {
   ASSERT_EQ(s.i.size(), 15u);
   ASSERT_EQ(s.j.size(), 9u);
   // The path is in column (7, 4) (pillars leaning 30 degrees: 17-23 m at its depths): children of
-  // the requested size there and in the columns within reach, fewer further, none 300 m away.
-  EXPECT_EQ(s.i[7], 10);
-  EXPECT_EQ(s.j[4], 6);
+  // the requested size near it, wider toward the column's sides, fewer in the columns further, none
+  // 300 m away. Column 7 is 100 m wide (i), row 4 60 m (j).
+  ASSERT_EQ(s.i_bounds.size(), 15u);
+  ASSERT_EQ(s.j_bounds.size(), 9u);
+  for (const auto* bounds : {&s.i_bounds, &s.j_bounds})
+    for (const std::vector<double>& b : *bounds) {
+      ASSERT_GE(b.size(), 2u);
+      EXPECT_EQ(b.front(), 0.0);
+      EXPECT_EQ(b.back(), 1.0);
+      for (size_t a = 1; a < b.size(); ++a) EXPECT_LT(b[a - 1], b[a]);
+    }
+  const std::vector<double>& b7 = s.i_bounds[7];
+  size_t holder = 0;  // the child holding the path's mid-point (x = 755 m at s about 0.55)
+  while (holder + 1 < b7.size() && b7[holder + 1] < 0.55) ++holder;
+  double widest = 0;
+  for (size_t a = 0; a + 1 < b7.size(); ++a) {
+    const double width = 100 * (b7[a + 1] - b7[a]);
+    widest = std::max(widest, width);
+    // Within reach (35 m) of the path the requested 10 m, up to the rounding of the count.
+    if (std::abs(100 * (b7[a] - 0.55)) < 25 && std::abs(100 * (b7[a + 1] - 0.55)) < 25) {
+      EXPECT_LE(width, 11.5) << a;
+    }
+    // Children grow (or stay) away from the path on both sides.
+    if (a + 1 < holder) {
+      EXPECT_GE(width, 100 * (b7[a + 2] - b7[a + 1]) * (1 - 1e-9)) << a;
+    }
+    if (a > holder) {
+      EXPECT_GE(width, 100 * (b7[a] - b7[a - 1]) * (1 - 1e-9)) << a;
+    }
+  }
+  std::printf("[ figures  ] column 7's children (m):");
+  for (size_t a = 0; a + 1 < b7.size(); ++a) std::printf(" %.1f", 100 * (b7[a + 1] - b7[a]));
+  std::printf("; children per column i:");
+  for (int n : s.i) std::printf(" %d", n);
+  std::printf("\n");
+  EXPECT_GE(s.i[7], 8);
+  EXPECT_LE(s.i[7], 10);  // equal widths of 10 m would be 10
+  EXPECT_GE(s.j[4], 5);
+  EXPECT_LE(s.j[4], 6);
   for (int i = 0; i < 15; ++i) {
     EXPECT_LE(s.i[i], s.i[7]) << i;
     if (std::abs(i - 7) >= 3) {
@@ -314,6 +350,8 @@ TEST(NearWellRefinement, SplitsFollowTheWellWhereverTheModelSits) {
   const ColumnSplits moved = near_well_splits(far, {{{well.path[0] + shift, well.path[1] + shift}, 10, 35, false}});
   EXPECT_EQ(moved.i, s.i);
   EXPECT_EQ(moved.j, s.j);
+  for (int i = 0; i < 15; ++i)
+    for (size_t a = 0; a < s.i_bounds[i].size(); ++a) EXPECT_NEAR(moved.i_bounds[i][a], s.i_bounds[i][a], 1e-9) << i;
 }
 
 // Thin layers (3 m) in coarse cells (100 m), a vertical 12 m well of drainage radius 10 m: without
@@ -355,6 +393,21 @@ TEST(NearWellRefinement, ThinLayersInCoarseCellsMesh) {
     for (int c = 0; c < out.mesh.n_cells(); ++c) transition += out.mesh.cell_region[c] == kTransition;
     std::printf("[ figures  ] lean %.0f deg: model 7 x 7 x 40 refined to %d x %d x %d, %d cells (%d transition)\n", lean,
                 r.nx, r.ny, r.nz, out.mesh.n_cells(), transition);
+    if (lean != 0) continue;
+    // Children of equal widths across each split column (near_well_grading: off): sound too, with
+    // more cells (the graded children grow away from the well within its column).
+    std::ofstream(tmp.path / "equal.yaml") << well_case("M.GRDECL", ", near_well_grading: off", 10);
+    const CaseSpec eq = load_case((tmp.path / "equal.yaml").string());
+    HybridMesh equal;
+    ASSERT_NO_THROW(equal = build_hybrid_mesh(eq));
+    ASSERT_TRUE(equal.self_check.ok()) << equal.self_check.message;
+    double ve = 0, ve0 = 0;
+    for (int c = 0; c < equal.mesh.n_cells(); ++c) ve += equal.geometry.cell_volume[c];
+    for (double c : cell_volumes(*eq.reservoir.corner_point)) ve0 += c;
+    EXPECT_NEAR(ve / (ve0 - exact_wellbore_hole_volume(eq, 0, equal.blocks[0].sectors)), 1.0, 1e-9);
+    EXPECT_LT(out.mesh.n_cells(), equal.mesh.n_cells());
+    std::printf("[ figures  ] lean 0 deg, equal children: refined to %d x %d, %d cells\n", eq.reservoir.corner_point->nx,
+                eq.reservoir.corner_point->ny, equal.mesh.n_cells());
   }
 }
 
@@ -376,6 +429,10 @@ TEST(NearWellRefinement, CaseKeyIsChecked) {
             "reservoir.upright_pillars: expected auto, on or off, got 'yes'");
   EXPECT_EQ(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], upright_pillars: auto}\n"),
             "reservoir.upright_pillars: only with reservoir.grdecl (a corner-point model)");
+  EXPECT_EQ(error_of(well_case("M.GRDECL", ", near_well_grading: auto", 10)),
+            "reservoir.near_well_grading: expected on or off, got 'auto'");
+  EXPECT_EQ(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], near_well_grading: on}\n"),
+            "reservoir.near_well_grading: only with reservoir.grdecl (a corner-point model)");
   EXPECT_NE(error_of(well_case("M.GRDECL", ", near_well_cell_size: fine", 10)).find("expected auto, off or a size"),
             std::string::npos);
   EXPECT_NE(error_of("name: m\nreservoir: {x: [0, 1], y: [0, 1], z: [0, 1], near_well_cell_size: 3}\n")

@@ -750,7 +750,9 @@ TEST(CornerPointSurface, RefinedSurfaceLetsTheBlockEndNearerToIt) {
   const double meshed = by_surface.md.back() - by_surface.md.front(), one_r = by_radius.md.back() - by_radius.md.front();
   std::printf("[ figures  ] refined surface: gaps %.3f and %.3f m (R = %g m); block %.3f m long, %.3f m with 1 R gaps\n",
               by_surface.gap[0], by_surface.gap[1], R, meshed, one_r);
-  EXPECT_GT(meshed, one_r + R / 4);
+  // 20.6 m against 18.75 with children of equal widths, 20.0 m with graded ones (the faces above the
+  // well a little wider: gaps 4.17 m instead of 4.10).
+  EXPECT_GT(meshed, one_r + R / 8);
   HybridMesh out;
   ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
   expect_sound_mesh(cs, out);
