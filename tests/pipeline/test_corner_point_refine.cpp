@@ -60,6 +60,14 @@ std::string well_case(const std::string& grdecl, const std::string& reservoir_ex
          hmtest::grdecl_number(radius) + ", end_caps: flat, bhp: 150}\n";
 }
 
+// The mesh's volume over the (refined) model's minus the wellbore hole of well 0.
+double volume_over_model_minus_hole(const CaseSpec& cs, const HybridMesh& out) {
+  double v = 0, v0 = 0;
+  for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
+  for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
+  return v / (v0 - exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors));
+}
+
 }  // namespace
 
 // Children of planar-faced cells (planar layers, parallel inclined pillars, a fault of 2.5 layers)
@@ -384,11 +392,7 @@ TEST(NearWellRefinement, ThinLayersInCoarseCellsMesh) {
     ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
     EXPECT_TRUE(out.build_report.ok);
     // Volume: the refined model's (equal to the model's: planar faces) minus the wellbore hole.
-    double v = 0, v0 = 0;
-    for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
-    for (double c : cell_volumes(r)) v0 += c;
-    const double hole = exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors);
-    EXPECT_NEAR(v / (v0 - hole), 1.0, 1e-9);
+    EXPECT_NEAR(volume_over_model_minus_hole(cs, out), 1.0, 1e-9);
     int transition = 0;
     for (int c = 0; c < out.mesh.n_cells(); ++c) transition += out.mesh.cell_region[c] == kTransition;
     std::printf("[ figures  ] lean %.0f deg: model 7 x 7 x 40 refined to %d x %d x %d, %d cells (%d transition)\n", lean,
@@ -401,10 +405,7 @@ TEST(NearWellRefinement, ThinLayersInCoarseCellsMesh) {
     HybridMesh equal;
     ASSERT_NO_THROW(equal = build_hybrid_mesh(eq));
     ASSERT_TRUE(equal.self_check.ok()) << equal.self_check.message;
-    double ve = 0, ve0 = 0;
-    for (int c = 0; c < equal.mesh.n_cells(); ++c) ve += equal.geometry.cell_volume[c];
-    for (double c : cell_volumes(*eq.reservoir.corner_point)) ve0 += c;
-    EXPECT_NEAR(ve / (ve0 - exact_wellbore_hole_volume(eq, 0, equal.blocks[0].sectors)), 1.0, 1e-9);
+    EXPECT_NEAR(volume_over_model_minus_hole(eq, equal), 1.0, 1e-9);
     EXPECT_LT(out.mesh.n_cells(), equal.mesh.n_cells());
     std::printf("[ figures  ] lean 0 deg, equal children: refined to %d x %d, %d cells\n", eq.reservoir.corner_point->nx,
                 eq.reservoir.corner_point->ny, equal.mesh.n_cells());
@@ -488,14 +489,6 @@ HybridMesh mesh_in_local_frame(const CaseSpec& cs) {
     ADD_FAILURE() << e.what();
     return {};
   }
-}
-
-// The mesh's volume over the (refined) model's minus the wellbore hole of well 0.
-double volume_over_model_minus_hole(const CaseSpec& cs, const HybridMesh& out) {
-  double v = 0, v0 = 0;
-  for (int c = 0; c < out.mesh.n_cells(); ++c) v += out.geometry.cell_volume[c];
-  for (double c : cell_volumes(*cs.reservoir.corner_point)) v0 += c;
-  return v / (v0 - exact_wellbore_hole_volume(cs, 0, out.blocks[0].sectors));
 }
 
 // Reek's well SW1: a vertical well in column (8, 52) (0-based (7, 51)), from the top face centre of
