@@ -226,10 +226,9 @@ TEST(FlowMeshgen, CornerPointModelWithWellsDeckMatchesSolverDemo) {
 // as shipped (its MULTFLT/MULTZ act on the mesh's faces, docs/corner-point.md): flow runs the deck and
 // matches solver_demo. HM_LONG_TESTS=1 (flow on ~100k cells). Not as typed: flow's default ILU0/BiCGStab
 // stops at 200 iterations and the first day never converges ("Convergence failure for linear solver",
-// also without the well); with --linear-solver-max-iter=2000 it runs to the end. Not passing yet,
-// measured: rates 4.9e-11, pressures off by a uniform 3.3e-4 bar (2.4e-6 relative), the same with a
-// run 10 times longer: where flow stops the lone producer at rest (docs/export-eclipse.md, "Reek with
-// a well").
+// also without the well); with --linear-solver-max-iter=2000 it runs to the end. Passes since meshgen
+// and solver_demo leave out the connections below 1e-6 that flow drops (before: pressures 2.4e-6 off;
+// docs/export-eclipse.md, "Reek with a well").
 TEST(FlowMeshgen, ReekWellDeckMatchesSolverDemo) {
   REQUIRE_FLOW_E2E();
   if (std::getenv("HM_LONG_TESTS") == nullptr) GTEST_SKIP() << "set HM_LONG_TESTS=1 (Reek: ~100k cells in flow)";
