@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "fvcheck/lib/checks.hpp"
 #include "hybrid_mesh.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
@@ -272,6 +273,13 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
       if (!outcomes[k]) to_build.push_back(k), ++out.transition_builds;
     }
     build_transitions(to_build, out.cavities.cavities, coords, out.grid, out.blocks, base, topts, opts.threads, outcomes);
+    // A face toward a model cell is judged by the self-check from the site to its flux point: one
+    // that would fail it moves that wall away now, like the transition's own refusals.
+    for (int k : to_build)
+      if (outcomes[k]->ok())
+        if (auto r = model_wall_orthogonality_refusal(outcomes[k]->cells, out.cavities.cavities[k], coords,
+                                                      CheckOptions{}.min_orthogonality_deg))
+          outcomes[k] = TransitionOutcome{{}, std::move(r)};
     if (auto all = all_transitions(outcomes)) {
       transitions = std::move(*all);
       break;

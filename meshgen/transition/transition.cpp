@@ -4,9 +4,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
+#include "meshgen/core/fv_quality.hpp"
+#include "meshgen/core/geometry.hpp"
 #include "transition_internal.hpp"
 
 namespace hm {
@@ -300,6 +303,48 @@ PolyMesh transition_submesh(const TransitionCells& t, const std::vector<Vec3>& n
   PolyMesh mesh = builder.finish(&report);
   if (global_node) *global_node = std::move(used);
   return mesh;
+}
+
+std::optional<TransitionRefusal> model_wall_orthogonality_refusal(const TransitionCells& t, const Cavity& cavity,
+                                                                  const std::vector<Vec3>& node_coords,
+                                                                  double min_orthogonality_deg) {
+  std::map<std::vector<int32_t>, int32_t> wall_of;  // sorted global nodes -> cavity face with a model cell behind
+  for (const auto& polygons : t.cell_polygons)
+    for (int32_t q : polygons) {
+      const ConstrainedFace& face = cavity.faces[q];
+      if (face.side != FaceSide::Reservoir || face.outside_cell < 0) continue;
+      std::vector<int32_t> key = face.nodes;
+      std::sort(key.begin(), key.end());
+      wall_of[key] = q;
+    }
+  if (wall_of.empty()) return std::nullopt;
+  std::vector<int32_t> global;
+  const PolyMesh sub = transition_submesh(t, node_coords, &global);
+  const MeshGeometry geo = compute_geometry(sub);
+  const std::vector<double> qo = face_orthogonality(sub, geo, BoundaryPoint::Flux);
+  TransitionRefusal r;
+  double worst = 90;
+  for (int f = 0; f < sub.n_faces(); ++f) {
+    if (sub.face_neighbour[f] >= 0 || !(qo[f] < min_orthogonality_deg)) continue;
+    std::vector<int32_t> key;
+    for (const int32_t* v = sub.face_begin(f); v != sub.face_end(f); ++v) key.push_back(global[*v]);
+    std::sort(key.begin(), key.end());
+    const auto it = wall_of.find(key);
+    if (it == wall_of.end()) continue;
+    r.polygons.push_back(it->second);
+    r.cells_to_deactivate.push_back(cavity.faces[it->second].outside_cell);
+    worst = std::min(worst, qo[f]);
+  }
+  if (r.polygons.empty()) return std::nullopt;
+  for (std::vector<int32_t>* v : {&r.polygons, &r.cells_to_deactivate}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+  std::ostringstream os;
+  os << "transition: " << r.polygons.size() << " faces on model walls have Q_O below " << min_orthogonality_deg
+     << " degrees at their boundary flux point (worst " << worst << ")";
+  r.reason = os.str();
+  return r;
 }
 
 }  // namespace hm

@@ -141,6 +141,16 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
 PolyMesh transition_submesh(const TransitionCells& cells, const std::vector<Vec3>& node_coords,
                             std::vector<int32_t>* global_node = nullptr);
 
+/// The transition faces on the cavity's model polygons (FaceSide::Reservoir with a model cell
+/// behind) whose Q_O is below `min_orthogonality_deg`, measured as fvcheck measures a face toward
+/// a corner-point model cell: from the transition cell's site to the face's boundary flux point.
+/// A power diagram puts a polygon's site over its circumcentre, which an obtuse triangle has
+/// outside itself; near the plane the segment then leans. As a refusal naming those polygons and
+/// the model cells behind them (deactivating them moves that wall away); nullopt when none fails.
+std::optional<TransitionRefusal> model_wall_orthogonality_refusal(const TransitionCells& cells, const Cavity& cavity,
+                                                                  const std::vector<Vec3>& node_coords,
+                                                                  double min_orthogonality_deg);
+
 /// Dual (Voronoi) edge parameters of each constrained polygon, found from the Delaunay
 /// tetrahedra attached to it (paper 5.3): the internal Voronoi vertex is O + t_in n, the
 /// external one O + t_out n (O circumcentre, n unit normal into the cavity; +-inf if none).

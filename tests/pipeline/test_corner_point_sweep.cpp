@@ -130,11 +130,13 @@ TEST(CornerPointSweep, CiSubsetMeshesSoundly) {
 }
 
 // HM_LONG_TESTS=1: every seed in a forked child; no crash, hang or mesh failing a check; the table.
+// HM_CP_SWEEP_CASES seeds (30) from HM_CP_SWEEP_FIRST (1).
 TEST(CornerPointSweep, SweepTable) {
   if (!long_tests()) GTEST_SKIP() << "HM_LONG_TESTS=1 runs the sweep";
   const int n = std::getenv("HM_CP_SWEEP_CASES") ? std::atoi(std::getenv("HM_CP_SWEEP_CASES")) : 30;
+  const int first = std::getenv("HM_CP_SWEEP_FIRST") ? std::atoi(std::getenv("HM_CP_SWEEP_FIRST")) : 1;
   std::map<Outcome, int> count;
-  for (uint32_t seed = 1; seed <= static_cast<uint32_t>(n); ++seed) {
+  for (uint32_t seed = first; seed < static_cast<uint32_t>(first + n); ++seed) {
     const CornerPointSweepCase c = make_corner_point_case(seed);
     const CaseResult r = run_isolated([&] { return mesh_corner_point_case(c); }, 300);
     ++count[r.outcome];

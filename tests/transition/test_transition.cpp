@@ -346,5 +346,44 @@ TEST(Transition, OpenCavityIsReported) {
   EXPECT_GT(sc.report.unmatched_faces, 0);
 }
 
+// The wall check of a corner-point cavity (model_wall_orthogonality_refusal): one tetrahedral cell
+// whose base is an obtuse model triangle (its circumcentre outside it). A site over the triangle
+// passes; a site low over the circumcentre's side fails at its boundary flux point (on edge AB) and
+// names the polygon and the model cell behind it. An outer-surface or well polygon is not a wall.
+TEST(Transition, ModelWallFaceBelowOrthogonalityIsRefusedWithTheCellBehind) {
+  const std::vector<Vec3> coords{{0, 0, 0}, {10, 0, 0}, {5, 1, 0}, {5, 0.5, 5}};
+  Cavity cav;
+  ConstrainedFace wall;
+  wall.nodes = {0, 1, 2};  // normal +z: into the cavity
+  wall.side = FaceSide::Reservoir;
+  wall.outside_cell = 7;
+  wall.inside_cell = 3;
+  cav.faces.push_back(wall);
+  TransitionCells t;
+  t.base_node_id = 4;
+  t.cells.push_back({{{0, 2, 1}}, {{0, 1, 3}}, {{1, 2, 3}}, {{2, 0, 3}}});  // outward
+  t.cell_polygons = {{0}};
+  t.cell_site = {0};
+  t.weights = {0};
+  t.h_ref = {5};
+
+  t.sites = {{5, 0.5, 1}};  // foot inside the triangle: Q_O 90
+  EXPECT_FALSE(model_wall_orthogonality_refusal(t, cav, coords, 45).has_value());
+
+  t.sites = {{5, -3, 0.5}};  // foot outside: to (5, 0, 0), asin(0.5 / |(0, 3, -0.5)|) = 9.5 degrees
+  const auto r = model_wall_orthogonality_refusal(t, cav, coords, 45);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->polygons, std::vector<int32_t>{0});
+  EXPECT_EQ(r->cells_to_deactivate, std::vector<int32_t>{7});
+  EXPECT_NE(r->reason.find("worst 9.46"), std::string::npos) << r->reason;
+  EXPECT_FALSE(model_wall_orthogonality_refusal(t, cav, coords, 9).has_value());  // above the threshold
+
+  cav.faces[0].outside_cell = -1;  // the model's outer surface: no cell to move away
+  EXPECT_FALSE(model_wall_orthogonality_refusal(t, cav, coords, 45).has_value());
+  cav.faces[0].outside_cell = 7;
+  cav.faces[0].side = FaceSide::Well;
+  EXPECT_FALSE(model_wall_orthogonality_refusal(t, cav, coords, 45).has_value());
+}
+
 }  // namespace
 }  // namespace hm::testing
