@@ -372,13 +372,20 @@ void clip_paths_to_model(CaseSpec& cs, const std::vector<WellSpec>& as_given, Su
       if (path.cut[e] > 0)
         gaps += std::string(gaps.empty() ? "" : ", ") + (e == 0 ? "start " : "end ") + fmt6(path.gap[e]) + " m (" +
                 fmt6(path.gap[e] / w.drainage_radius) + " x drainage_radius)";
-    std::string text = key + " (" + w.name + "): its path crosses the corner-point model's surface; the radial block is "
+    const bool crosses = path.crosses[0] || path.crosses[1];
+    const bool near = (path.cut[0] > 0 && !path.crosses[0]) || (path.cut[1] > 0 && !path.crosses[1]);
+    const std::string where = crosses && near ? "crosses the corner-point model's surface and ends near it"
+                              : crosses       ? "crosses the corner-point model's surface"
+                                              : "ends near the corner-point model's surface";
+    std::string text = key + " (" + w.name + "): its path " + where + "; the radial block is "
                        "built from measured depth " + fmt6(path.md.front()) + " to " + fmt6(path.md.back()) +
                        " m (flat ends that keep " + gaps + " from the surface) and the transition fills the rest to "
                        "the surface";
     bool open_outside = false;
     for (const auto& iv : w.perforations) open_outside = open_outside || iv[0] < path.md.front() || iv[1] > path.md.back();
-    if (w.perforations.empty()) text += "; the path between the surface and the block has no wellbore connection";
+    if (w.perforations.empty())
+      text += near ? "; the path beyond the block's ends has no wellbore connection"
+                   : "; the path between the surface and the block has no wellbore connection";
     if (open_outside) text += "; perforated depths outside that range have no wellbore connection";
     cs.notes.push_back(text);
   }

@@ -146,11 +146,6 @@ ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, co
       throw InputError(tkey + ": leaves the corner-point model's active cells and comes back (at measured depth " +
                        metres(path.interpolate(md, s_of(k))) + "); only one connected part inside can be meshed");
   ClippedPath out;
-  if (first == 0 && last == n - 1) {
-    out.points = ws.trajectory;
-    out.md = md;
-    return out;
-  }
 
   // 2. The crossings (bisection between the samples on either side), then each crossing end moved
   //    inward until the block's end cross-section and the gap beyond it are inside.
@@ -188,13 +183,23 @@ ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, co
            : rule == SurfaceGapRule::Least      ? kSurfaceGapMin * R
                                                 : gap;
   };
-  if (first > 0) {
-    out.gap[0] = gap_at(a);
+  // An end inside the model keeps the same gap as a crossing end: a path that ends near the model's
+  // surface is moved back as one that crosses it.
+  out.gap[0] = gap_at(a);
+  if (first > 0 || !end_clear(a, out.gap[0]))
     while (a < b && !end_clear(a, out.gap[0])) a += step;
-  }
-  if (last < n - 1) {
-    out.gap[1] = gap_at(b);
+  else
+    out.gap[0] = 0;
+  out.gap[1] = gap_at(b);
+  if (last < n - 1 || !end_clear(b, out.gap[1]))
     while (b > a && !end_clear(b, out.gap[1])) b -= step;
+  else
+    out.gap[1] = 0;
+  out.crosses = {first > 0, last < n - 1};
+  if (a == 0 && b == L) {
+    out.points = ws.trajectory;
+    out.md = md;
+    return out;
   }
   if (!(b - a > std::min(ws.segment_length, R)))
     throw InputError(tkey + ": only " + metres(std::max(0.0, b - a)) + " of its " + metres(b0 - a0) +

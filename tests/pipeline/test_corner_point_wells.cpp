@@ -757,3 +757,38 @@ TEST(CornerPointSurface, RefinedSurfaceLetsTheBlockEndNearerToIt) {
   ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
   expect_sound_mesh(cs, out);
 }
+
+// A well from above that ends inside the model 3 m over its bottom (R = 5 m): its end is moved back as a
+// crossing end is, until the end cross-section keeps surface_gap from the bottom, and the case says so;
+// the mesh is sound. (Wells of the corner-point sweep ending so, seeds 12, 17 and 20, were refused
+// before: their cavity reached the bottom where the surface's triangles held the block's nodes.)
+TEST(CornerPointSurface, WellEndingNearTheBottomIsMovedBackAsACrossingEnd) {
+  TiltedModel g;
+  g.nx = g.ny = 5, g.nz = 10, g.dx = g.dy = 60, g.dz = 3;
+  const double x = 150, y = 150, R = 5;
+  // The bottom under (x, y): the surface is bilinear in the column, as the depth formula is.
+  const double bottom = 1000 + std::tan(g.dip_deg * M_PI / 180) * x + 0.01 * y + 1e-4 * x * y + g.dz * g.nz;
+  const double z_end = bottom - 3;
+  TempDir tmp("cpendnear");
+  const CaseSpec cs = case_of(tmp, g, vertical_well(x, y, 980, z_end));
+  const CornerPointModel& model = *cs.reservoir.corner_point;
+  WellSpec given = cs.wells[0];
+  given.trajectory = {{x, y, 980}, {x, y, z_end}};
+  given.trajectory_md = {0, z_end - 980};
+  const ClippedPath path = clip_path_to_model(model, given, "wells[0]", SurfaceGapRule::SurfaceFaces);
+  EXPECT_TRUE(path.crosses[0]);
+  EXPECT_FALSE(path.crosses[1]);
+  EXPECT_GT(path.cut[1], 0.0);
+  EXPECT_GE(path.gap[1], kSurfaceGapMin * R);
+  EXPECT_LE(path.gap[1], kSurfaceGap * R);
+  EXPECT_EQ(cs.wells[0].trajectory, path.points);
+  EXPECT_LE(path.points.back().z, bottom - path.gap[1]);  // the end cross-section's centre keeps the gap too
+  bool noted = false;
+  for (const std::string& n : cs.notes) noted = noted || n.find("crosses the corner-point model's surface and ends near it") != std::string::npos;
+  EXPECT_TRUE(noted);
+  std::printf("[ figures  ] well ending 3 m over the bottom: block end moved back %.3f m (gap %.3f m, R = %g m)\n",
+              path.cut[1], path.gap[1], R);
+  HybridMesh out;
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  expect_sound_mesh(cs, out);
+}

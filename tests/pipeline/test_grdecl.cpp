@@ -543,17 +543,28 @@ TEST(CornerPoint, InvertedCellAndWellsAreRefusedWithTheReason) {
     }
   }
   write(tmp.path / "CPG.GRDECL", SyntheticCpg{}.text());
-  // A path inside the model 2 m under its dipping top: the block (R = 5 m) crosses the top. (A path
-  // that crosses the surface is cut inside it: docs/corner-point.md.)
-  const CaseSpec cs = load_case(write(tmp.path / "w.yaml",
-                                      "name: w\nreservoir: {grdecl: CPG.GRDECL}\nwells:\n  - {name: P1, trajectory: "
-                                      "[[230, 200, 1526.4], [270, 200, 1529.6]], radius: 0.1, drainage_radius: 5, "
-                                      "bhp: 150}\n"));
+  // A path inside the model 2 m under its dipping top: the block (R = 5 m) would cross the top. Its ends
+  // are moved back as a crossing path's are (docs/corner-point.md), and none of it keeps the gap.
+  try {
+    load_case(write(tmp.path / "w.yaml",
+                    "name: w\nreservoir: {grdecl: CPG.GRDECL}\nwells:\n  - {name: P1, trajectory: "
+                    "[[230, 200, 1526.4], [270, 200, 1529.6]], radius: 0.1, drainage_radius: 5, bhp: 150}\n"));
+    ADD_FAILURE() << "a well block through the top of a corner-point model was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("wells[0].trajectory: only 0 m of its", 0), 0u) << what;
+    EXPECT_NE(what.find("from the model's surface"), std::string::npos) << what;
+  }
+  // Ends deep enough, the middle 2 m under the top: the block crosses it there.
+  const CaseSpec cs = load_case(write(tmp.path / "v.yaml",
+                                      "name: v\nreservoir: {grdecl: CPG.GRDECL}\nwells:\n  - {name: P1, trajectory: "
+                                      "[[200, 200, 1531], [240, 200, 1527.2], [280, 200, 1537.4]], radius: 0.1, "
+                                      "drainage_radius: 5, end_caps: flat, bhp: 150}\n"));
   ASSERT_TRUE(cs.notes.empty()) << "the path was cut: " << cs.notes.front();
   try {
     build_hybrid_mesh(cs);
     ADD_FAILURE() << "a well block through the top of a corner-point model was meshed";
-  } catch (const InputError& e) {  // its block crosses the model's top (docs/corner-point.md)
+  } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("reaches outside the meshed cells of the corner-point model"), std::string::npos)
         << e.what();
   }
