@@ -68,15 +68,16 @@ struct ClippedPath {
   std::vector<double> md;
   std::array<double, 2> cut{0, 0};
   std::array<double, 2> gap{0, 0};  ///< per clipped end, the gap (m) its end cross-section keeps
-  std::array<bool, 2> crosses{false, false};  ///< per end: the user's path crosses the surface there (else it ends inside)
+  std::array<bool, 2> crosses{false, false};  ///< per end: the path crosses the surface there (else ends inside)
   bool clipped() const { return cut[0] > 0 || cut[1] > 0; }
 };
 
 /// The part of `ws`'s path (grid frame) inside the model's active cells, each end that crosses the
 /// model's surface, or ends inside it too near it, moved inward (by drainage_radius / 16 steps) until
 /// the block's end cross-section (radius drainage_radius) keeps the gap of `rule` from the surface
-/// (sampled: its centre and 16 rim points, each in 26 directions). Throws InputError naming `key` when no part is inside, when the
-/// path leaves the model and comes back, or when too little of it is left.
+/// (sampled: its centre and 16 rim points, each in 26 directions). Throws InputError naming `key`
+/// when no part is inside, when the path leaves the model and comes back, or when too little of it
+/// is left.
 ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, const std::string& key,
                                SurfaceGapRule rule = SurfaceGapRule::DrainageRadius);
 
