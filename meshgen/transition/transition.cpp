@@ -90,6 +90,29 @@ std::vector<PolygonDual> polygon_duals(const Cavity& cavity, const std::vector<V
   return out;
 }
 
+std::vector<int32_t> transition_detail::submesh_face_polygons(const PolyMesh& sub,
+                                                              const std::vector<int32_t>& global,
+                                                              const TransitionCells& t, const Cavity& cavity,
+                                                              const std::function<bool(int32_t)>& wanted) {
+  std::vector<int32_t> out(sub.n_faces(), -1);
+  std::map<std::vector<int32_t>, int32_t> polygon_of;  // sorted global nodes -> cavity face
+  for (const auto& polygons : t.cell_polygons)
+    for (int32_t q : polygons) {
+      if (!wanted(q)) continue;
+      std::vector<int32_t> key = cavity.faces[q].nodes;
+      std::sort(key.begin(), key.end());
+      polygon_of[key] = q;
+    }
+  for (int f = 0; f < sub.n_faces() && !polygon_of.empty(); ++f) {
+    if (sub.face_neighbour[f] >= 0) continue;
+    std::vector<int32_t> key;
+    for (const int32_t* v = sub.face_begin(f); v != sub.face_end(f); ++v) key.push_back(global[*v]);
+    std::sort(key.begin(), key.end());
+    if (const auto it = polygon_of.find(key); it != polygon_of.end()) out[f] = it->second;
+  }
+  return out;
+}
+
 std::vector<int> non_admissible_polygons(const Cavity& cavity, const std::vector<Vec3>& node_coords) {
   std::vector<std::string> notes;
   return non_admissible(cavity, frames_of(cavity, node_coords, notes));
@@ -308,31 +331,24 @@ PolyMesh transition_submesh(const TransitionCells& t, const std::vector<Vec3>& n
 std::optional<TransitionRefusal> model_wall_orthogonality_refusal(const TransitionCells& t, const Cavity& cavity,
                                                                   const std::vector<Vec3>& node_coords,
                                                                   double min_orthogonality_deg) {
-  std::map<std::vector<int32_t>, int32_t> wall_of;  // sorted global nodes -> cavity face with a model cell behind
+  auto is_wall = [&](int32_t q) {
+    return cavity.faces[q].side == FaceSide::Reservoir && cavity.faces[q].outside_cell >= 0;
+  };
+  bool any_wall = false;
   for (const auto& polygons : t.cell_polygons)
-    for (int32_t q : polygons) {
-      const ConstrainedFace& face = cavity.faces[q];
-      if (face.side != FaceSide::Reservoir || face.outside_cell < 0) continue;
-      std::vector<int32_t> key = face.nodes;
-      std::sort(key.begin(), key.end());
-      wall_of[key] = q;
-    }
-  if (wall_of.empty()) return std::nullopt;
+    for (int32_t q : polygons) any_wall = any_wall || is_wall(q);
+  if (!any_wall) return std::nullopt;
   std::vector<int32_t> global;
   const PolyMesh sub = transition_submesh(t, node_coords, &global);
   const MeshGeometry geo = compute_geometry(sub);
   const std::vector<double> qo = face_orthogonality(sub, geo, BoundaryPoint::Flux);
+  const std::vector<int32_t> wall = submesh_face_polygons(sub, global, t, cavity, is_wall);
   TransitionRefusal r;
   double worst = 90;
   for (int f = 0; f < sub.n_faces(); ++f) {
-    if (sub.face_neighbour[f] >= 0 || !(qo[f] < min_orthogonality_deg)) continue;
-    std::vector<int32_t> key;
-    for (const int32_t* v = sub.face_begin(f); v != sub.face_end(f); ++v) key.push_back(global[*v]);
-    std::sort(key.begin(), key.end());
-    const auto it = wall_of.find(key);
-    if (it == wall_of.end()) continue;
-    r.polygons.push_back(it->second);
-    r.cells_to_deactivate.push_back(cavity.faces[it->second].outside_cell);
+    if (wall[f] < 0 || !(qo[f] < min_orthogonality_deg)) continue;
+    r.polygons.push_back(wall[f]);
+    r.cells_to_deactivate.push_back(cavity.faces[wall[f]].outside_cell);
     worst = std::min(worst, qo[f]);
   }
   if (r.polygons.empty()) return std::nullopt;

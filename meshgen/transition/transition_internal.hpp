@@ -3,6 +3,7 @@
 // diagram of the sites) live in their own translation units and talk through these types.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -13,6 +14,12 @@
 #include "transition.hpp"
 
 namespace hm::transition_detail {
+
+/// Per face of `sub` (transition_submesh of t, `global` its node ids): the cavity polygon the face is
+/// (a boundary face over exactly that polygon's nodes), among the polygons `wanted` accepts; else -1.
+std::vector<int32_t> submesh_face_polygons(const PolyMesh& sub, const std::vector<int32_t>& global,
+                                           const TransitionCells& t, const Cavity& cavity,
+                                           const std::function<bool(int32_t)>& wanted);
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 

@@ -133,26 +133,14 @@ ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& gl
   const MeshGeometry geo = compute_geometry(sub);
   const CheckOptions opt;
   if (!outside_centres.empty()) {
-    std::map<std::vector<int32_t>, int32_t> polygon_of;  // sorted global nodes -> cavity face
-    for (int c = 0; c < sub.n_cells(); ++c)
-      for (int32_t q : t.cell_polygons[c]) {
-        if (!std::isfinite(outside_centres[q].x)) continue;
-        std::vector<int32_t> key = cavity.faces[q].nodes;
-        std::sort(key.begin(), key.end());
-        polygon_of[key] = q;
-      }
-    for (int f = 0; f < sub.n_faces() && !polygon_of.empty(); ++f) {
-      if (sub.face_neighbour[f] >= 0) continue;
-      std::vector<int32_t> key;
-      for (const int32_t* v = sub.face_begin(f); v != sub.face_end(f); ++v) key.push_back(global[*v]);
-      std::sort(key.begin(), key.end());
-      const auto it = polygon_of.find(key);
-      if (it == polygon_of.end()) continue;
-      if (face_orthogonality_of(sub, geo, f, outside_centres[it->second]) < opt.min_orthogonality_deg) {
+    const std::vector<int32_t> polygon = submesh_face_polygons(
+        sub, global, t, cavity, [&](int32_t q) { return std::isfinite(outside_centres[q].x); });
+    for (int f = 0; f < sub.n_faces(); ++f)
+      if (polygon[f] >= 0 &&
+          face_orthogonality_of(sub, geo, f, outside_centres[polygon[f]]) < opt.min_orthogonality_deg) {
         out.cell[sub.face_owner[f]] = 1;
         ++out.count;
       }
-    }
   }
   for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)}) {
     out.count += r.violations;
