@@ -21,6 +21,7 @@
 
 #include "meshgen/case/case_limits.hpp"
 #include "meshgen/case/near_well_layers.hpp"
+#include "meshgen/case/corner_point_fault_steps.hpp"
 #include "meshgen/case/corner_point_path.hpp"
 #include "meshgen/case/corner_point_refine.hpp"
 #include "meshgen/case/corner_point_straighten.hpp"
@@ -525,6 +526,30 @@ void refine_near_wells(CaseSpec& cs) {
   use_model(r, refined);
 }
 
+// A corner-point model whose faults step by a fraction of a layer near a well: its layers split there
+// (meshgen/case/corner_point_fault_steps.hpp) so that the two sides meet face to face in the cavities.
+void split_fault_steps_near_wells(CaseSpec& cs) {
+  ReservoirSpec& r = cs.reservoir;
+  if (!r.corner_point || cs.wells.empty()) return;
+  std::vector<FaultStepRequest> requests;
+  for (const WellSpec& w : cs.wells)
+    requests.push_back({w.trajectory, kFaultStepReach * (cs.transition.dilation + 2) * w.drainage_radius});
+  const FaultStepSplit split = fault_step_children(*r.corner_point, requests);
+  if (!split.splits()) return;
+  auto model = std::make_shared<const CornerPointModel>(layers_split_at_fault_steps(*r.corner_point, split));
+  int split_layers = 0;
+  for (int n : split.children) split_layers += n > 1;
+  cs.notes.push_back("reservoir: " + std::to_string(split.steps) + " cell corners on faults near the wells step by a "
+                     "fraction of a layer: " + std::to_string(split_layers) + " layers split there, " +
+                     std::to_string(r.corner_point->nz) + " -> " + std::to_string(model->nz) +
+                     " layers, so that the faults' two sides meet face to face (docs/corner-point.md, \"Fault steps\")");
+  const double cells = double(model->nx) * model->ny * model->nz;
+  if (cells > kMaxCells)
+    fail("reservoir.grdecl", "splitting the layers at the fault steps near the wells gives " + fmt_count(cells) +
+                                 " cells > " + fmt_count(kMaxCells));
+  use_model(r, model);
+}
+
 ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, std::vector<std::string>& notes) {
   const Fields f(n, "reservoir",
                  {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size",
@@ -815,6 +840,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   const std::vector<WellSpec> as_given = cs.wells;
   clip_paths_to_model(cs, as_given, SurfaceGapRule::Least, false);
   check_wells(cs);
+  split_fault_steps_near_wells(cs);
   refine_near_wells(cs);
   clip_paths_to_model(cs, as_given, SurfaceGapRule::SurfaceFaces, true);
   check_wells(cs);

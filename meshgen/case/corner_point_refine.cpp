@@ -71,7 +71,8 @@ std::vector<Vec3> sample_path(const std::vector<Vec3>& path, double step) {
   return out;
 }
 
-// Thickness (in depth) at (s, t) of the layer of column (i, j) that holds depth z; 0 if none does.
+// Thickness (in depth) at (s, t) of the layer of column (i, j) that holds depth z (of the layer as read, when
+// layers are split at fault steps); 0 if none does.
 double layer_thickness(const CornerPointModel& m, int i, int j, double s, double t, double z) {
   const auto w = bilinear_weights(s, t);
   for (int k = 0; k < m.nz; ++k) {
@@ -80,7 +81,23 @@ double layer_thickness(const CornerPointModel& m, int i, int j, double s, double
       top += w[a] * m.zcorn[zcorn_index(m, i, j, k, a)];
       bottom += w[a] * m.zcorn[zcorn_index(m, i, j, k, 4 | a)];
     }
-    if (top <= z && z <= bottom) return bottom - top;
+    if (top <= z && z <= bottom) {
+      // Layers split at fault steps: a child counts as at least kStepChildSizing of its parent's
+      // thickness (docs/corner-point.md, "Fault steps": sized by the thinner child, thin layers gave
+      // several times the cells; sized by the parent, a sheared model and two wells failed).
+      if (!m.parent_layer.empty()) {
+        int k0 = k, k1 = k;
+        while (k0 > 0 && m.parent_layer[k0 - 1] == m.parent_layer[k]) --k0;
+        while (k1 + 1 < m.nz && m.parent_layer[k1 + 1] == m.parent_layer[k]) ++k1;
+        double parent_top = 0, parent_bottom = 0;
+        for (int a = 0; a < 4; ++a) {
+          parent_top += w[a] * m.zcorn[zcorn_index(m, i, j, k0, a)];
+          parent_bottom += w[a] * m.zcorn[zcorn_index(m, i, j, k1, 4 | a)];
+        }
+        return std::max(bottom - top, kStepChildSizing * (parent_bottom - parent_top));
+      }
+      return bottom - top;
+    }
   }
   return 0;
 }
@@ -251,6 +268,8 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
   r.nz = m.nz;
   r.parent_nx = m.parent_cell.empty() ? m.nx : m.parent_nx;
   r.parent_ny = m.parent_cell.empty() ? m.ny : m.parent_ny;
+  r.parent_layer = m.parent_layer;
+  r.parent_nz = m.parent_nz;
   r.pinch = m.pinch;
   r.region_mult = m.region_mult;
   r.multregt_records = m.multregt_records;
@@ -287,22 +306,14 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
       for (int a = 0; a < 6; ++a) out[a] = w[0] * p[0][a] + w[1] * p[1][a] + w[2] * p[2][a] + w[3] * p[3][a];
     }
 
-  const size_t n = size_t(r.nx) * r.ny * r.nz;
-  r.corners.resize(n);
-  r.zcorn.assign(8 * n, 0.0);
-  r.actnum.resize(n);
-  r.parent_cell.resize(n);
-  for (auto* a : {&r.permx, &r.permy, &r.permz, &r.poro, &r.ntg}) a->resize(n);
-  if (!m.pore_volume_mult.empty()) r.pore_volume_mult.resize(n);
-  for (int d = 0; d < 6; ++d)
-    if (!m.trans_mult[d].empty()) r.trans_mult[d].resize(n);
+  resize_cell_arrays(r, m);
   for (int k = 0; k < r.nz; ++k)
     for (int J = 0; J < r.ny; ++J)
       for (int I = 0; I < r.nx; ++I) {
         const size_t c = I + size_t(r.nx) * (J + size_t(r.ny) * k);
         const int i = si[I].parent, j = sj[J].parent;
         const int pc = i + m.nx * (j + m.ny * k);
-        r.parent_cell[c] = m.parent_cell.empty() ? pc : m.parent_cell[pc];
+        inherit_cell(r, c, m, pc);
         for (int q = 0; q < 8; ++q) {
           const double s = q & 1 ? si[I].s1 : si[I].s0;
           const double t = (q >> 1) & 1 ? sj[J].s1 : sj[J].s0;
@@ -315,13 +326,6 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
           r.corners[c][q] = on_model_pillar ? m.corners[pc][side | (s == 1 ? 1 : 0) | (t == 1 ? 2 : 0)]
                                             : pillar_point(r, I + (q & 1) + (r.nx + 1) * (J + ((q >> 1) & 1)), z);
         }
-        r.actnum[c] = m.actnum[pc];
-        r.permx[c] = m.permx[pc];
-        r.permy[c] = m.permy[pc];
-        r.permz[c] = m.permz[pc];
-        r.poro[c] = m.poro[pc];
-        r.ntg[c] = m.ntg[pc];
-        if (!m.pore_volume_mult.empty()) r.pore_volume_mult[c] = m.pore_volume_mult[pc];
         // +x, -x, +y, -y act on the parent's faces; z on every child.
         const bool at[6] = {si[I].child == si[I].of - 1, si[I].child == 0, sj[J].child == sj[J].of - 1,
                             sj[J].child == 0, true, true};

@@ -45,6 +45,9 @@ constexpr double kRefineWiderThan = 4.0;
 /// wall stay Delaunay admissible only if the cells are not much wider than thick (measured on
 /// 3 m layers: docs/corner-point.md, "Near-well refinement").
 constexpr double kCellsPerLayerThickness = 1.5;
+/// In a model whose layers are split at fault steps, a child's thickness counts as at least this
+/// fraction of its parent's for limit_by_layer (measured: docs/corner-point.md, "Fault steps").
+constexpr double kStepChildSizing = 0.5;
 /// Beyond `reach` the target size grows by this much per metre of distance from the path, so
 /// that neighbouring slices differ by a bounded ratio and refinement dies out within a few
 /// model columns.

@@ -296,6 +296,25 @@ size_t zcorn_index(const CornerPointModel& m, int i, int j, int k, int q) {
          4 * nx * ny * (2 * size_t(k) + ((q >> 2) & 1));
 }
 
+void resize_cell_arrays(CornerPointModel& r, const CornerPointModel& m) {
+  const size_t n = size_t(r.nx) * r.ny * r.nz;
+  r.corners.assign(n, {});
+  r.zcorn.assign(8 * n, 0.0);
+  r.actnum.resize(n);
+  r.parent_cell.resize(n);
+  for (auto* v : {&r.permx, &r.permy, &r.permz, &r.poro, &r.ntg}) v->resize(n);
+  r.pore_volume_mult.resize(m.pore_volume_mult.empty() ? 0 : n);
+  for (int d = 0; d < 6; ++d) r.trans_mult[d].resize(m.trans_mult[d].empty() ? 0 : n);
+}
+
+void inherit_cell(CornerPointModel& r, size_t c, const CornerPointModel& m, size_t s) {
+  r.actnum[c] = m.actnum[s];
+  r.parent_cell[c] = m.parent_cell.empty() ? static_cast<int32_t>(s) : m.parent_cell[s];
+  r.permx[c] = m.permx[s], r.permy[c] = m.permy[s], r.permz[c] = m.permz[s];
+  r.poro[c] = m.poro[s], r.ntg[c] = m.ntg[s];
+  if (!m.pore_volume_mult.empty()) r.pore_volume_mult[c] = m.pore_volume_mult[s];
+}
+
 double corner_depth(const CornerPointModel& m, int c, int q) {
   const int i = c % m.nx, j = (c / m.nx) % m.ny, k = c / (m.nx * m.ny);
   return m.zcorn[zcorn_index(m, i, j, k, q)];

@@ -41,6 +41,10 @@ struct CornerPointModel {
   /// cell lies in (natural order of that model). Empty for a model as read.
   std::vector<int32_t> parent_cell;
   int parent_nx = 0, parent_ny = 0;  ///< refined model: nx, ny of the model as read
+  /// A model whose layers are split at fault steps (corner_point_fault_steps.hpp): the layer of the
+  /// model as read that each layer lies in, and that model's nz. Empty and 0 when no layer is split.
+  std::vector<int> parent_layer;
+  int parent_nz = 0;
   /// PINCH as OPM read it (EclipseGrid::isPinchActive and the keyword's items). OPM Flow connects two
   /// cells of a column that touch across layers of zero thickness only with PINCH (opm-grid's
   /// process_grdecl); the other items are kept to write the keyword back (docs/corner-point.md,
@@ -118,6 +122,15 @@ ReservoirSpec rectilinear_reservoir(const CornerPointModel& model, const std::st
 /// direction of the axis along which those differ (I, else J, else K); 1 without MULTREGT or within
 /// one cell of the model as read.
 double region_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
+
+/// Sizes the per-cell arrays of `r` (r.nx x r.ny x r.nz cells), a model derived from `m` (refined,
+/// split): corners, ZCORN, ACTNUM, parent_cell, rock, and the pore-volume and transmissibility
+/// multipliers that `m` has.
+void resize_cell_arrays(CornerPointModel& r, const CornerPointModel& m);
+
+/// Cell c of derived model r lies in cell s of m: it takes its ACTNUM, rock and pore-volume multiplier,
+/// and its cell as read (parent_cell). Not its geometry or transmissibility multipliers.
+void inherit_cell(CornerPointModel& r, size_t c, const CornerPointModel& m, size_t s);
 
 /// The cell of the model as read that cell c of `model` (refined or not) lies in.
 inline int64_t cell_as_read(const CornerPointModel& model, int64_t c) {

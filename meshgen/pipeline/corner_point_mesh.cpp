@@ -161,10 +161,19 @@ void attach_minpv_connections(HybridMesh& out, const CornerPointModel& model) {
   for (int64_t c = 0; c < static_cast<int64_t>(model.corners.size()); ++c)
     if (auto it = children.find(cell_as_read(model, c)); it != children.end()) it->second.push_back(c);
   const int64_t parent_nxy = model.parent_cell.empty() ? nxy : int64_t(model.parent_nx) * model.parent_ny;
+  // Layers split at fault steps: the upper cell's bottom child connects to the lower cell's top child.
+  std::vector<int64_t> first_layer;  // per layer as read, its first layer in `model`
+  for (int k = 0; k < static_cast<int>(model.parent_layer.size()); ++k)
+    if (k == 0 || model.parent_layer[k] != model.parent_layer[k - 1]) first_layer.push_back(k);
   int64_t faces = 0, missing = 0;
   for (const auto& [up, low] : model.minpv_connections)
     for (const int64_t cu : children[up]) {
-      const int64_t cl = cu + (low / parent_nxy - up / parent_nxy) * nxy;
+      int64_t cl = cu + (low / parent_nxy - up / parent_nxy) * nxy;
+      if (!model.parent_layer.empty()) {
+        const int64_t k = cu / nxy;
+        if (k + 1 < model.nz && model.parent_layer[k + 1] == model.parent_layer[k]) continue;
+        cl = cu % nxy + first_layer[low / parent_nxy] * nxy;
+      }
       const auto iu = mesh_cell.find(cu), il = mesh_cell.find(cl);
       if (iu == mesh_cell.end() || il == mesh_cell.end()) {
         ++missing;

@@ -29,7 +29,8 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
   j["cavities"] = h.cavities.cavities.size();
   if (const auto& m = cs.reservoir.corner_point) {
     const bool refined = !m->parent_cell.empty();
-    j["corner_point"] = {{"model", {refined ? m->parent_nx : m->nx, refined ? m->parent_ny : m->ny, m->nz}},
+    j["corner_point"] = {{"model", {refined ? m->parent_nx : m->nx, refined ? m->parent_ny : m->ny,
+                                    m->parent_layer.empty() ? m->nz : m->parent_nz}},
                          {"meshed", {m->nx, m->ny, m->nz}}};
   }
   nlohmann::json cav = nlohmann::json::array();

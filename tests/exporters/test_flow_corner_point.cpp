@@ -366,6 +366,27 @@ TEST(FlowCornerPoint, MinpvModelWithWellsMatchesSolverDemo) {
   EXPECT_GT(std::max(miss.pressure, miss.rate), 1e-5);
 }
 
+// A fault of 10 m throw (2.2 layers) 10 m from the producer, and the MINPV model's pinching layer: the
+// layers near the wells are split at the fault's steps (docs/corner-point.md, "Fault steps"), the deck
+// carries the split model (its children, the connections across the removed cells between the upper
+// cell's bottom child and the lower cell's top child), flow runs it and matches solver_demo.
+TEST(FlowCornerPoint, ModelSplitAtFaultStepsMatchesSolverDemo) {
+  REQUIRE_FLOW();
+  TempDir tmp("flow_cpw_steps");
+  TiltedModel g;
+  g.fault_i = 5, g.throw_m = 10;
+  g.pinch_k = 5, g.pinch_x = 180;
+  g.keywords = "MINPV\n 120 /\n";
+  CornerPointFlowRun r;
+  run_case(tmp, g, hmtest::deviated_well_yaml() + injector_yaml(150, 150, 1045, 1057), &r);
+  if (HasFatalFailure()) return;
+  ASSERT_GT(r.cs.reservoir.corner_point->nz, g.nz);
+  ASSERT_GT(r.out.mesh.n_nncs(), 0);
+  std::printf("[ figures  ] fault steps: %d -> %d layers, %d cells\n", g.nz, r.cs.reservoir.corner_point->nz,
+              r.out.mesh.n_cells());
+  expect_corner_point_run("tilted, fault steps split, MINPV", tmp, r);
+}
+
 // Pore volumes other than volume x PORO x NTG (MULTPV: an aquifer column x 1000, every seventh cell x 2.5;
 // docs/corner-point.md, "Pore volumes"). With near-well cells the deck's PORV carries them (flow's INIT PORV
 // equals ours, the multiplier included, on every cell; the near-well cells take their model cell's), the

@@ -19,6 +19,7 @@
 
 #include "../exporters/exporter_test_support.hpp"
 #include "corner_point_test_models.hpp"
+#include "model_cell_volumes.hpp"
 #include "meshgen/case/corner_point_refine.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
@@ -40,19 +41,7 @@ CornerPointModel read_model(const TempDir& tmp, const hmtest::LayeredModel& g) {
 }
 
 // The model's cells meshed alone (no wells): mesh volume per model cell (natural order).
-std::vector<double> cell_volumes(const CornerPointModel& m) {
-  CaseSpec cs;
-  cs.name = "m";
-  cs.reservoir = corner_point_reservoir(std::make_shared<const CornerPointModel>(m), "reservoir.grdecl");
-  const HybridMesh out = build_hybrid_mesh(cs);
-  EXPECT_TRUE(out.build_report.ok);
-  std::vector<double> v(m.corners.size(), 0.0);
-  for (int c = 0; c < out.mesh.n_cells(); ++c) {
-    const auto& ijk = out.mesh.cell_ijk[c];
-    v[ijk[0] + m.nx * (ijk[1] + m.ny * ijk[2])] = out.geometry.cell_volume[c];
-  }
-  return v;
-}
+std::vector<double> cell_volumes(const CornerPointModel& m) { return hmtest::model_cell_volumes(m); }
 
 std::string well_case(const std::string& grdecl, const std::string& reservoir_extra, double radius) {
   return "name: m\nreservoir: {grdecl: " + grdecl + reservoir_extra +

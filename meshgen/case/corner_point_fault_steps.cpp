@@ -1,0 +1,280 @@
+#include "corner_point_fault_steps.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "segment_distance.hpp"
+
+namespace hm {
+
+bool FaultStepSplit::splits() const {
+  return std::any_of(children.begin(), children.end(), [](int n) { return n > 1; });
+}
+
+namespace {
+
+// The up-to-4 columns around pillar (I, J), as slots a (bit 0: the column's i is I, bit 1: its j is J),
+// and the corner of that column on the pillar.
+struct PillarColumns {
+  const CornerPointModel& m;
+  bool present(int I, int J, int a) const {
+    const int ci = I - 1 + (a & 1), cj = J - 1 + (a >> 1);
+    return ci >= 0 && cj >= 0 && ci < m.nx && cj < m.ny;
+  }
+  static int column_i(int I, int a) { return I - 1 + (a & 1); }
+  static int column_j(int J, int a) { return J - 1 + (a >> 1); }
+  static int corner(int a) { return (a & 1 ? 0 : 1) | (a & 2 ? 0 : 2); }
+  double top(int I, int J, int a, int k) const {
+    return m.zcorn[zcorn_index(m, column_i(I, a), column_j(J, a), k, corner(a))];
+  }
+  double bottom(int I, int J, int a, int k) const {
+    return m.zcorn[zcorn_index(m, column_i(I, a), column_j(J, a), k, 4 | corner(a))];
+  }
+  bool active(int I, int J, int a, int k) const {
+    return m.actnum[column_i(I, a) + size_t(m.nx) * (column_j(J, a) + size_t(m.ny) * k)] != 0;
+  }
+};
+
+// The depths of the active cells' tops and bottoms of column slot a on pillar (I, J), sorted.
+std::vector<double> column_boundaries(const PillarColumns& pc, int I, int J, int a) {
+  std::vector<double> out;
+  for (int k = 0; k < pc.m.nz; ++k)
+    if (pc.active(I, J, a, k)) out.push_back(pc.top(I, J, a, k)), out.push_back(pc.bottom(I, J, a, k));
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// Whether a boundary of column slot a lies strictly inside an active cell of slot b at pillar (I, J)
+// (kMinStepFraction of that cell's thickness from its ends).
+bool cuts_a_cell_of(const PillarColumns& pc, int I, int J, const std::vector<double>& boundaries_a, int b) {
+  for (int k = 0; k < pc.m.nz; ++k) {
+    if (!pc.active(I, J, b, k)) continue;
+    const double top = pc.top(I, J, b, k), bottom = pc.bottom(I, J, b, k), margin = kMinStepFraction * (bottom - top);
+    const auto it = std::upper_bound(boundaries_a.begin(), boundaries_a.end(), top + margin);
+    if (it != boundaries_a.end() && *it < bottom - margin) return true;
+  }
+  return false;
+}
+
+// The column slots at a pillar whose layers are offset against each other both ways (a fault's two
+// sides): offset[a][b]. A column with a boundary inside another's cell but not the other way round (a
+// layer pinching out or ending, cells MINPV removed and their neighbours extended over them) is no
+// fault step.
+std::array<std::array<bool, 4>, 4> offset_columns(const PillarColumns& pc, int I, int J,
+                                                  const std::vector<std::vector<double>>& boundaries) {
+  std::array<std::array<bool, 4>, 4> cut{}, out{};
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      cut[a][b] = a != b && pc.present(I, J, a) && pc.present(I, J, b) && cuts_a_cell_of(pc, I, J, boundaries[a], b);
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b) out[a][b] = cut[a][b] && cut[b][a];
+  return out;
+}
+
+// Boundaries of the columns offset against column slot a (offset[a]) strictly inside (top, bottom),
+// kMinStepFraction of the thickness away from either end and from each other (the upper one kept), at
+// most `limit`.
+std::vector<double> steps_inside(const std::vector<std::vector<double>>& boundaries, const std::array<bool, 4>& offset,
+                                 double top, double bottom, size_t limit) {
+  const double margin = kMinStepFraction * (bottom - top);
+  std::vector<double> d;
+  for (int b = 0; b < 4; ++b) {
+    if (!offset[b]) continue;
+    const auto& v = boundaries[b];
+    for (auto it = std::upper_bound(v.begin(), v.end(), top + margin); it != v.end() && *it < bottom - margin; ++it)
+      d.push_back(*it);
+  }
+  std::sort(d.begin(), d.end());
+  std::vector<double> out;
+  for (double z : d)
+    if (out.empty() || z - out.back() >= margin) out.push_back(z);
+  if (out.size() > limit) out.resize(limit);
+  return out;
+}
+
+bool within_reach(Vec3 p, const std::vector<FaultStepRequest>& wells) {
+  for (const FaultStepRequest& w : wells)
+    for (size_t s = 0; s + 1 < w.path.size(); ++s)
+      if (segment_segment_distance(p, p, w.path[s], w.path[s + 1]) <= w.reach) return true;
+  return false;
+}
+
+// Split depths of one layer at one pillar side: n - 1 increasing depths strictly inside the layer.
+// Exact ones are the other side's ZCORN values; the rest pad the widest gaps at their middles.
+std::vector<double> padded(std::vector<double> exact, double top, double bottom, size_t n_minus_1) {
+  while (exact.size() < n_minus_1) {
+    std::vector<double> b{top};
+    b.insert(b.end(), exact.begin(), exact.end());
+    b.push_back(bottom);
+    size_t widest = 0;
+    for (size_t g = 1; g + 1 < b.size(); ++g)
+      if (b[g + 1] - b[g] > b[widest + 1] - b[widest]) widest = g;
+    exact.insert(exact.begin() + static_cast<long>(widest), 0.5 * (b[widest] + b[widest + 1]));
+  }
+  return exact;
+}
+
+}  // namespace
+
+FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells) {
+  FaultStepSplit out;
+  out.children.assign(m.nz, 1);
+  const PillarColumns pc{m};
+  std::vector<std::vector<double>> boundaries(4);
+  for (int J = 0; J <= m.ny; ++J)
+    for (int I = 0; I <= m.nx; ++I) {
+      for (int a = 0; a < 4; ++a) boundaries[a] = pc.present(I, J, a) ? column_boundaries(pc, I, J, a) : std::vector<double>{};
+      const auto offset = offset_columns(pc, I, J, boundaries);
+      if (std::none_of(offset.begin(), offset.end(), [](const auto& row) { return row[0] || row[1] || row[2] || row[3]; }))
+        continue;
+      const int p = I + (m.nx + 1) * J;
+      for (int k = 0; k < m.nz; ++k)
+        for (int a = 0; a < 4; ++a) {
+          if (!pc.present(I, J, a) || !pc.active(I, J, a, k)) continue;
+          const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
+          if (!(bottom > top)) continue;
+          const size_t n = steps_inside(boundaries, offset[a], top, bottom, kMaxStepChildren - 1).size();
+          if (n == 0 || !within_reach(pillar_point(m, p, 0.5 * (top + bottom)), wells)) continue;
+          ++out.steps;
+          out.children[k] = std::max(out.children[k], 1 + static_cast<int>(n));
+        }
+    }
+  return out;
+}
+
+CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const FaultStepSplit& split) {
+  const PillarColumns pc{m};
+  const int np = (m.nx + 1) * (m.ny + 1);
+  // Per split layer: per pillar and column slot, the child boundaries inside the layer (n - 1 depths).
+  std::vector<std::vector<std::vector<double>>> inner(m.nz);
+  std::vector<std::vector<std::vector<double>>> all_boundaries(np, std::vector<std::vector<double>>(4));
+  std::vector<std::array<std::array<bool, 4>, 4>> offset(np);
+  for (int J = 0; J <= m.ny; ++J)
+    for (int I = 0; I <= m.nx; ++I) {
+      const int p = I + (m.nx + 1) * J;
+      for (int a = 0; a < 4; ++a)
+        if (pc.present(I, J, a)) all_boundaries[p][a] = column_boundaries(pc, I, J, a);
+      offset[p] = offset_columns(pc, I, J, all_boundaries[p]);
+    }
+  for (int k = 0; k < m.nz; ++k) {
+    const int n = split.children[k];
+    if (n <= 1) continue;
+    auto& depth = inner[k];
+    depth.assign(size_t(np) * 4, {});
+    // Sides: the columns at a pillar whose layer k has the same top and bottom share their depths.
+    std::vector<int> side(size_t(np) * 4, -1);
+    std::deque<int> queue;  // pillar * 4 + representative slot, breadth first from the steps
+    for (int J = 0; J <= m.ny; ++J)
+      for (int I = 0; I <= m.nx; ++I) {
+        const int p = I + (m.nx + 1) * J;
+        for (int a = 0; a < 4; ++a) {
+          if (!pc.present(I, J, a)) continue;
+          int rep = a;
+          for (int b = 0; b < a; ++b)
+            if (pc.present(I, J, b) && pc.top(I, J, b, k) == pc.top(I, J, a, k) &&
+                pc.bottom(I, J, b, k) == pc.bottom(I, J, a, k)) {
+              rep = side[size_t(p) * 4 + b];
+              break;
+            }
+          side[size_t(p) * 4 + a] = rep;
+          if (rep != a) continue;
+          const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
+          if (!(bottom > top)) continue;
+          std::vector<double> exact = steps_inside(all_boundaries[p], offset[p][a], top, bottom, size_t(n - 1));
+          if (exact.empty()) continue;
+          depth[size_t(p) * 4 + a] = padded(std::move(exact), top, bottom, size_t(n - 1));
+          queue.push_back(p * 4 + a);
+        }
+      }
+    // Breadth first: a side without steps takes the fractions of the side it is reached from across
+    // one of its columns, so that every column sharing the pillar there gets the same depths.
+    auto fractions_of = [&](int node) {
+      const int p = node / 4, a = node % 4, I = p % (m.nx + 1), J = p / (m.nx + 1);
+      const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
+      std::vector<double> f;
+      for (double z : depth[size_t(node)]) f.push_back(bottom > top ? (z - top) / (bottom - top) : 0.5);
+      return f;
+    };
+    auto assign = [&](int node, const std::vector<double>& f) {
+      const int p = node / 4, a = node % 4, I = p % (m.nx + 1), J = p / (m.nx + 1);
+      const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
+      auto& d = depth[size_t(node)];
+      for (double x : f) d.push_back(top + x * (bottom - top));
+    };
+    while (!queue.empty()) {
+      const int node = queue.front();
+      queue.pop_front();
+      const std::vector<double> f = fractions_of(node);
+      const int p = node / 4, I = p % (m.nx + 1), J = p / (m.nx + 1);
+      for (int a = 0; a < 4; ++a) {
+        if (!pc.present(I, J, a) || side[size_t(p) * 4 + a] != node % 4) continue;
+        const int ci = PillarColumns::column_i(I, a), cj = PillarColumns::column_j(J, a);
+        for (int q = 0; q < 4; ++q) {
+          const int I2 = ci + (q & 1), J2 = cj + (q >> 1), p2 = I2 + (m.nx + 1) * J2;
+          const int a2 = (ci - I2 + 1) | ((cj - J2 + 1) << 1);
+          const int rep = side[size_t(p2) * 4 + a2], node2 = p2 * 4 + rep;
+          if (!depth[size_t(node2)].empty()) continue;
+          assign(node2, f);
+          queue.push_back(node2);
+        }
+      }
+    }
+    std::vector<double> equal;
+    for (int c = 1; c < n; ++c) equal.push_back(double(c) / n);
+    for (int node = 0; node < np * 4; ++node)
+      if (side[size_t(node)] == node % 4 && depth[size_t(node)].empty()) assign(node, equal);
+    // Every slot reads its side's depths.
+    for (int node = 0; node < np * 4; ++node)
+      if (side[size_t(node)] >= 0 && side[size_t(node)] != node % 4)
+        depth[size_t(node)] = depth[size_t(node / 4 * 4 + side[size_t(node)])];
+  }
+
+  CornerPointModel r = m;
+  std::vector<int> first_child(m.nz + 1, 0);
+  for (int k = 0; k < m.nz; ++k) first_child[k + 1] = first_child[k] + split.children[k];
+  r.nz = first_child[m.nz];
+  if (m.parent_cell.empty()) r.parent_nx = m.nx, r.parent_ny = m.ny;
+  r.parent_nz = m.parent_layer.empty() ? m.nz : m.parent_nz;
+  r.parent_layer.resize(r.nz);
+  for (int k = 0; k < m.nz; ++k)
+    for (int c = first_child[k]; c < first_child[k + 1]; ++c) r.parent_layer[c] = m.parent_layer.empty() ? k : m.parent_layer[k];
+  resize_cell_arrays(r, m);
+  r.opm_volume.clear();
+  for (int k = 0; k < m.nz; ++k) {
+    const int nk = split.children[k];
+    for (int j = 0; j < m.ny; ++j)
+      for (int i = 0; i < m.nx; ++i) {
+        const size_t pcell = i + size_t(m.nx) * (j + size_t(m.ny) * k);
+        for (int child = 0; child < nk; ++child) {
+          const int kc = first_child[k] + child;
+          const size_t c = i + size_t(r.nx) * (j + size_t(r.ny) * kc);
+          for (int q = 0; q < 8; ++q) {
+            const int corner = q & 3, I = i + (q & 1), J = j + ((q >> 1) & 1), p = I + (m.nx + 1) * J;
+            const int level = child + (q >> 2);  // 0: the parent's top ... nk: its bottom
+            double z;
+            if (level == 0 || level == nk) {
+              z = m.zcorn[zcorn_index(m, i, j, k, (level == 0 ? 0 : 4) | corner)];
+              r.corners[c][q] = m.corners[pcell][(level == 0 ? 0 : 4) | corner];
+            } else {
+              const int a = (i - I + 1) | ((j - J + 1) << 1);
+              z = inner[k][size_t(p) * 4 + a][size_t(level - 1)];
+              r.corners[c][q] = pillar_point(m, p, z);
+            }
+            r.zcorn[zcorn_index(r, i, j, kc, q)] = z;
+          }
+          inherit_cell(r, c, m, pcell);
+          // x and y multipliers on every child's faces; MULTZ on the parent's bottom, MULTZ- on its top.
+          const bool at[6] = {true, true, true, true, child == nk - 1, child == 0};
+          for (int d = 0; d < 6; ++d)
+            if (!m.trans_mult[d].empty()) r.trans_mult[d][c] = at[d] ? m.trans_mult[d][pcell] : 1.0;
+        }
+      }
+  }
+  return r;
+}
+
+}  // namespace hm

@@ -1,0 +1,134 @@
+// Layers split at fault steps near the wells (meshgen/case/corner_point_fault_steps.hpp,
+// docs/corner-point.md "Fault steps"). What can fail: which layers are split and only near a well,
+// the children tile their parents, the two sides of the fault meet face to face afterwards (no fault
+// face left, every child depth on a fault pillar is a depth of the other side), rock and multipliers
+// are inherited as the keywords mean, and a well across a fraction-of-a-layer throw meshes soundly.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <set>
+
+#include "../exporters/exporter_test_support.hpp"
+#include "corner_point_test_models.hpp"
+#include "model_cell_volumes.hpp"
+#include "meshgen/case/corner_point_fault_steps.hpp"
+#include "meshgen/case/grdecl.hpp"
+#include "meshgen/grids/corner_point_grid.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
+
+using namespace hm;
+using hmtest::TempDir;
+
+namespace {
+
+// 8 x 5 x 6 cells of 30 x 30 x 2 m, dipping, pillars leaning 10 degrees along x, a fault of 0.4 layer
+// (0.8 m) on pillar line i = 4.
+hmtest::LayeredModel faulted_model() {
+  hmtest::LayeredModel g;
+  g.nx = 8, g.ny = 5, g.nz = 6, g.dx = 30, g.dy = 30, g.dz = 2, g.dip_deg = 3, g.pillar_deg = 10;
+  g.fault_i = 4, g.throw_m = 0.8;
+  return g;
+}
+
+CornerPointModel read_model(const TempDir& tmp, const hmtest::LayeredModel& g) {
+  std::ofstream(tmp.path / "M.GRDECL") << g.text();
+  return read_corner_point_model((tmp.path / "M.GRDECL").string(), "reservoir.grdecl");
+}
+
+// Mesh volume per model cell (natural order), the model's cells meshed alone; and the fault faces.
+std::vector<double> cell_volumes(const CornerPointModel& m, int64_t* fault_faces) {
+  MeshBuilder scratch;
+  *fault_faces = corner_point_cell_faces(m, std::vector<char>(m.actnum.size(), 1), scratch).fault_faces;
+  return hmtest::model_cell_volumes(m);
+}
+
+// The depths of column (i, j)'s corners on pillar (I, J), all layers.
+std::set<double> depths_on_pillar(const CornerPointModel& m, int i, int j, int I, int J) {
+  std::set<double> out;
+  const int q = (I > i ? 1 : 0) | (J > j ? 2 : 0);
+  for (int k = 0; k < m.nz; ++k) out.insert(m.zcorn[zcorn_index(m, i, j, k, q)]), out.insert(m.zcorn[zcorn_index(m, i, j, k, 4 | q)]);
+  return out;
+}
+
+}  // namespace
+
+// A vertical well beside the fault asks for every layer it reaches to be split in two; a well far
+// from the fault asks nothing.
+TEST(FaultSteps, LayersNearAWellAcrossAFractionalThrowAreSplit) {
+  TempDir tmp("cpsteps_children");
+  const CornerPointModel m = read_model(tmp, faulted_model());
+  // The fault's pillar line is at x = 120 at depth 1000 (leaning 10 degrees along x).
+  const FaultStepSplit near = fault_step_children(m, {{{{125, 75, 1000}, {125, 75, 1012}}, 20}});
+  ASSERT_EQ(near.children.size(), 6u);
+  for (int k = 0; k < m.nz; ++k) EXPECT_EQ(near.children[k], 2) << "layer " << k;
+  EXPECT_GT(near.steps, 0);
+  const FaultStepSplit far = fault_step_children(m, {{{{15, 15, 1000}, {15, 15, 1012}}, 20}});
+  EXPECT_FALSE(far.splits());
+  // A whole-layer throw is no step.
+  hmtest::LayeredModel whole = faulted_model();
+  whole.throw_m = 2 * whole.dz;
+  EXPECT_FALSE(fault_step_children(read_model(tmp, whole), {{{{125, 75, 1000}, {125, 75, 1012}}, 20}}).splits());
+}
+
+// The split model: children tile their parents, the parents' tops and bottoms are kept bit for bit,
+// the fault's two sides meet face to face (no fault face), rock and multipliers as the keywords mean.
+TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
+  TempDir tmp("cpsteps_tile");
+  CornerPointModel m = read_model(tmp, faulted_model());
+  const int marked = 3 + m.nx * (2 + m.ny * 2);  // cell (3, 2, 2), beside the fault: +x, -y, +z and -z multipliers
+  m.trans_mult[0][marked] = 0.5;
+  m.trans_mult[3][marked] = 0.25;
+  m.trans_mult[4][marked] = 0.125;
+  m.trans_mult[5][marked] = 0.0625;
+  const FaultStepSplit split = fault_step_children(m, {{{{125, 75, 1000}, {125, 75, 1012}}, 20}});
+  const CornerPointModel r = layers_split_at_fault_steps(m, split);
+  ASSERT_EQ(r.nz, 2 * m.nz);
+  ASSERT_EQ(r.parent_layer.size(), size_t(r.nz));
+  EXPECT_EQ(r.parent_nz, m.nz);
+  check_corner_point_geometry(r, "split");
+
+  int64_t faults_before = 0, faults_after = 0;
+  const std::vector<double> parent_volume = cell_volumes(m, &faults_before), child_volume = cell_volumes(r, &faults_after);
+  EXPECT_GT(faults_before, 0);
+  EXPECT_EQ(faults_after, 0);
+  std::vector<double> sum(parent_volume.size(), 0.0);
+  for (size_t c = 0; c < r.corners.size(); ++c) sum[r.parent_cell[c]] += child_volume[c];
+  for (size_t p = 0; p < parent_volume.size(); ++p) EXPECT_NEAR(sum[p] / parent_volume[p], 1.0, 1e-12) << "model cell " << p;
+
+  // On the fault's pillars (line i = 4) every child depth of one side is a depth of the other side but
+  // the left side's top and the right side's bottom (the throw).
+  for (int J = 0; J <= m.ny; ++J)
+    for (int j : {J - 1, J}) {
+      if (j < 0 || j >= m.ny) continue;
+      const std::set<double> left = depths_on_pillar(r, 3, j, 4, J), right = depths_on_pillar(r, 4, j, 4, J);
+      std::vector<double> only;
+      std::set_symmetric_difference(left.begin(), left.end(), right.begin(), right.end(), std::back_inserter(only));
+      ASSERT_EQ(only.size(), 2u) << "pillar (4, " << J << ")";
+      EXPECT_EQ(only[0], *left.begin());
+      EXPECT_EQ(only[1], *right.rbegin());
+    }
+
+  for (size_t c = 0; c < r.corners.size(); ++c) {
+    const int p = r.parent_cell[c], k = static_cast<int>(c / (size_t(r.nx) * r.ny));
+    const bool first = k == 0 || r.parent_layer[k - 1] != r.parent_layer[k];
+    const bool last = k + 1 == r.nz || r.parent_layer[k + 1] != r.parent_layer[k];
+    for (int q = 0; q < 8; ++q)
+      if ((q < 4 && first) || (q >= 4 && last)) {
+        EXPECT_EQ(r.corners[c][q], m.corners[p][q]) << c << " " << q;
+      }
+    EXPECT_EQ(r.permx[c], m.permx[p]);
+    EXPECT_EQ(r.poro[c], m.poro[p]);
+    EXPECT_EQ(r.actnum[c], m.actnum[p]);
+    if (p != marked) {
+      for (int d = 0; d < 6; ++d) EXPECT_EQ(r.trans_mult[d][c], 1.0);
+      continue;
+    }
+    EXPECT_EQ(r.trans_mult[0][c], 0.5);
+    EXPECT_EQ(r.trans_mult[3][c], 0.25);
+    EXPECT_EQ(r.trans_mult[4][c], last ? 0.125 : 1.0);
+    EXPECT_EQ(r.trans_mult[5][c], first ? 0.0625 : 1.0);
+  }
+}
