@@ -96,11 +96,27 @@ std::vector<double> steps_inside(const std::vector<std::vector<double>>& boundar
   return out;
 }
 
-bool within_reach(Vec3 p, const std::vector<FaultStepRequest>& wells) {
-  for (const FaultStepRequest& w : wells)
-    for (size_t s = 0; s + 1 < w.path.size(); ++s)
-      if (segment_segment_distance(p, p, w.path[s], w.path[s + 1]) <= w.reach) return true;
-  return false;
+// Distance from p to a well's path.
+double path_distance(Vec3 p, const FaultStepRequest& w) {
+  double d = std::numeric_limits<double>::infinity();
+  for (size_t s = 0; s + 1 < w.path.size(); ++s) d = std::min(d, segment_segment_distance(p, p, w.path[s], w.path[s + 1]));
+  return d;
+}
+
+// Per cell: whether its bounding sphere (about the mean of its corners) comes within reach of a well
+// that asked.
+std::vector<char> cells_near(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells,
+                             const std::vector<char>& asked) {
+  std::vector<char> near(m.corners.size(), 0);
+  for (size_t c = 0; c < m.corners.size(); ++c) {
+    Vec3 centre{0, 0, 0};
+    for (const Vec3& q : m.corners[c]) centre += q / 8.0;
+    double radius = 0;
+    for (const Vec3& q : m.corners[c]) radius = std::max(radius, norm(q - centre));
+    for (size_t w = 0; w < wells.size() && !near[c]; ++w)
+      near[c] = asked[w] && path_distance(centre, wells[w]) <= wells[w].reach + radius;
+  }
+  return near;
 }
 
 // Split depths of one layer at one pillar side: n - 1 increasing depths strictly inside the layer.
@@ -123,6 +139,7 @@ std::vector<double> padded(std::vector<double> exact, double top, double bottom,
 FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells) {
   FaultStepSplit out;
   out.children.assign(m.nz, 1);
+  std::vector<char> asked(wells.size(), 0);
   const PillarColumns pc{m};
   std::vector<std::vector<double>> boundaries(4);
   for (int J = 0; J <= m.ny; ++J)
@@ -138,11 +155,17 @@ FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<
           const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
           if (!(bottom > top)) continue;
           const size_t n = steps_inside(boundaries, offset[a], top, bottom, kMaxStepChildren - 1).size();
-          if (n == 0 || !within_reach(pillar_point(m, p, 0.5 * (top + bottom)), wells)) continue;
+          if (n == 0) continue;
+          const Vec3 corner = pillar_point(m, p, 0.5 * (top + bottom));
+          bool reached = false;
+          for (size_t w = 0; w < wells.size(); ++w)
+            if (path_distance(corner, wells[w]) <= wells[w].reach) asked[w] = 1, reached = true;
+          if (!reached) continue;
           ++out.steps;
           out.children[k] = std::max(out.children[k], 1 + static_cast<int>(n));
         }
     }
+  if (out.splits()) out.near = cells_near(m, wells, asked);
   return out;
 }
 
@@ -165,7 +188,11 @@ CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const Fa
     if (n <= 1) continue;
     auto& depth = inner[k];
     depth.assign(size_t(np) * 4, {});
-    // Sides: the columns at a pillar whose layer k has the same top and bottom share their depths.
+    // Sides: the columns at a pillar whose layer k has the same top and bottom, and that are all near
+    // a well or all not, share their depths.
+    auto near_cell = [&](int I, int J, int a) {
+      return split.near[PillarColumns::column_i(I, a) + size_t(m.nx) * (PillarColumns::column_j(J, a) + size_t(m.ny) * k)] != 0;
+    };
     std::vector<int> side(size_t(np) * 4, -1);
     std::deque<int> queue;  // pillar * 4 + representative slot, breadth first from the steps
     for (int J = 0; J <= m.ny; ++J)
@@ -176,13 +203,17 @@ CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const Fa
           int rep = a;
           for (int b = 0; b < a; ++b)
             if (pc.present(I, J, b) && pc.top(I, J, b, k) == pc.top(I, J, a, k) &&
-                pc.bottom(I, J, b, k) == pc.bottom(I, J, a, k)) {
+                pc.bottom(I, J, b, k) == pc.bottom(I, J, a, k) && near_cell(I, J, b) == near_cell(I, J, a)) {
               rep = side[size_t(p) * 4 + b];
               break;
             }
           side[size_t(p) * 4 + a] = rep;
           if (rep != a) continue;
           const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
+          if (!near_cell(I, J, a)) {  // whole in the first child, the others of zero thickness at its bottom
+            depth[size_t(p) * 4 + a].assign(size_t(n - 1), bottom);
+            continue;
+          }
           if (!(bottom > top)) continue;
           std::vector<double> exact = steps_inside(all_boundaries[p], offset[p][a], top, bottom, size_t(n - 1));
           if (exact.empty()) continue;
@@ -255,20 +286,25 @@ CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const Fa
           for (int q = 0; q < 8; ++q) {
             const int corner = q & 3, I = i + (q & 1), J = j + ((q >> 1) & 1), p = I + (m.nx + 1) * J;
             const int level = child + (q >> 2);  // 0: the parent's top ... nk: its bottom
-            double z;
-            if (level == 0 || level == nk) {
-              z = m.zcorn[zcorn_index(m, i, j, k, (level == 0 ? 0 : 4) | corner)];
-              r.corners[c][q] = m.corners[pcell][(level == 0 ? 0 : 4) | corner];
-            } else {
-              const int a = (i - I + 1) | ((j - J + 1) << 1);
-              z = inner[k][size_t(p) * 4 + a][size_t(level - 1)];
-              r.corners[c][q] = pillar_point(m, p, z);
-            }
+            const double top = m.zcorn[zcorn_index(m, i, j, k, corner)], bottom = m.zcorn[zcorn_index(m, i, j, k, 4 | corner)];
+            const double z = level == 0    ? top
+                             : level == nk ? bottom
+                                           : inner[k][size_t(p) * 4 + ((i - I + 1) | ((j - J + 1) << 1))][size_t(level - 1)];
+            // On the parent's top or bottom: its corner bit for bit.
+            r.corners[c][q] = z == top      ? m.corners[pcell][corner]
+                              : z == bottom ? m.corners[pcell][4 | corner]
+                                            : pillar_point(m, p, z);
             r.zcorn[zcorn_index(r, i, j, kc, q)] = z;
           }
           inherit_cell(r, c, m, pcell);
-          // x and y multipliers on every child's faces; MULTZ on the parent's bottom, MULTZ- on its top.
-          const bool at[6] = {true, true, true, true, child == nk - 1, child == 0};
+          // x and y multipliers on every child's faces; MULTZ where the child ends at the parent's
+          // bottom, MULTZ- where it starts at its top.
+          bool at_top = true, at_bottom = true;
+          for (int q = 0; q < 4; ++q) {
+            at_top = at_top && r.zcorn[zcorn_index(r, i, j, kc, q)] == m.zcorn[zcorn_index(m, i, j, k, q)];
+            at_bottom = at_bottom && r.zcorn[zcorn_index(r, i, j, kc, 4 | q)] == m.zcorn[zcorn_index(m, i, j, k, 4 | q)];
+          }
+          const bool at[6] = {true, true, true, true, at_bottom, child == 0 && at_top};
           for (int d = 0; d < 6; ++d)
             if (!m.trans_mult[d].empty()) r.trans_mult[d][c] = at[d] ? m.trans_mult[d][pcell] : 1.0;
         }

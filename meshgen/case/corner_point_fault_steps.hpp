@@ -2,9 +2,10 @@
 // whose throw is a fraction of a layer, the two sides' cells meet along faces that match only in
 // part: the cavity's walls then carry nodes in the middle of their edges, and no triangulation of
 // such a wall face keeps every polygon site in its own cell (measured: the site correction stalls,
-// or the step's triangles are not Delaunay admissible). Splitting each layer there at the other
-// side's layer boundaries makes the two sides meet face to face; as a corner-point grid again
-// (whole layers split, each child a corner-point cell), so that the deck carries it as it is.
+// or the step's triangles are not Delaunay admissible). Splitting each layer near the wells at the other
+// side's layer boundaries makes the two sides meet face to face there; the result is a corner-point
+// grid again (the cells away from the wells keep their thickness in one child, the others of zero
+// thickness), so that the deck carries it as it is.
 #pragma once
 #include <string>
 #include <vector>
@@ -23,7 +24,7 @@ constexpr int kMaxStepChildren = 4;
 
 /// A step counts within this many times a well's cavity reach, (dilation + 2) drainage radii, of its
 /// path: the cavity may grow beyond its dilation (Gabriel rounds, enlargements).
-constexpr double kFaultStepReach = 2.0;
+constexpr double kFaultStepReach = 1.0;
 
 /// Where a well asks for fault steps to be split: its path and the distance from it within which a
 /// step counts.
@@ -35,6 +36,9 @@ struct FaultStepRequest {
 /// What split_layers_at_fault_steps did.
 struct FaultStepSplit {
   std::vector<int> children;  ///< per layer of the input model, >= 1 (all 1: nothing to split)
+  /// Per cell of the input model: within reach of a well that asked for a split (its cells are split;
+  /// the others keep their whole thickness in their first child, the rest of zero thickness).
+  std::vector<char> near;
   int64_t steps = 0;          ///< cell corners on a fault pillar within reach that asked for a split
   bool splits() const;
 };
@@ -45,13 +49,16 @@ struct FaultStepSplit {
 /// many children as the most such boundaries in one corner, plus one.
 FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells);
 
-/// The model with layer k split into split.children[k] children. On each side of each fault pillar
-/// the children end exactly at the other side's boundaries (the same ZCORN values) where the counts
-/// agree; elsewhere a pillar takes the fractions of the nearest pillar that has them (breadth first
-/// over the columns, so that cells sharing a pillar keep sharing their corners), equal children where
-/// none is near. The parent's top and bottom stay bit for bit. Rock, ACTNUM and the x/y multipliers
-/// are the parent's in every child; MULTZ acts on the bottom child's bottom, MULTZ- on the top
-/// child's top. `parent_cell` maps each cell to the model's cell as read, `parent_layer` each layer.
+/// The model with layer k split into split.children[k] children. Cells near the wells (split.near):
+/// on each side of each fault pillar the children end exactly at the other side's boundaries (the same
+/// ZCORN values); elsewhere a pillar takes the fractions of the nearest pillar that has them (breadth
+/// first over the columns, so that cells sharing a pillar keep sharing their corners), equal children
+/// where none is near. The other cells keep their whole thickness in their first child, the others of
+/// zero thickness at its bottom (not meshed; the cells above and below connect as in the model as read,
+/// `across_pinched_layers` counting layers as read). The parent's top and bottom stay bit for bit. Rock,
+/// ACTNUM and the x/y multipliers are the parent's in every child; MULTZ acts on the bottom of the
+/// children that end at the parent's bottom, MULTZ- on the top of the one that starts at its top.
+/// `parent_cell` maps each cell to the model's cell as read, `parent_layer` each layer.
 CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const FaultStepSplit& split);
 
 }  // namespace hm

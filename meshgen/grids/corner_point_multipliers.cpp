@@ -30,7 +30,10 @@ TriangleKey triangle_key(const std::vector<Vec3>& xyz, const int32_t* v) {
 
 bool across_pinched_layers(const CornerPointModel& model, int64_t a, int64_t b) {
   const int64_t nxy = static_cast<int64_t>(model.nx) * model.ny;
-  return a % nxy == b % nxy && std::abs(a / nxy - b / nxy) > 1;
+  if (a % nxy != b % nxy) return false;
+  // Layers split at fault steps: the children of zero thickness away from the steps are no pinch-out.
+  const auto layer = [&](int64_t c) { return model.parent_layer.empty() ? c / nxy : model.parent_layer[static_cast<size_t>(c / nxy)]; };
+  return std::abs(layer(a) - layer(b)) > 1;
 }
 
 bool minpv_connects(const CornerPointModel& model, int64_t a, int64_t b) {

@@ -161,18 +161,30 @@ void attach_minpv_connections(HybridMesh& out, const CornerPointModel& model) {
   for (int64_t c = 0; c < static_cast<int64_t>(model.corners.size()); ++c)
     if (auto it = children.find(cell_as_read(model, c)); it != children.end()) it->second.push_back(c);
   const int64_t parent_nxy = model.parent_cell.empty() ? nxy : int64_t(model.parent_nx) * model.parent_ny;
-  // Layers split at fault steps: the upper cell's bottom child connects to the lower cell's top child.
-  std::vector<int64_t> first_layer;  // per layer as read, its first layer in `model`
-  for (int k = 0; k < static_cast<int>(model.parent_layer.size()); ++k)
-    if (k == 0 || model.parent_layer[k] != model.parent_layer[k - 1]) first_layer.push_back(k);
+  // Layers split at fault steps: the upper cell's lowest meshed child connects to the lower cell's
+  // highest meshed child (children of zero thickness are not meshed).
+  std::vector<int64_t> first_layer(static_cast<size_t>(model.parent_nz) + 1, 0);  // per layer as read
+  for (int k = static_cast<int>(model.parent_layer.size()) - 1; k >= 0; --k) first_layer[model.parent_layer[k]] = k;
+  if (!model.parent_layer.empty()) first_layer.back() = model.nz;
+  auto meshed_child = [&](int64_t column, int64_t layer_as_read, bool lowest) -> int64_t {
+    for (int64_t a = first_layer[layer_as_read + 1] - 1; a >= first_layer[layer_as_read]; --a) {
+      const int64_t k = lowest ? a : first_layer[layer_as_read] + first_layer[layer_as_read + 1] - 1 - a;
+      if (mesh_cell.count(column + k * nxy)) return column + k * nxy;
+    }
+    return -1;
+  };
   int64_t faces = 0, missing = 0;
   for (const auto& [up, low] : model.minpv_connections)
-    for (const int64_t cu : children[up]) {
+    for (int64_t cu : children[up]) {
       int64_t cl = cu + (low / parent_nxy - up / parent_nxy) * nxy;
       if (!model.parent_layer.empty()) {
-        const int64_t k = cu / nxy;
-        if (k + 1 < model.nz && model.parent_layer[k + 1] == model.parent_layer[k]) continue;
-        cl = cu % nxy + first_layer[low / parent_nxy] * nxy;
+        if (cu / nxy != first_layer[up / parent_nxy]) continue;  // one connection per column
+        const int64_t up_mesh = meshed_child(cu % nxy, up / parent_nxy, true), low_mesh = meshed_child(cu % nxy, low / parent_nxy, false);
+        if (up_mesh < 0 || low_mesh < 0) {
+          ++missing;
+          continue;
+        }
+        cu = up_mesh, cl = low_mesh;
       }
       const auto iu = mesh_cell.find(cu), il = mesh_cell.find(cl);
       if (iu == mesh_cell.end() || il == mesh_cell.end()) {

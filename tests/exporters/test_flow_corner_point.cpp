@@ -366,10 +366,11 @@ TEST(FlowCornerPoint, MinpvModelWithWellsMatchesSolverDemo) {
   EXPECT_GT(std::max(miss.pressure, miss.rate), 1e-5);
 }
 
-// A fault of 10 m throw (2.2 layers) 10 m from the producer, and the MINPV model's pinching layer: the
-// layers near the wells are split at the fault's steps (docs/corner-point.md, "Fault steps"), the deck
-// carries the split model (its children, the connections across the removed cells between the upper
-// cell's bottom child and the lower cell's top child), flow runs it and matches solver_demo.
+// A fault of 10 m throw (2.2 layers) crossed by the deviated producer, an injector beyond it, and the MINPV
+// model's pinching layer: the cells near the producer are split at the fault's steps (docs/corner-point.md,
+// "Fault steps"), the others keep their thickness beside children of none; the deck carries the split
+// model (the connections across those children and across the removed cells, between the meshed
+// children), flow runs it as typed and matches solver_demo.
 TEST(FlowCornerPoint, ModelSplitAtFaultStepsMatchesSolverDemo) {
   REQUIRE_FLOW();
   TempDir tmp("flow_cpw_steps");
@@ -378,7 +379,7 @@ TEST(FlowCornerPoint, ModelSplitAtFaultStepsMatchesSolverDemo) {
   g.pinch_k = 5, g.pinch_x = 180;
   g.keywords = "MINPV\n 120 /\n";
   CornerPointFlowRun r;
-  run_case(tmp, g, hmtest::deviated_well_yaml() + injector_yaml(150, 150, 1045, 1057), &r);
+  run_case(tmp, g, hmtest::deviated_well_yaml() + injector_yaml(170, 170, 1045, 1057), &r);
   if (HasFatalFailure()) return;
   ASSERT_GT(r.cs.reservoir.corner_point->nz, g.nz);
   ASSERT_GT(r.out.mesh.n_nncs(), 0);

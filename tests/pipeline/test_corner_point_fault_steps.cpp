@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -45,14 +46,6 @@ std::vector<double> cell_volumes(const CornerPointModel& m, int64_t* fault_faces
   return hmtest::model_cell_volumes(m);
 }
 
-// The depths of column (i, j)'s corners on pillar (I, J), all layers.
-std::set<double> depths_on_pillar(const CornerPointModel& m, int i, int j, int I, int J) {
-  std::set<double> out;
-  const int q = (I > i ? 1 : 0) | (J > j ? 2 : 0);
-  for (int k = 0; k < m.nz; ++k) out.insert(m.zcorn[zcorn_index(m, i, j, k, q)]), out.insert(m.zcorn[zcorn_index(m, i, j, k, 4 | q)]);
-  return out;
-}
-
 }  // namespace
 
 // A vertical well beside the fault asks for every layer it reaches to be split in two; a well far
@@ -74,7 +67,8 @@ TEST(FaultSteps, LayersNearAWellAcrossAFractionalThrowAreSplit) {
 }
 
 // The split model: children tile their parents, the parents' tops and bottoms are kept bit for bit,
-// the fault's two sides meet face to face (no fault face), rock and multipliers as the keywords mean.
+// near the well the fault's two sides meet face to face, away from it a cell stays whole (its other
+// children of zero thickness), rock and multipliers as the keywords mean.
 TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
   TempDir tmp("cpsteps_tile");
   CornerPointModel m = read_model(tmp, faulted_model());
@@ -93,28 +87,59 @@ TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
   int64_t faults_before = 0, faults_after = 0;
   const std::vector<double> parent_volume = cell_volumes(m, &faults_before), child_volume = cell_volumes(r, &faults_after);
   EXPECT_GT(faults_before, 0);
-  EXPECT_EQ(faults_after, 0);
+  std::printf("[ figures  ] fault faces: %lld before, %lld after (between cells near the well and the others)\n",
+              static_cast<long long>(faults_before), static_cast<long long>(faults_after));
   std::vector<double> sum(parent_volume.size(), 0.0);
   for (size_t c = 0; c < r.corners.size(); ++c) sum[r.parent_cell[c]] += child_volume[c];
-  for (size_t p = 0; p < parent_volume.size(); ++p) EXPECT_NEAR(sum[p] / parent_volume[p], 1.0, 1e-12) << "model cell " << p;
+  int near = 0, far = 0;
+  for (size_t p = 0; p < parent_volume.size(); ++p) {
+    EXPECT_NEAR(sum[p] / parent_volume[p], 1.0, 1e-12) << "model cell " << p;
+    (split.near[p] ? near : far)++;
+  }
+  EXPECT_GT(near, 0);
+  EXPECT_GT(far, 0);
+  // Away from the well a cell is whole in its first child, the other of zero thickness (not meshed).
+  for (size_t c = 0; c < r.corners.size(); ++c) {
+    const size_t p = static_cast<size_t>(r.parent_cell[c]);
+    if (split.near[p]) continue;
+    const bool first = c / (size_t(r.nx) * r.ny) == size_t(2 * (p / (size_t(m.nx) * m.ny)));
+    EXPECT_NEAR(child_volume[c], first ? parent_volume[p] : 0.0, 1e-12 * parent_volume[p]) << "cell " << c;
+  }
 
-  // On the fault's pillars (line i = 4) every child depth of one side is a depth of the other side but
-  // the left side's top and the right side's bottom (the throw).
+  // On the fault's pillars (line i = 4), between cells near the well: every child depth of one side is a
+  // depth of the other side, within the range both sides span.
   for (int J = 0; J <= m.ny; ++J)
     for (int j : {J - 1, J}) {
       if (j < 0 || j >= m.ny) continue;
-      const std::set<double> left = depths_on_pillar(r, 3, j, 4, J), right = depths_on_pillar(r, 4, j, 4, J);
-      std::vector<double> only;
-      std::set_symmetric_difference(left.begin(), left.end(), right.begin(), right.end(), std::back_inserter(only));
-      ASSERT_EQ(only.size(), 2u) << "pillar (4, " << J << ")";
-      EXPECT_EQ(only[0], *left.begin());
-      EXPECT_EQ(only[1], *right.rbegin());
+      auto near_depths = [&](int i) {
+        std::set<double> out;
+        const int q = (4 > i ? 1 : 0) | (J > j ? 2 : 0);
+        for (int k = 0; k < r.nz; ++k) {
+          const size_t c = i + size_t(r.nx) * (j + size_t(r.ny) * k);
+          if (!split.near[static_cast<size_t>(r.parent_cell[c])]) continue;
+          out.insert(r.zcorn[zcorn_index(r, i, j, k, q)]), out.insert(r.zcorn[zcorn_index(r, i, j, k, 4 | q)]);
+        }
+        return out;
+      };
+      const std::set<double> left = near_depths(3), right = near_depths(4);
+      if (left.empty() || right.empty()) continue;
+      const double lo = std::max(*left.begin(), *right.begin()), hi = std::min(*left.rbegin(), *right.rbegin());
+      int matched = 0;
+      for (const std::set<double>* side : {&left, &right})
+        for (double z : *side)
+          if (z >= lo && z <= hi) {
+            EXPECT_TRUE(left.count(z) && right.count(z)) << "pillar (4, " << J << ") depth " << z;
+            ++matched;
+          }
+      EXPECT_GT(matched, 4);
     }
 
   for (size_t c = 0; c < r.corners.size(); ++c) {
     const int p = r.parent_cell[c], k = static_cast<int>(c / (size_t(r.nx) * r.ny));
     const bool first = k == 0 || r.parent_layer[k - 1] != r.parent_layer[k];
     const bool last = k + 1 == r.nz || r.parent_layer[k + 1] != r.parent_layer[k];
+    bool at_bottom = true;  // the child ends at its parent's bottom (the last one; the first too away from the well)
+    for (int q = 4; q < 8; ++q) at_bottom = at_bottom && r.corners[c][q] == m.corners[p][q];
     for (int q = 0; q < 8; ++q)
       if ((q < 4 && first) || (q >= 4 && last)) {
         EXPECT_EQ(r.corners[c][q], m.corners[p][q]) << c << " " << q;
@@ -128,7 +153,9 @@ TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
     }
     EXPECT_EQ(r.trans_mult[0][c], 0.5);
     EXPECT_EQ(r.trans_mult[3][c], 0.25);
-    EXPECT_EQ(r.trans_mult[4][c], last ? 0.125 : 1.0);
+    EXPECT_TRUE(split.near[p]);
+    EXPECT_EQ(r.trans_mult[4][c], at_bottom ? 0.125 : 1.0);
+    EXPECT_EQ(at_bottom, last);
     EXPECT_EQ(r.trans_mult[5][c], first ? 0.0625 : 1.0);
   }
 }
