@@ -74,6 +74,49 @@ std::vector<ResTriangle> reservoir_triangles(const CornerPointCellFaces& cells, 
 
 }  // namespace
 
+int regularize_cavity_surface(const CornerPointCellFaces& cells, std::vector<char>& active,
+                              const std::vector<Vec3>& coords) {
+  int added = 0;
+  for (;;) {
+    const std::vector<ResTriangle> tris = reservoir_triangles(cells, active, coords);
+    std::map<std::pair<int32_t, int32_t>, std::vector<int32_t>> edge_tris;
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (size_t i = 0; i < 3; ++i) {
+        const int32_t a = tris[t].nodes[i], b = tris[t].nodes[(i + 1) % 3];
+        edge_tris[{std::min(a, b), std::max(a, b)}].push_back(static_cast<int32_t>(t));
+      }
+    std::set<int32_t> offending;  // triangles at a non-manifold edge or vertex
+    for (const auto& [e, ts] : edge_tris)
+      if (ts.size() > 2) offending.insert(ts.begin(), ts.end());
+    // Fans around each vertex: its triangles joined across the edges they share through it.
+    std::map<int32_t, std::vector<int32_t>> vertex_tris;
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (int32_t v : tris[t].nodes) vertex_tris[v].push_back(static_cast<int32_t>(t));
+    for (const auto& [v, ts] : vertex_tris) {
+      std::vector<int32_t> fan(ts.size(), -1);
+      std::vector<size_t> stack{0};
+      fan[0] = 0;
+      while (!stack.empty()) {
+        const size_t u = stack.back();
+        stack.pop_back();
+        for (int32_t x : tris[ts[u]].nodes) {
+          if (x == v) continue;
+          for (int32_t t : edge_tris.at({std::min(v, x), std::max(v, x)})) {
+            const size_t w = std::find(ts.begin(), ts.end(), t) - ts.begin();
+            if (fan[w] < 0) fan[w] = 0, stack.push_back(w);
+          }
+        }
+      }
+      if (std::find(fan.begin(), fan.end(), -1) != fan.end()) offending.insert(ts.begin(), ts.end());
+    }
+    int grown = 0;
+    for (int32_t t : offending)
+      if (tris[t].outside >= 0 && active[tris[t].outside]) active[tris[t].outside] = 0, ++grown;
+    if (grown == 0) return added;
+    added += grown;
+  }
+}
+
 CornerPointLocator::CornerPointLocator(const CornerPointModel& model, const CornerPointCellFaces& cells,
                                        const std::vector<int32_t>& among, const std::vector<Vec3>& coords) {
   for (int32_t c : among) {
@@ -137,6 +180,7 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
     if (c >= 0 && c < nc) active[c] = 0;
   const ReservoirGrid index_grid = make_reservoir_grid(cs.reservoir);  // index arithmetic (nx, ny, nz)
   int regularized = regularize_deactivated(index_grid, active);
+  regularized += regularize_cavity_surface(cells, active, coords);
 
   const WellSurfaces well_side = well_surfaces(blocks, well_node_ids);
   const std::vector<int32_t>& well_vertices = well_side.vertices;
@@ -271,6 +315,7 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
     for (int32_t c : grow) active[c] = 0;
     repaired += static_cast<int>(grow.size());
     regularized += regularize_deactivated(index_grid, active);
+    regularized += regularize_cavity_surface(cells, active, coords);
   }
   out.gabriel_violations_remaining = remaining;
   if (remaining > 0)

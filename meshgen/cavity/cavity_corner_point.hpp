@@ -33,6 +33,14 @@ class CornerPointLocator {
   std::vector<Cell> cells_;
 };
 
+/// Makes the boundary of the deactivated meshed cells (active[c] == 0) a 2-manifold where the model's
+/// index space misleads regularize_deactivated (a zero-thickness cell between two cells of a column,
+/// layers split at fault steps, faults): at every edge of the boundary's triangles used by more than two
+/// of them, and every vertex whose triangles make more than one fan, the active cells behind those
+/// triangles are deactivated, until none is left. Returns the cells added.
+int regularize_cavity_surface(const CornerPointCellFaces& cells, std::vector<char>& active,
+                              const std::vector<Vec3>& node_coords);
+
 /// The cavities of the wells in a corner-point model: `cells` (corner_point_cell_faces) with
 /// its nodes in `node_coords`, `well_node_ids[w]` the builder ids of block w's nodes. Every
 /// cavity has cells_are_boxes = false, no mirror plane, and a locate_cell over its cells.
