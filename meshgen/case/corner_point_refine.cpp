@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <utility>
 
 namespace hm {
@@ -205,41 +206,89 @@ bool ColumnSplits::refines() const {
          std::any_of(j.begin(), j.end(), [](int n) { return n > 1; });
 }
 
+namespace {
+
+// The model cell (ip, jp) holding x in plan and its parameters (s, t) there; false outside the columns.
+bool locate_point(const CornerPointModel& m, Vec3 x, int& ip, int& jp, double& s, double& t) {
+  for (int j = 0; j < m.ny; ++j)
+    for (int i = 0; i < m.nx; ++i)
+      if (locate_in_column(m, i, j, x, s, t)) return ip = i, jp = j, true;
+  return false;
+}
+
+// Calls visit(slice index, along i?, request) for what each point of the path asks of each slice
+// across it wider than `wider_than` target sizes (every slice of its row along i, of its column along j).
+template <class Visit>
+void for_each_ask(const CornerPointModel& m, const RefinementRequest& r, double wider_than, Visit visit) {
+  for (const Vec3& x : sample_path(r.path, 0.5 * r.cell_size)) {
+    int ip = -1, jp = -1;
+    double s = 0, t = 0;
+    if (!locate_point(m, x, ip, jp, s, t)) continue;
+    double size = r.cell_size;
+    if (const double h = layer_thickness(m, ip, jp, s, t, x.z); r.limit_by_layer && h > 0)
+      size = std::min(size, kCellsPerLayerThickness * h);
+    auto ask = [&](int slice, bool along_i, int holder, double at, Vec3 lo, Vec3 hi) {
+      const double width = plan_distance(lo, hi);
+      if (!(width > wider_than * size)) return;
+      if (slice == holder)
+        visit(slice, along_i, SliceRequest{width, 0.0, at, size, r.reach, r.graded});
+      else if (slice > holder)
+        visit(slice, along_i, SliceRequest{width, plan_distance(x, lo), 0.0, size, r.reach, r.graded});
+      else
+        visit(slice, along_i, SliceRequest{width, plan_distance(x, hi), 1.0, size, r.reach, r.graded});
+    };
+    for (int i = 0; i < m.nx; ++i)
+      ask(i, true, ip, s, column_point(m, i, jp, 0, t, x.z), column_point(m, i, jp, 1, t, x.z));
+    for (int j = 0; j < m.ny; ++j)
+      ask(j, false, jp, t, column_point(m, ip, j, s, 0, x.z), column_point(m, ip, j, s, 1, x.z));
+  }
+}
+
+}  // namespace
+
 ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<RefinementRequest>& wells) {
-  std::vector<std::vector<SliceRequest>> ask_i(m.nx), ask_j(m.ny);
-  for (const RefinementRequest& r : wells) {
-    if (!(r.cell_size > 0)) continue;
-    for (const Vec3& x : sample_path(r.path, 0.5 * r.cell_size)) {
-      int ip = -1, jp = -1;
-      double s = 0, t = 0;
-      for (int j = 0; j < m.ny && ip < 0; ++j)
-        for (int i = 0; i < m.nx && ip < 0; ++i)
-          if (locate_in_column(m, i, j, x, s, t)) ip = i, jp = j;
-      if (ip < 0) continue;
-      double size = r.cell_size;
-      if (const double h = layer_thickness(m, ip, jp, s, t, x.z); r.limit_by_layer && h > 0)
-        size = std::min(size, kCellsPerLayerThickness * h);
-      // Slices along i in the row of x (at its t), then along j in its column (at its s); a slice
-      // no wider than kRefineWiderThan sizes is left whole.
-      auto ask = [&](std::vector<SliceRequest>& asks, int slice, int holder, double at, Vec3 lo, Vec3 hi) {
-        const double width = plan_distance(lo, hi);
-        if (!(width > kRefineWiderThan * size)) return;
-        if (slice == holder)
-          asks.push_back({width, 0.0, at, size, r.reach, r.graded});
-        else if (slice > holder)
-          asks.push_back({width, plan_distance(x, lo), 0.0, size, r.reach, r.graded});
-        else
-          asks.push_back({width, plan_distance(x, hi), 1.0, size, r.reach, r.graded});
-      };
-      for (int i = 0; i < m.nx; ++i)
-        ask(ask_i[i], i, ip, s, column_point(m, i, jp, 0, t, x.z), column_point(m, i, jp, 1, t, x.z));
-      for (int j = 0; j < m.ny; ++j)
-        ask(ask_j[j], j, jp, t, column_point(m, ip, j, s, 0, x.z), column_point(m, ip, j, s, 1, x.z));
-    }
+  using Asks = std::vector<std::vector<SliceRequest>>;
+  std::vector<Asks> ask_i(wells.size(), Asks(m.nx)), ask_j(wells.size(), Asks(m.ny));
+  auto ask_of = [&](size_t w) {
+    return [&, w](int slice, bool along_i, const SliceRequest& q) { (along_i ? ask_i : ask_j)[w][slice].push_back(q); };
+  };
+  for (size_t w = 0; w < wells.size(); ++w)
+    if (wells[w].cell_size > 0) for_each_ask(m, wells[w], kRefineWiderThan, ask_of(w));
+  // A well whose reach (or the slices next to it) the children of another well cross asks for every
+  // slice there wider than its size: cells many times longer than wide beside its cavity give walls no Gabriel repair clears.
+  auto split_by_others = [&](const std::vector<Asks>& asks, size_t w, size_t slice) {
+    std::vector<SliceRequest> others;
+    for (size_t o = 0; o < wells.size(); ++o)
+      if (o != w) others.insert(others.end(), asks[o][slice].begin(), asks[o][slice].end());
+    return slice_bounds(others).size() > 2;
+  };
+  std::vector<size_t> crossed;
+  for (size_t w = 0; w < wells.size() && wells.size() > 1; ++w) {
+    if (!(wells[w].cell_size > 0)) continue;
+    std::set<std::pair<bool, int>> near;  // slices within the well's reach, and the next ones (the cavity's walls)
+    for_each_ask(m, wells[w], 0.0, [&](int slice, bool along_i, const SliceRequest& q) {
+      if (q.d < wells[w].reach)
+        for (int next : {slice - 1, slice, slice + 1})
+          if (next >= 0 && next < (along_i ? m.nx : m.ny)) near.insert({along_i, next});
+    });
+    for (const auto& [along_i, slice] : near)
+      if (split_by_others(along_i ? ask_i : ask_j, w, slice)) {
+        crossed.push_back(w);
+        break;
+      }
+  }
+  for (size_t w : crossed) {
+    ask_i[w].assign(m.nx, {}), ask_j[w].assign(m.ny, {});
+    for_each_ask(m, wells[w], kRefineBesideChildrenWiderThan, ask_of(w));
+  }
+  Asks all_i(m.nx), all_j(m.ny);
+  for (size_t w = 0; w < wells.size(); ++w) {
+    for (int i = 0; i < m.nx; ++i) all_i[i].insert(all_i[i].end(), ask_i[w][i].begin(), ask_i[w][i].end());
+    for (int j = 0; j < m.ny; ++j) all_j[j].insert(all_j[j].end(), ask_j[w][j].begin(), ask_j[w][j].end());
   }
   ColumnSplits out;
-  for (const auto& asks : ask_i) out.i_bounds.push_back(slice_bounds(asks));
-  for (const auto& asks : ask_j) out.j_bounds.push_back(slice_bounds(asks));
+  for (const auto& asks : all_i) out.i_bounds.push_back(slice_bounds(asks));
+  for (const auto& asks : all_j) out.j_bounds.push_back(slice_bounds(asks));
   for (const auto& b : out.i_bounds) out.i.push_back(static_cast<int>(b.size()) - 1);
   for (const auto& b : out.j_bounds) out.j.push_back(static_cast<int>(b.size()) - 1);
   return out;

@@ -40,6 +40,9 @@ struct RefinementRequest {
 /// A column or row wider than this many target cell sizes is split (Gabriel repair handles the
 /// narrower ones with a round or two: docs/corner-point.md, measured).
 constexpr double kRefineWiderThan = 4.0;
+/// Where another well's children cross a well's reach, that well's slices wider than this many target
+/// sizes are split too (docs/corner-point.md, "Near-well refinement": two wells).
+constexpr double kRefineBesideChildrenWiderThan = 1.0;
 /// With limit_by_layer, near-well cells are at most this many layer thicknesses wide: where the
 /// pillars are inclined the cells are sheared, and the constrained triangles of a sheared cavity
 /// wall stay Delaunay admissible only if the cells are not much wider than thick (measured on

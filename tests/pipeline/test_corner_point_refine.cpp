@@ -351,6 +351,53 @@ TEST(NearWellRefinement, SplitsFollowTheWellWhereverTheModelSits) {
     for (size_t a = 0; a < s.i_bounds[i].size(); ++a) EXPECT_NEAR(moved.i_bounds[i][a], s.i_bounds[i][a], 1e-9) << i;
 }
 
+// Two wells: a well whose columns are narrow for its own size keeps them alone, but where the children
+// of another well's columns cross its reach (or the slices next to it) its own slices there are split
+// to its size too: cells many times longer than wide beside its cavity gave walls no Gabriel repair
+// cleared (docs/corner-point.md, "Near-well refinement", two wells).
+TEST(NearWellRefinement, AWellCrossedByAnothersChildrenIsRefinedToItsSize) {
+  TempDir tmp("cprefine2");
+  hmtest::LayeredModel g;
+  g.nx = 12, g.ny = 12, g.nz = 6, g.dx = 20, g.dy = 20;
+  const CornerPointModel m = read_model(tmp, g);
+  // A vertical well at (x, y) through the middle four layers, asking for cells of `size` within 20 m.
+  auto well = [&](double x, double y, double size) {
+    const double top = 1000 + std::tan(g.dip_deg * M_PI / 180) * x + 0.01 * y;
+    return RefinementRequest{{{x, y, top + 3}, {x, y, top + 15}}, size, 20, false};
+  };
+  // A: 4 m cells asked in 20 m columns (split); B: 5 m cells in 20 m columns (not wider than 4 sizes).
+  const RefinementRequest a = well(110, 110, 4), b_far = well(30, 30, 5), b_beside = well(30, 110, 5);
+  EXPECT_FALSE(near_well_splits(m, {b_beside}).refines());  // fail half: alone, B's columns stay whole
+  const ColumnSplits alone = near_well_splits(m, {a});
+  ASSERT_TRUE(alone.refines());
+  // B at (30, 30): A's rows and columns (about 110 +- 30 m) do not come near it: A's splits unchanged.
+  const ColumnSplits far = near_well_splits(m, {a, b_far});
+  EXPECT_EQ(far.i, alone.i);
+  EXPECT_EQ(far.j, alone.j);
+  // B at (30, 110): A's rows pass through it, so B's columns 0-2 (x 0-60 m) get children of about 5 m
+  // near it, and A's splits are kept where B asks nothing more.
+  const ColumnSplits beside = near_well_splits(m, {a, b_beside});
+  std::printf("[ figures  ] children per column i, A alone:");
+  for (int n : alone.i) std::printf(" %d", n);
+  std::printf("; A and B beside its rows:");
+  for (int n : beside.i) std::printf(" %d", n);
+  std::printf("\n");
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(alone.i[i], 1) << i;
+    EXPECT_GE(beside.i[i], 3) << i;
+    for (size_t q = 0; q + 1 < beside.i_bounds[i].size(); ++q) {  // within B's reach: its size, to rounding
+      const double x0 = 20 * (i + beside.i_bounds[i][q]), x1 = 20 * (i + beside.i_bounds[i][q + 1]);
+      if (std::abs(x0 - 30) <= 20 && std::abs(x1 - 30) <= 20) {
+        EXPECT_LE(x1 - x0, 7.0) << i;
+      }
+    }
+  }
+  for (int i = 3; i < 12; ++i) {
+    EXPECT_GE(beside.i[i], alone.i[i]) << i;
+  }
+  EXPECT_EQ(beside.i.back(), alone.i.back());  // 210-240 m, beyond both reaches
+}
+
 // Thin layers (3 m) in coarse cells (100 m), a vertical 12 m well of drainage radius 10 m: without
 // refinement the Gabriel repair takes the cavity to the model's top (refused, with the reason);
 // with it the mesh is sound, for vertical pillars and pillars leaning 40 and 56 degrees (sheared
