@@ -21,7 +21,7 @@ namespace {
 struct PillarColumns {
   const CornerPointModel& m;
   bool present(int I, int J, int a) const {
-    const int ci = I - 1 + (a & 1), cj = J - 1 + (a >> 1);
+    const int ci = column_i(I, a), cj = column_j(J, a);
     return ci >= 0 && cj >= 0 && ci < m.nx && cj < m.ny;
   }
   static int column_i(int I, int a) { return I - 1 + (a & 1); }
@@ -65,7 +65,7 @@ bool cuts_a_cell_of(const PillarColumns& pc, int I, int J, const std::vector<dou
 // layer pinching out or ending, cells MINPV removed and their neighbours extended over them) is no
 // fault step.
 std::array<std::array<bool, 4>, 4> offset_columns(const PillarColumns& pc, int I, int J,
-                                                  const std::vector<std::vector<double>>& boundaries) {
+                                                  const std::array<std::vector<double>, 4>& boundaries) {
   std::array<std::array<bool, 4>, 4> cut{}, out{};
   for (int a = 0; a < 4; ++a)
     for (int b = 0; b < 4; ++b)
@@ -78,7 +78,7 @@ std::array<std::array<bool, 4>, 4> offset_columns(const PillarColumns& pc, int I
 // Boundaries of the columns offset against column slot a (offset[a]) strictly inside (top, bottom),
 // kMinStepFraction of the thickness away from either end and from each other (the upper one kept), at
 // most `limit`.
-std::vector<double> steps_inside(const std::vector<std::vector<double>>& boundaries, const std::array<bool, 4>& offset,
+std::vector<double> steps_inside(const std::array<std::vector<double>, 4>& boundaries, const std::array<bool, 4>& offset,
                                  double top, double bottom, size_t limit) {
   const double margin = kMinStepFraction * (bottom - top);
   std::vector<double> d;
@@ -141,14 +141,16 @@ FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<
   out.children.assign(m.nz, 1);
   std::vector<char> asked(wells.size(), 0);
   const PillarColumns pc{m};
-  std::vector<std::vector<double>> boundaries(4);
+  FaultPillar fp;
   for (int J = 0; J <= m.ny; ++J)
     for (int I = 0; I <= m.nx; ++I) {
-      for (int a = 0; a < 4; ++a) boundaries[a] = pc.present(I, J, a) ? column_boundaries(pc, I, J, a) : std::vector<double>{};
-      const auto offset = offset_columns(pc, I, J, boundaries);
+      const auto& boundaries = fp.boundaries;
+      for (int a = 0; a < 4; ++a) fp.boundaries[a] = pc.present(I, J, a) ? column_boundaries(pc, I, J, a) : std::vector<double>{};
+      const auto& offset = fp.offset = offset_columns(pc, I, J, boundaries);
       if (std::none_of(offset.begin(), offset.end(), [](const auto& row) { return row[0] || row[1] || row[2] || row[3]; }))
         continue;
-      const int p = I + (m.nx + 1) * J;
+      const int p = fp.pillar = I + (m.nx + 1) * J;
+      out.fault_pillars.push_back(fp);
       for (int k = 0; k < m.nz; ++k)
         for (int a = 0; a < 4; ++a) {
           if (!pc.present(I, J, a) || !pc.active(I, J, a, k)) continue;
@@ -174,15 +176,8 @@ CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const Fa
   const int np = (m.nx + 1) * (m.ny + 1);
   // Per split layer: per pillar and column slot, the child boundaries inside the layer (n - 1 depths).
   std::vector<std::vector<std::vector<double>>> inner(m.nz);
-  std::vector<std::vector<std::vector<double>>> all_boundaries(np, std::vector<std::vector<double>>(4));
-  std::vector<std::array<std::array<bool, 4>, 4>> offset(np);
-  for (int J = 0; J <= m.ny; ++J)
-    for (int I = 0; I <= m.nx; ++I) {
-      const int p = I + (m.nx + 1) * J;
-      for (int a = 0; a < 4; ++a)
-        if (pc.present(I, J, a)) all_boundaries[p][a] = column_boundaries(pc, I, J, a);
-      offset[p] = offset_columns(pc, I, J, all_boundaries[p]);
-    }
+  std::vector<const FaultPillar*> fault_pillar(np, nullptr);
+  for (const FaultPillar& fp : split.fault_pillars) fault_pillar[fp.pillar] = &fp;
   for (int k = 0; k < m.nz; ++k) {
     const int n = split.children[k];
     if (n <= 1) continue;
@@ -214,8 +209,9 @@ CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const Fa
             depth[size_t(p) * 4 + a].assign(size_t(n - 1), bottom);
             continue;
           }
-          if (!(bottom > top)) continue;
-          std::vector<double> exact = steps_inside(all_boundaries[p], offset[p][a], top, bottom, size_t(n - 1));
+          if (!(bottom > top) || !fault_pillar[p]) continue;
+          std::vector<double> exact =
+              steps_inside(fault_pillar[p]->boundaries, fault_pillar[p]->offset[a], top, bottom, size_t(n - 1));
           if (exact.empty()) continue;
           depth[size_t(p) * 4 + a] = padded(std::move(exact), top, bottom, size_t(n - 1));
           queue.push_back(p * 4 + a);

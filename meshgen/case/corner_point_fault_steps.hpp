@@ -7,6 +7,7 @@
 // grid again (the cells away from the wells keep their thickness in one child, the others of zero
 // thickness), so that the deck carries it as it is.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -33,13 +34,23 @@ struct FaultStepRequest {
   double reach = 0;
 };
 
-/// What split_layers_at_fault_steps did.
+/// A pillar whose columns' layers are offset against each other both ways (a fault's two sides there).
+struct FaultPillar {
+  int pillar = 0;  ///< I + (nx + 1) J
+  /// Per column slot a (bit 0: the column's i is I, bit 1: its j is J): the depths of its active
+  /// cells' tops and bottoms on the pillar, sorted, distinct; empty for a slot outside the model.
+  std::array<std::vector<double>, 4> boundaries;
+  std::array<std::array<bool, 4>, 4> offset{};  ///< offset[a][b]: slots a and b are offset both ways
+};
+
+/// What fault_step_children found.
 struct FaultStepSplit {
   std::vector<int> children;  ///< per layer of the input model, >= 1 (all 1: nothing to split)
   /// Per cell of the input model: within reach of a well that asked for a split (its cells are split;
   /// the others keep their whole thickness in their first child, the rest of zero thickness).
   std::vector<char> near;
   int64_t steps = 0;          ///< cell corners on a fault pillar within reach that asked for a split
+  std::vector<FaultPillar> fault_pillars;  ///< every such pillar of the model, by increasing pillar
   bool splits() const;
 };
 

@@ -143,7 +143,8 @@ TEST(CornerPointSweep, SweepTable) {
   std::map<Outcome, int> count;
   for (uint32_t seed = first; seed < static_cast<uint32_t>(first + n); ++seed) {
     const CornerPointSweepCase c = make_corner_point_case(seed);
-    // 900 s: the largest seeds (thin layers split at a fault's steps, 1.8M cells) take about 8 minutes.
+    // 900 s: the largest seeds (thin layers split at a fault's steps: seeds 4 and 23, 1.5-1.7M cells) mesh in
+    // about 5 minutes alone and take longer beside the test suites (docs/corner-point.md, sweep).
     const CaseResult r = run_isolated([&] { return mesh_corner_point_case(c); }, 900);
     ++count[r.outcome];
     std::printf("| %s | %s | %s | %.1f |\n", c.label.c_str(), outcome_name(r.outcome),
