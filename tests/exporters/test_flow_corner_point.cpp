@@ -371,21 +371,29 @@ TEST(FlowCornerPoint, MinpvModelWithWellsMatchesSolverDemo) {
 // "Fault steps"), the others keep their thickness beside children of none; the deck carries the split
 // model (the connections across those children and across the removed cells, between the meshed
 // children), flow runs it as typed and matches solver_demo.
+// The injector at (40, 150) sits beside the producer's refined rows (its own columns refined to its size
+// since session 25: "Near-well refinement", two wells).
 TEST(FlowCornerPoint, ModelSplitAtFaultStepsMatchesSolverDemo) {
   REQUIRE_FLOW();
-  TempDir tmp("flow_cpw_steps");
   TiltedModel g;
   g.fault_i = 5, g.throw_m = 10;
   g.pinch_k = 5, g.pinch_x = 180;
   g.keywords = "MINPV\n 120 /\n";
-  CornerPointFlowRun r;
-  run_case(tmp, g, hmtest::deviated_well_yaml() + injector_yaml(170, 170, 1045, 1057), &r);
-  if (HasFatalFailure()) return;
-  ASSERT_GT(r.cs.reservoir.corner_point->nz, g.nz);
-  ASSERT_GT(r.out.mesh.n_nncs(), 0);
-  std::printf("[ figures  ] fault steps: %d -> %d layers, %d cells\n", g.nz, r.cs.reservoir.corner_point->nz,
-              r.out.mesh.n_cells());
-  expect_corner_point_run("tilted, fault steps split, MINPV", tmp, r);
+  for (const auto& [x, y] : {std::pair{170.0, 170.0}, {40.0, 150.0}}) {
+    const std::string where = "tilted, fault steps split, MINPV, injector at (" + hmtest::grdecl_number(x) + ", " +
+                              hmtest::grdecl_number(y) + ")";
+    SCOPED_TRACE(where);
+    TempDir tmp("flow_cpw_steps");
+    CornerPointFlowRun r;
+    run_case(tmp, g, hmtest::deviated_well_yaml() + injector_yaml(x, y, 1045, 1057), &r);
+    if (HasFatalFailure()) return;
+    ASSERT_GT(r.cs.reservoir.corner_point->nz, g.nz);
+    ASSERT_GT(r.out.mesh.n_nncs(), 0);
+    std::printf("[ figures  ] fault steps: %d -> %d layers, %d cells\n", g.nz, r.cs.reservoir.corner_point->nz,
+                r.out.mesh.n_cells());
+    expect_corner_point_run(where.c_str(), tmp, r);
+    if (HasFatalFailure()) return;
+  }
 }
 
 // Pore volumes other than volume x PORO x NTG (MULTPV: an aquifer column x 1000, every seventh cell x 2.5;

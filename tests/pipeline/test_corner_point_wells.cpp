@@ -550,6 +550,80 @@ TEST(CornerPointWells, WellAcrossAFaultOfTenMetresMeshesSoundly) {
   expect_sound_mesh(cs, out);
 }
 
+// The 10 m fault model of the flow test (a pinching layer, MINPV), the deviated producer across the
+// fault, and an injector where the producer's refined rows and columns pass beside it (its own 20 m
+// columns are not wider than 4 of its 5 m cells). It failed at all four places (session 24: the cavity's
+// walls were cells 3 m wide and 20 m long; and at (150, 150) the cavity was not a 2-manifold across the
+// split's zero-thickness layers). The injector's columns are now refined to its size too
+// (docs/corner-point.md, "Near-well refinement", two wells); each case meshes soundly.
+TEST(CornerPointWells, SecondWellBesideTheFirstOnesChildrenMeshesSoundly) {
+  TiltedModel g;
+  g.fault_i = 5, g.throw_m = 10, g.pinch_k = 5, g.pinch_x = 180;
+  g.keywords = "MINPV\n 120 /\n";
+  for (const auto& [x, y] : {std::pair{40.0, 150.0}, {150.0, 150.0}, {150.0, 40.0}, {140.0, 90.0}}) {
+    SCOPED_TRACE("injector at (" + num(x) + ", " + num(y) + ")");
+    TempDir tmp("cpwells2");
+    const CaseSpec cs = case_of(tmp, g, hmtest::deviated_well_yaml() + hmtest::injector_yaml(x, y, 1045, 1057));
+    const HybridMesh out = build_hybrid_mesh(cs);
+    expect_sound_mesh(cs, out);
+    if (HasFatalFailure()) return;
+  }
+}
+
+// Two deactivated cells that touch only along an edge across a layer of zero thickness (a pinch-out, or
+// the children of none that a split at fault steps leaves): in the model's index space they are two
+// layers apart, so regularize_deactivated sees nothing, yet the cavity's boundary has an edge of four
+// triangles. regularize_cavity_surface deactivates the cells around it: afterwards every edge of the
+// boundary is used by exactly two triangles and the deactivated cells are one face-connected set.
+TEST(CornerPointWells, CavityAcrossAZeroThicknessLayerIsMadeAManifold) {
+  TempDir tmp("cpcavity");
+  TiltedModel g;
+  g.nx = 5, g.ny = 4, g.nz = 5, g.pinch_k = 2, g.pinch_x = -100;  // layer 2 of no thickness anywhere
+  const CaseSpec cs = case_of(tmp, g, "");
+  const CornerPointModel& m = *cs.reservoir.corner_point;
+  MeshBuilder builder;
+  const CornerPointCellFaces cells = corner_point_cell_faces(m, std::vector<char>(m.actnum.size(), 1), builder);
+  std::vector<Vec3> coords(builder.n_nodes());
+  for (int32_t v = 0; v < builder.n_nodes(); ++v) coords[v] = builder.node(v);
+  auto cell = [&](int i, int j, int k) { return i + m.nx * (j + m.ny * k); };
+  ASSERT_FALSE(cells.meshed[cell(1, 1, 2)]);
+  std::vector<char> active(m.actnum.size(), 1);
+  active[cell(1, 1, 1)] = active[cell(2, 1, 3)] = 0;
+  // The boundary's triangles per undirected edge (the deactivated cells lie inside the model: the
+  // active cells' triangles toward them are the whole boundary).
+  auto most_used_edge = [&] {
+    std::map<std::pair<int32_t, int32_t>, int> uses;
+    for (size_t c = 0; c < active.size(); ++c)
+      if (cells.meshed[c] && active[c])
+        for (const CavityTriangle& t : cavity_triangles(cells, static_cast<int>(c), active, coords))
+          for (size_t e = 0; e < 3; ++e) ++uses[{std::min(t.nodes[e], t.nodes[(e + 1) % 3]), std::max(t.nodes[e], t.nodes[(e + 1) % 3])}];
+    int most = 0, least = 99;
+    for (const auto& [e, n] : uses) most = std::max(most, n), least = std::min(least, n);
+    EXPECT_EQ(least, 2);
+    return most;
+  };
+  EXPECT_EQ(most_used_edge(), 4);  // fail half: the two cells' shared edge
+  std::vector<char> in_index_space = active;
+  EXPECT_EQ(regularize_deactivated(make_reservoir_grid(cs.reservoir), in_index_space), 0);
+  const int added = regularize_cavity_surface(cells, active, coords);
+  EXPECT_GE(added, 1);
+  EXPECT_EQ(most_used_edge(), 2);
+  std::vector<int32_t> dead;
+  for (size_t c = 0; c < active.size(); ++c)
+    if (cells.meshed[c] && !active[c]) dead.push_back(static_cast<int32_t>(c));
+  std::set<int32_t> reached{dead[0]};
+  std::vector<int32_t> stack{dead[0]};
+  while (!stack.empty()) {
+    const int32_t c = stack.back();
+    stack.pop_back();
+    for (int32_t nb : cells.neighbour[c])
+      if (nb >= 0 && !active[nb] && reached.insert(nb).second) stack.push_back(nb);
+  }
+  EXPECT_EQ(reached.size(), dead.size());
+  std::printf("[ figures  ] two cells meeting at an edge across a zero-thickness layer: %d cells added, %zu deactivated\n",
+              added, dead.size());
+}
+
 // Reek (docs/corner-point.md, "Reek"): a vertical well in the column of OP_1 (29, 28), in layers 6-9
 // of 14 (3 m thick, cells ~100-160 m wide), drainage radius 10 m. What happens is measured and printed;
 // the property: a sound mesh or a refusal with the reason, never a bad mesh.
