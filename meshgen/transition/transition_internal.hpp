@@ -225,6 +225,22 @@ class PowerDiagram {
   int moved_ = 0;
 };
 
+/// What one site move did to the cells of its region (its cell and their face neighbours), measured on
+/// the diagram before and after the round's rebuild.
+struct MoveEffect {
+  bool newly_failing = false;  ///< a cell of the region (or of no move's region) fails a shape check it passed
+  double q_s_before = 0, q_s_after = 0;          ///< sum of Q_S over the region
+  int skewed_before = 0, skewed_after = 0;       ///< faces above checkMesh's skewness limit
+  double worst_skew_before = 0, worst_skew_after = 0;
+  int failing_before = 0, failing_after = 0;     ///< cells failing a shape check of the self-check
+  bool failures_known = true;  ///< every failing cell identified, before and after (not only the worst)
+};
+/// Whether a move is kept: never when it makes a cell fail a shape check; else when it leaves fewer
+/// cells around it failing one (mending the raw diagram's failures is a gain in itself); else a step
+/// against skewness must lower the count of skewed faces or their worst, a short-edge move must raise
+/// Q_S without adding a skewed face; a sliver removal (slivers_only) is kept whenever nothing fails.
+bool move_is_kept(const MoveEffect& e, bool skew_step, bool slivers_only);
+
 /// The site optimiser (transition_optimize.cpp): rounds of independent site moves that
 /// remove or expand short edges, each followed by a rebuild of the exact diagram; `out` is a
 /// valid diagram of `set` on entry and on exit. Q_S's h is the entry diagram's h_ref.

@@ -492,11 +492,13 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     }
   }
   moves.resize(keep);
-  // Keep a move only if the Q_S of the cells it touches improves (sum over its region).
+  // Keep a move by what it did to the cells around it (move_is_kept).
   Measured after = measure(fresh);
   const std::vector<double>& qs2 = after.qs;
   const std::vector<int>& skewed2 = after.skewed;
   const std::vector<double>& max_skew2 = after.max_skew;
+  const std::vector<char>& failing2 = after.failing.cell;
+  const bool failures_known = now.failing.complete && after.failing.complete;
   // No move may make a cell fail a shape check of the self-check (shape_failures): one whose
   // region holds a newly failing cell is refused, and all of them when such a cell lies in no
   // move's region.
@@ -508,21 +510,17 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   for (size_t c = 0; c < worse.size(); ++c) stray = stray || (worse[c] && !covered[c]);
   std::vector<Move> kept;
   for (const Move& m : moves) {
-    double before = 0, after = 0;
-    int skew_before = 0, skew_after = 0;
-    double worst_before = 0, worst_after = 0;
-    bool fails = stray;
-    for (int c : m.region) fails = fails || worse[c];
+    MoveEffect e;
+    e.newly_failing = stray;
+    e.failures_known = failures_known;
     for (int c : m.region) {
-      before += qs[c], after += qs2[c], skew_before += skewed[c], skew_after += skewed2[c];
-      worst_before = std::max(worst_before, max_skew[c]), worst_after = std::max(worst_after, max_skew2[c]);
+      e.newly_failing = e.newly_failing || worse[c];
+      e.q_s_before += qs[c], e.q_s_after += qs2[c], e.skewed_before += skewed[c], e.skewed_after += skewed2[c];
+      e.worst_skew_before = std::max(e.worst_skew_before, max_skew[c]);
+      e.worst_skew_after = std::max(e.worst_skew_after, max_skew2[c]);
+      e.failing_before += now.failing.cell[c], e.failing_after += failing2[c];
     }
-    // A step against skewness must lower the count of skewed faces around, or their worst
-    // skewness; a short-edge move must raise Q_S without adding a skewed face.
-    const bool better =
-        !fails && (slivers_only_ || (m.skew ? skew_after < skew_before || (skew_after == skew_before && worst_after < worst_before)
-                                            : skew_after <= skew_before && after > before + 1e-12));
-    if (better) kept.push_back(m);
+    if (move_is_kept(e, m.skew, slivers_only_)) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
   rep.refused += static_cast<int>(moves.size() - kept.size());
@@ -550,6 +548,16 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
 }
 
 }  // namespace
+
+bool move_is_kept(const MoveEffect& e, bool skew_step, bool slivers_only) {
+  if (e.newly_failing) return false;
+  if (slivers_only) return true;
+  if (e.failures_known && e.failing_after < e.failing_before) return true;
+  if (skew_step)
+    return e.skewed_after < e.skewed_before ||
+           (e.skewed_after == e.skewed_before && e.worst_skew_after < e.worst_skew_before);
+  return e.skewed_after <= e.skewed_before && e.q_s_after > e.q_s_before + 1e-12;
+}
 
 constexpr int kSkewRounds = 8;
 constexpr int kSliverRounds = 4;
