@@ -29,7 +29,12 @@ struct CornerPointSweepCase {
   std::string label;
 };
 
-CornerPointSweepCase make_corner_point_case(uint32_t seed) {
+// `wells` = 2 adds an injector drawn after everything else (the model and the producer are those of
+// the one-well case of the same seed): vertical from 30 m above the top to 40-90 % of the thickness,
+// 2.5-7.5 of the larger drainage radius across the producer's path from its mid-point in plan (close
+// enough that the producer's refined columns pass beside it and that the cavities merge in some
+// cases), kept within the middle 70 % of the model.
+CornerPointSweepCase make_corner_point_case(uint32_t seed, int wells = 1) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   CornerPointSweepCase c;
@@ -60,14 +65,31 @@ CornerPointSweepCase make_corner_point_case(uint32_t seed) {
   c.wells = "wells:\n  - {name: P1, trajectory: [[" + num(x0) + ", " + num(y0) + ", " + num(top(x0, y0) - 30) + "], [" +
             num(x1) + ", " + num(y1) + ", " + num(top(x1, y1) + bottom_depth) +
             "]], radius: 0.1, drainage_radius: " + num(radius) + ", bhp: 150}\n";
-  char label[256];
+  std::string second;
+  if (wells >= 2) {
+    const double r2 = detail::log_uniform(rng, 5, std::max(5.0, std::min(20.0, 0.3 * thickness)));
+    // Across the producer's path in plan (its azimuth +- 90 degrees), so that the distance is to the path.
+    const double apart = (2.5 + 5 * u(rng)) * std::max(radius, r2);
+    const double direction = azimuth + (u(rng) < 0.5 ? 0.5 : -0.5) * M_PI;
+    const double lx = g.nx * g.dx, ly = g.ny * g.dy, depth2 = (0.4 + 0.5 * u(rng)) * thickness;
+    const double xi = std::clamp(0.5 * (x0 + x1) + apart * std::cos(direction), 0.15 * lx, 0.85 * lx);
+    const double yi = std::clamp(0.5 * (y0 + y1) + apart * std::sin(direction), 0.15 * ly, 0.85 * ly);
+    c.wells += "  - {name: I1, type: injector, trajectory: [[" + num(xi) + ", " + num(yi) + ", " + num(top(xi, yi) - 30) +
+               "], [" + num(xi) + ", " + num(yi) + ", " + num(top(xi, yi) + depth2) +
+               "]], radius: 0.1, drainage_radius: " + num(r2) + ", bhp: 250}\n";
+    char text[128];
+    std::snprintf(text, sizeof text, "; injector R %4.1f m, %5.1f m away", r2,
+                  std::hypot(xi - 0.5 * (x0 + x1), yi - 0.5 * (y0 + y1)));
+    second = text;
+  }
+  char label[384];
   std::snprintf(label, sizeof label,
                 "seed %3u: %2d x %2d x %2d cells of %5.1f m x %4.2f m, dip %3.1f, pillars %4.1f deg along %s%s, R %4.1f m, "
                 "inclination %4.1f deg, %s",
                 seed, g.nx, g.ny, g.nz, g.dx, g.dz, g.dip_deg, g.pillar_deg, g.pillar_azimuth_deg == 0 ? "x" : "y",
                 g.fault_i > 0 ? (", fault " + std::to_string(g.throw_m / g.dz).substr(0, 4) + " layer").c_str() : "",
                 radius, inclination, bottom_depth > thickness ? "through the bottom" : "ends inside");
-  c.label = label;
+  c.label = label + second;
   return c;
 }
 
@@ -81,7 +103,8 @@ CaseResult mesh_corner_point_case(const CornerPointSweepCase& c) {
     const HybridMesh h = build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));  // throws if the self-check fails
     CaseSpec bare = cs;
     bare.wells.clear();
-    const double expected = total_volume(build_hybrid_mesh(bare).geometry) - exact_wellbore_hole_volume(cs, 0, h.blocks[0].sectors);
+    double expected = total_volume(build_hybrid_mesh(bare).geometry);
+    for (size_t w = 0; w < cs.wells.size(); ++w) expected -= exact_wellbore_hole_volume(cs, static_cast<int>(w), h.blocks[w].sectors);
     const double got = total_volume(h.geometry);
     std::string bad;
     if (!h.build_report.ok) bad += "builder; ";
@@ -106,6 +129,11 @@ TEST(CornerPointSweep, GeneratorIsDeterministicAndCoversTheRanges) {
   for (uint32_t seed = 1; seed <= 40; ++seed) {
     const CornerPointSweepCase a = make_corner_point_case(seed), b = make_corner_point_case(seed);
     EXPECT_EQ(a.model.text(), b.model.text());
+    // Two wells: the one-well case's model and producer, and an injector.
+    const CornerPointSweepCase two = make_corner_point_case(seed, 2);
+    EXPECT_EQ(two.model.text(), a.model.text());
+    EXPECT_EQ(two.wells.substr(0, a.wells.size()), a.wells);
+    EXPECT_NE(two.wells.find("name: I1"), std::string::npos);
     EXPECT_EQ(a.wells, b.wells);
     EXPECT_GE(a.model.dx, 25.0 - 1e-9);
     EXPECT_LE(a.model.dx, 150.0 + 1e-9);
@@ -134,15 +162,17 @@ TEST(CornerPointSweep, CiSubsetMeshesSoundly) {
 }
 
 // HM_LONG_TESTS=1: every seed in a forked child; no crash, hang or mesh failing a check; the table.
-// HM_CP_SWEEP_CASES seeds (30) from HM_CP_SWEEP_FIRST (1). Run it alone (--gtest_filter=...SweepTable):
+// HM_CP_SWEEP_CASES seeds (30) from HM_CP_SWEEP_FIRST (1), HM_CP_SWEEP_WELLS wells (1, or 2: the
+// producer and an injector beside it). Run it alone (--gtest_filter=...SweepTable):
 // after a test that meshed in this process the thread pool exists, and a forked child can hang on it.
 TEST(CornerPointSweep, SweepTable) {
   if (!long_tests()) GTEST_SKIP() << "HM_LONG_TESTS=1 runs the sweep";
   const int n = std::getenv("HM_CP_SWEEP_CASES") ? std::atoi(std::getenv("HM_CP_SWEEP_CASES")) : 30;
   const int first = std::getenv("HM_CP_SWEEP_FIRST") ? std::atoi(std::getenv("HM_CP_SWEEP_FIRST")) : 1;
+  const int wells = std::getenv("HM_CP_SWEEP_WELLS") ? std::atoi(std::getenv("HM_CP_SWEEP_WELLS")) : 1;
   std::map<Outcome, int> count;
   for (uint32_t seed = first; seed < static_cast<uint32_t>(first + n); ++seed) {
-    const CornerPointSweepCase c = make_corner_point_case(seed);
+    const CornerPointSweepCase c = make_corner_point_case(seed, wells);
     // 900 s: the largest seeds (thin layers split at a fault's steps: seeds 4 and 23, 1.5-1.7M cells) mesh in
     // about 5 minutes alone and take longer beside the test suites (docs/corner-point.md, sweep).
     const CaseResult r = run_isolated([&] { return mesh_corner_point_case(c); }, 900);
