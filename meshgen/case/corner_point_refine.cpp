@@ -255,7 +255,8 @@ ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<Refin
   for (size_t w = 0; w < wells.size(); ++w)
     if (wells[w].cell_size > 0) for_each_ask(m, wells[w], kRefineWiderThan, ask_of(w));
   // A well whose reach (or the slices next to it) the children of another well cross asks for every
-  // slice there wider than its size: cells many times longer than wide beside its cavity give walls no Gabriel repair clears.
+  // slice there wider than its size: cells many times longer than wide beside its cavity give walls
+  // that no Gabriel repair clears. One pass: a well so refined that crosses a third is not followed.
   auto split_by_others = [&](const std::vector<Asks>& asks, size_t w, size_t slice) {
     std::vector<SliceRequest> others;
     for (size_t o = 0; o < wells.size(); ++o)
