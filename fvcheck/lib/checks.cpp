@@ -431,9 +431,10 @@ CheckResult check_convexity(const PolyMesh& m, const MeshGeometry& geo, const Ch
     }
   });
   int64_t outside_cells = 0;
+  r.failing.assign(m.n_cells(), 0);
   for (int c = 0; c < m.n_cells(); ++c) {
     if (flags[c] & 1) ++outside_cells, push_example(ex_outside, c);
-    if (flags[c]) ++r.violations;
+    if (flags[c]) ++r.violations, r.failing[c] = 1;
   }
   rank_worst(r, true);
   r.counts = {{"cells_with_node_outside_face_plane", outside_cells},
@@ -675,8 +676,9 @@ CheckResult check_closure(const PolyMesh& m, const MeshGeometry& geo, const Chec
       r.values[c] = std::isnan(ratio) ? 1.0 : ratio;
     }
   });
+  r.failing.assign(m.n_cells(), 0);
   for (int c = 0; c < m.n_cells(); ++c)
-    if (!(r.values[c] <= opt.closure_tol)) ++r.violations;
+    if (!(r.values[c] <= opt.closure_tol)) ++r.violations, r.failing[c] = 1;
   rank_worst(r, true);
   r.measures = {{"tolerance", opt.closure_tol}};
   return r;
@@ -690,12 +692,13 @@ CheckResult check_volume(const PolyMesh& m, const MeshGeometry& geo, const Check
   CheckResult r;
   r.name = "volume";
   r.values.assign(m.n_cells(), 0.0);
+  r.failing.assign(m.n_cells(), 0);
   double min_vol = std::numeric_limits<double>::infinity(), total = 0;
   for (int c = 0; c < m.n_cells(); ++c) {
     const double L = sc.length[c], v = geo.cell_volume[c];
     r.values[c] = L > 0 ? v / (L * L * L) : 0.0;
     if (std::isnan(r.values[c])) r.values[c] = -1.0;
-    if (!(r.values[c] > opt.volume_rel_tol)) ++r.violations;
+    if (!(r.values[c] > opt.volume_rel_tol)) ++r.violations, r.failing[c] = 1;
     min_vol = std::min(min_vol, v);
     total += v;
   }
@@ -717,11 +720,11 @@ CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, cons
   } else {
     r.values = face_orthogonality(m, geo);
   }
-  std::vector<int32_t> bad_cells;
   std::vector<char> cell_bad(m.n_cells(), 0);
+  r.failing.assign(m.n_faces(), 0);
   for (int f = 0; f < m.n_faces(); ++f)
     if (!(r.values[f] >= opt.min_orthogonality_deg)) {
-      ++r.violations;
+      ++r.violations, r.failing[f] = 1;
       cell_bad[m.face_owner[f]] = 1;
       if (m.face_neighbour[f] >= 0) cell_bad[m.face_neighbour[f]] = 1;
     }
@@ -754,7 +757,7 @@ CheckResult check_auto_centering(const PolyMesh& m, const MeshGeometry& geo, con
   CheckResult r;
   r.name = "auto_centering";
   r.values.assign(m.n_cells(), 0.0);
-  std::vector<char> violates(m.n_cells(), 0);
+  r.failing.assign(m.n_cells(), 0);
   parallel_ranges(m.n_cells(), [&](int64_t b, int64_t e) {
     for (int c = static_cast<int>(b); c < e; ++c) {
       const Vec3 x = m.cell_fv_center[c];
@@ -769,10 +772,10 @@ CheckResult check_auto_centering(const PolyMesh& m, const MeshGeometry& geo, con
       double value = L > 0 ? worst / L : 1.0;
       if (std::isnan(value) || !std::isfinite(worst)) value = 1.0;  // no usable face or a NaN centre
       r.values[c] = value;
-      violates[c] = !(worst < -sc.tol[c]) || !std::isfinite(worst);
+      r.failing[c] = !(worst < -sc.tol[c]) || !std::isfinite(worst);
     }
   });
-  r.violations = std::count(violates.begin(), violates.end(), 1);
+  r.violations = std::count(r.failing.begin(), r.failing.end(), 1);
   rank_worst(r, true);
   r.measures = {{"rel_tol", opt.rel_tol}};
   return r;
@@ -784,9 +787,10 @@ CheckResult check_planarity(const PolyMesh& m, const MeshGeometry& geo, const Ch
   r.id_kind = IdKind::Face;
   r.values = face_planarity(m, geo);
   std::vector<char> cell_bad(m.n_cells(), 0);
+  r.failing.assign(m.n_faces(), 0);
   for (int f = 0; f < m.n_faces(); ++f)
     if (!(r.values[f] <= opt.max_planarity_deg)) {
-      ++r.violations;
+      ++r.violations, r.failing[f] = 1;
       cell_bad[m.face_owner[f]] = 1;
       if (m.face_neighbour[f] >= 0) cell_bad[m.face_neighbour[f]] = 1;
     }
@@ -823,6 +827,7 @@ std::vector<CheckResult> check_shapes(const PolyMesh& mesh, const MeshGeometry& 
     for (int32_t& id : r.worst_ids) id = cell_of[r.id_kind == IdKind::Face ? sub.face_owner[id] : id];
     r.id_kind = IdKind::Cell;
     r.values.clear();
+    r.failing.clear();
   }
   return out;
 }

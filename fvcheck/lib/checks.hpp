@@ -43,6 +43,7 @@ struct CheckResult {
   double worst = 0;                 ///< worst measured value (meaning per check, docs/fvcheck.md)
   std::vector<int32_t> worst_ids;   ///< up to 10 ids with the worst values, worst first
   std::vector<double> values;       ///< one measured value per cell or per face (may be empty)
+  std::vector<char> failing;        ///< per cell or face as values: 1 where it violates (empty: not per item)
   std::vector<std::pair<std::string, int64_t>> counts;                ///< named sub-counts
   std::vector<std::pair<std::string, std::vector<int32_t>>> id_lists;  ///< named example ids (<= 10 each)
   std::vector<std::pair<std::string, double>> measures;                ///< named extra values (thresholds, ...)

@@ -419,6 +419,29 @@ TEST(AutoCentering, InsidePassesOutsideAndOnFaceFail) {
   EXPECT_EQ(check_auto_centering(m, g).violations, 0);
 }
 
+// Every violating item is flagged, not only the ten worst the reports name: the optimiser judges a
+// move by the failing cells around it (before, a diagram with more than ten failing cells left it
+// blind: corner-point sweep, two wells, seed 4).
+TEST(AutoCentering, EveryViolatingCellIsFlaggedBeyondTheTenWorst) {
+  PolyMesh m = box_grid(5, 5, 1);
+  std::vector<char> expected(m.n_cells(), 0);
+  for (int c = 0; c < m.n_cells(); c += 2) {
+    m.cell_fv_center[c].z += 2.0;  // above the grid: outside its cell
+    expected[c] = 1;
+  }
+  const MeshGeometry g = compute_geometry(m);
+  const CheckResult r = check_auto_centering(m, g);
+  EXPECT_EQ(r.violations, 13);
+  EXPECT_EQ(r.worst_ids.size(), 10u);
+  EXPECT_EQ(r.failing, expected);
+  // Each per-item check: a flag per value, as many flags as violations.
+  for (const CheckResult& c : {check_convexity(m, g), check_closure(m, g), check_volume(m, g),
+                               check_orthogonality(m, g), check_auto_centering(m, g), check_planarity(m, g)}) {
+    EXPECT_EQ(c.failing.size(), c.values.size()) << c.name;
+    EXPECT_EQ(std::count(c.failing.begin(), c.failing.end(), 1), c.violations) << c.name;
+  }
+}
+
 // ---------------------------------------------------------------- planarity
 TEST(Planarity, ExactValueOfALiftedCorner) {
   // Closed form: top face normal ~ (-t,-t,2); fan triangle normals ~ (0,-t,2), (-t,-2t,2),
