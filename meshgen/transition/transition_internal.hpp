@@ -233,13 +233,15 @@ struct MoveEffect {
   int skewed_before = 0, skewed_after = 0;       ///< faces above checkMesh's skewness limit
   double worst_skew_before = 0, worst_skew_after = 0;
   int failing_before = 0, failing_after = 0;     ///< cells failing a shape check of the self-check
-  bool failures_known = true;  ///< every failing cell identified, before and after (not only the worst)
 };
-/// Whether a move is kept: never when it makes a cell fail a shape check; else when it leaves fewer
-/// cells around it failing one (mending the raw diagram's failures is a gain in itself); else a step
-/// against skewness must lower the count of skewed faces or their worst, a short-edge move must raise
-/// Q_S without adding a skewed face; a sliver removal (slivers_only) is kept whenever nothing fails.
-bool move_is_kept(const MoveEffect& e, bool skew_step, bool slivers_only);
+/// Why a site moves: to remove or expand a short edge, a step against a skewed face, a step of a
+/// failing cell's site or of a neighbour's (repair), the removal of a sliver edge (remove_sliver_edges).
+enum class MoveKind { ShortEdge, SkewStep, Repair, SliverRemoval };
+/// Whether a move is kept: never when it makes a cell fail a shape check; a sliver removal whenever
+/// nothing fails; else when it leaves fewer cells around it failing one (mending the raw diagram's
+/// failures is a gain in itself); a repair for nothing else; a step against skewness must lower the
+/// count of skewed faces or their worst, a short-edge move must raise Q_S without adding a skewed face.
+bool move_is_kept(const MoveEffect& e, MoveKind kind);
 
 /// The site optimiser (transition_optimize.cpp): rounds of independent site moves that
 /// remove or expand short edges, each followed by a rebuild of the exact diagram; `out` is a

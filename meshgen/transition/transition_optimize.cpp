@@ -47,7 +47,7 @@ struct Move {
   SiteState before, after;
   std::vector<int> region;  // cells
   bool removal = false;
-  bool skew = false;  // a step against a skewed face
+  MoveKind kind = MoveKind::ShortEdge;
   // The edge (power-sphere site quadruples of its ends; a constrained node as {-1,-1,-1,id})
   // and the site tried on it: a move refused once is not tried again.
   std::array<int, 9> tag{};
@@ -115,12 +115,10 @@ std::vector<int> skewed_faces_of_cells(const PolyMesh& sub, std::vector<int>* sk
 // the written mesh (meshgen/pipeline/self_check.cpp, fvcheck's checks at their defaults):
 // convexity, the FV centre (the site) inside, orthogonality of the faces between two transition
 // cells and of the faces on well polygons (toward the well cell's FV centre, which the submesh
-// does not hold: shape_failures is given it), planarity of every face. The checks report the cells
-// they fail through worst_ids (at most 10); `complete` is false when a check failed more.
+// does not hold: shape_failures is given it), planarity of every face.
 struct ShapeFailures {
   std::vector<char> cell;
-  bool complete = true;
-  int64_t count = 0;
+  int64_t count = 0;  ///< failing cells
 };
 
 // A boundary face of the submesh is a cavity polygon; where the FV centre beyond it is known
@@ -137,27 +135,32 @@ ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& gl
         sub, global, t, cavity, [&](int32_t q) { return std::isfinite(outside_centres[q].x); });
     for (int f = 0; f < sub.n_faces(); ++f)
       if (polygon[f] >= 0 &&
-          face_orthogonality_of(sub, geo, f, outside_centres[polygon[f]]) < opt.min_orthogonality_deg) {
+          face_orthogonality_of(sub, geo, f, outside_centres[polygon[f]]) < opt.min_orthogonality_deg)
         out.cell[sub.face_owner[f]] = 1;
-        ++out.count;
-      }
   }
-  for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)}) {
-    out.count += r.violations;
-    out.complete = out.complete && r.violations <= static_cast<int64_t>(r.worst_ids.size());
-    for (size_t i = 0; i < r.worst_ids.size() && static_cast<int64_t>(i) < r.violations; ++i) out.cell[r.worst_ids[i]] = 1;
-  }
+  for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)})
+    for (int c = 0; c < sub.n_cells(); ++c) out.cell[c] |= r.failing[c];
   const std::vector<double> qo = face_orthogonality(sub, geo);
   const CheckResult planarity = check_planarity(sub, geo, opt);
   for (int f = 0; f < sub.n_faces(); ++f) {
     const bool skewed = sub.face_neighbour[f] >= 0 && qo[f] < opt.min_orthogonality_deg;
-    const bool bent = !planarity.values.empty() && planarity.values[f] > opt.max_planarity_deg;
-    if (!skewed && !bent) continue;
+    if (!skewed && !planarity.failing[f]) continue;
     out.cell[sub.face_owner[f]] = 1;
     if (sub.face_neighbour[f] >= 0) out.cell[sub.face_neighbour[f]] = 1;
-    ++out.count;
   }
+  out.count = std::count(out.cell.begin(), out.cell.end(), 1);
   return out;
+}
+
+// Appends cell c and its face neighbours to the sorted set `cells`.
+void add_cell_and_neighbours(const PolyMesh& sub, int c, std::vector<int>& cells) {
+  cells.push_back(c);
+  for (const int32_t* f = sub.cell_begin(c); f != sub.cell_end(c); ++f) {
+    const int o = sub.face_owner[*f], n = sub.face_neighbour[*f];
+    if (n >= 0) cells.push_back(o == c ? n : o);
+  }
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
 }
 
 class SiteOptimizer {
@@ -169,9 +172,13 @@ class SiteOptimizer {
         outside_centres_(outside_centres), slivers_only_(slivers_only) {}
 
   // One round on `out` (a valid diagram of set_): true if some move was kept.
-  // skew_only: only steps against skewed faces. Sets skewed_left() to the count on entry.
+  // skew_only: only steps against skewed faces and repairs. Sets skewed_left() to the count on
+  // entry, proposed_last() to the moves proposed.
   bool round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only);
   int skewed_left() const { return skewed_left_; }
+  int proposed_last() const { return proposed_last_; }
+  // Cells of the diagram a round left that fail a shape check (-1 before the first round).
+  int64_t failing_now() const { return next_ ? next_->failing.count : -1; }
 
  private:
   Vec3 node(const TransitionCells& t, int32_t v) const {
@@ -196,8 +203,7 @@ class SiteOptimizer {
     return m;
   }
   // The cells of `after` (a diagram of the same sites, so the same cell per site) that fail a
-  // shape check while the same site's cell in `before` did not; all of them when the failures
-  // of `after` are not all known and outnumber those of `before`.
+  // shape check while the same site's cell in `before` did not.
   static std::vector<char> new_failures(const TransitionCells& t_before, const Measured& before,
                                         const TransitionCells& t_after, const Measured& after) {
     std::vector<char> bad_site;
@@ -206,11 +212,10 @@ class SiteOptimizer {
         if (bad_site.size() <= static_cast<size_t>(t_before.cell_site[c])) bad_site.resize(t_before.cell_site[c] + 1, 0);
         bad_site[t_before.cell_site[c]] = 1;
       }
-    const bool unknown = !after.failing.complete && after.failing.count > before.failing.count;
     std::vector<char> out(after.failing.cell.size(), 0);
     for (size_t c = 0; c < out.size(); ++c) {
       const size_t site = static_cast<size_t>(t_after.cell_site[c]);
-      out[c] = unknown || (after.failing.cell[c] && !(site < bad_site.size() && bad_site[site]));
+      out[c] = after.failing.cell[c] && !(site < bad_site.size() && bad_site[site]);
     }
     return out;
   }
@@ -243,6 +248,7 @@ class SiteOptimizer {
   std::set<std::array<int, 9>> refused_;
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   int skewed_left_ = 0;
+  int proposed_last_ = 0;
   // Only removals of sliver edges (below kSliverEdge h), kept unless a cell newly fails a
   // shape check: the pass run on a diagram that is not optimised (remove_sliver_edges).
   bool slivers_only_ = false;
@@ -368,15 +374,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   // The cells whose geometry a move of `site` changes: its own and its face neighbours.
   auto region_of = [&](int site) {
     std::vector<int> r;
-    const int c = cell_of_site[site];
-    if (c < 0) return r;
-    r.push_back(c);
-    for (const int32_t* f = sub.cell_begin(c); f != sub.cell_end(c); ++f) {
-      const int o = sub.face_owner[*f], n = sub.face_neighbour[*f];
-      if (n >= 0) r.push_back(o == c ? n : o);
-    }
-    std::sort(r.begin(), r.end());
-    r.erase(std::unique(r.begin(), r.end()), r.end());
+    if (cell_of_site[site] >= 0) add_cell_and_neighbours(sub, cell_of_site[site], r);
     return r;
   };
 
@@ -430,7 +428,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
       const int s = k % 4 < 2 ? s1 : s2, other = k % 4 < 2 ? s2 : s1;
       Move m;
       m.tag = {-2, s, other, k, 0, 0, 0, 0, 0};
-      m.skew = true;
+      m.kind = MoveKind::SkewStep;
       if (!refused_.count(m.tag) && trial_step(s, other, k % 2 == 1, k < 4 ? 1 : 2, &m)) best = m;
     }
     if (best.site >= 0) admit(best);
@@ -469,12 +467,40 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
         if (!trial_move(d, around.front(), x, opt_.max_shift * e.h, range_slack, &m) || locked[m.site]) continue;
         const double shift = norm(m.after.p - m.before.p);
         m.removal = removal;
+        if (slivers_only_) m.kind = MoveKind::SliverRemoval;
         if (shift < best_shift) best = m, best_shift = shift;
       }
     }
     if (best.site >= 0) admit(best);
   }
+  // Cells failing a shape check that no move above touches: a step of the cell's site or of a face
+  // neighbour's (toward or away from the other, a polygon site along its range), kept only if fewer
+  // cells around fail. Each round tries the first option not refused before, so later rounds try the
+  // next ones. Last, as the moves above mend most failing cells of a raw diagram in passing.
+  for (int c = 0; c < nc && !slivers_only_; ++c) {
+    const int s = out.cell_site[c];
+    if (!now.failing.cell[c] || locked[s]) continue;
+    Move best;
+    for (int size = 1; size <= 2 && best.site < 0; ++size)
+      for (int n : region_of(s)) {
+        const int other = out.cell_site[n];
+        if (other == s) continue;
+        for (int k = 0; k < 4 && best.site < 0; ++k) {
+          const int mover = k < 2 ? s : other, from = k < 2 ? other : s;
+          const bool away = k % 2 == 1;
+          if (moved[mover] || locked[mover]) continue;
+          Move m;
+          m.kind = MoveKind::Repair;
+          const bool polygon = set_.sites[mover].kind == SiteKind::InternalPolygon;
+          m.tag = {-3, mover, polygon ? -1 : from, away, size, 0, 0, 0, 0};
+          if (!refused_.count(m.tag) && trial_step(mover, from, away, size, &m)) best = m;
+        }
+        if (best.site >= 0) break;
+      }
+    if (best.site >= 0) admit(best);
+  }
   rep.proposed += static_cast<int>(moves.size());
+  proposed_last_ = static_cast<int>(moves.size());
   if (moves.empty()) return unchanged();
 
   // Rebuild with the moves; an invalid diagram keeps the first half of them, down to none.
@@ -492,13 +518,15 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     }
   }
   moves.resize(keep);
-  // Keep a move by what it did to the cells around it (move_is_kept).
+  // Keep a move by what it did to the cells around it (move_is_kept), its neighbours before and
+  // after the move (a diagram of the same sites: cell c is the same site's in both).
   Measured after = measure(fresh);
+  for (Move& m : moves)
+    if (cell_of_site[m.site] >= 0) add_cell_and_neighbours(after.sub, cell_of_site[m.site], m.region);
   const std::vector<double>& qs2 = after.qs;
   const std::vector<int>& skewed2 = after.skewed;
   const std::vector<double>& max_skew2 = after.max_skew;
   const std::vector<char>& failing2 = after.failing.cell;
-  const bool failures_known = now.failing.complete && after.failing.complete;
   // No move may make a cell fail a shape check of the self-check (shape_failures): one whose
   // region holds a newly failing cell is refused, and all of them when such a cell lies in no
   // move's region.
@@ -512,7 +540,6 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   for (const Move& m : moves) {
     MoveEffect e;
     e.newly_failing = stray;
-    e.failures_known = failures_known;
     for (int c : m.region) {
       e.newly_failing = e.newly_failing || worse[c];
       e.q_s_before += qs[c], e.q_s_after += qs2[c], e.skewed_before += skewed[c], e.skewed_after += skewed2[c];
@@ -520,7 +547,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
       e.worst_skew_after = std::max(e.worst_skew_after, max_skew2[c]);
       e.failing_before += now.failing.cell[c], e.failing_after += failing2[c];
     }
-    if (move_is_kept(e, m.skew, slivers_only_)) kept.push_back(m);
+    if (move_is_kept(e, m.kind)) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
   rep.refused += static_cast<int>(moves.size() - kept.size());
@@ -549,11 +576,12 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
 
 }  // namespace
 
-bool move_is_kept(const MoveEffect& e, bool skew_step, bool slivers_only) {
+bool move_is_kept(const MoveEffect& e, MoveKind kind) {
   if (e.newly_failing) return false;
-  if (slivers_only) return true;
-  if (e.failures_known && e.failing_after < e.failing_before) return true;
-  if (skew_step)
+  if (kind == MoveKind::SliverRemoval) return true;
+  if (e.failing_after < e.failing_before) return true;
+  if (kind == MoveKind::Repair) return false;
+  if (kind == MoveKind::SkewStep)
     return e.skewed_after < e.skewed_before ||
            (e.skewed_after == e.skewed_before && e.worst_skew_after < e.worst_skew_before);
   return e.skewed_after <= e.skewed_before && e.q_s_after > e.q_s_before + 1e-12;
@@ -561,6 +589,7 @@ bool move_is_kept(const MoveEffect& e, bool skew_step, bool slivers_only) {
 
 constexpr int kSkewRounds = 8;
 constexpr int kSliverRounds = 4;
+constexpr int kRepairRounds = 16;
 
 namespace {
 // An edge between two free vertices shorter than kSliverEdge x the h_ref of a cell it bounds.
@@ -605,6 +634,11 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
   for (int extra = 0; extra < kSkewRounds; ++extra) {
     ++rep.rounds;
     if (!optimizer.round(out, rep, true) || optimizer.skewed_left() == 0) break;
+  }
+  // Cells failing a shape check left: rounds of repairs while untried options remain.
+  for (int extra = 0; extra < kRepairRounds && optimizer.failing_now() != 0; ++extra) {
+    ++rep.rounds;
+    if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
   }
   out.h_ref = h_ref;
   return rep;

@@ -397,29 +397,26 @@ namespace hm::testing {
 TEST(SiteOptimizer, MoveIsKeptForWhatItDoesToTheCellsAroundIt) {
   using transition_detail::MoveEffect;
   using transition_detail::move_is_kept;
+  using Kind = transition_detail::MoveKind;
   MoveEffect mends;
   mends.q_s_before = 2.0, mends.q_s_after = 1.9;
   mends.failing_before = 2, mends.failing_after = 0;
-  EXPECT_TRUE(move_is_kept(mends, false, false));
-  EXPECT_TRUE(move_is_kept(mends, true, false));
-  MoveEffect unknown = mends;  // the failures beyond the ten worst are not identified: Q_S decides
-  unknown.failures_known = false;
-  EXPECT_FALSE(move_is_kept(unknown, false, false));
+  for (Kind k : {Kind::ShortEdge, Kind::SkewStep, Kind::Repair, Kind::SliverRemoval}) EXPECT_TRUE(move_is_kept(mends, k));
   MoveEffect breaks = mends;  // a newly failing cell refuses any move
   breaks.newly_failing = true;
-  EXPECT_FALSE(move_is_kept(breaks, false, false));
-  EXPECT_FALSE(move_is_kept(breaks, false, true));
+  for (Kind k : {Kind::ShortEdge, Kind::SkewStep, Kind::Repair, Kind::SliverRemoval}) EXPECT_FALSE(move_is_kept(breaks, k));
   MoveEffect gain;  // a short-edge move: Q_S up, no skewed face added
   gain.q_s_before = 1.0, gain.q_s_after = 1.2;
-  EXPECT_TRUE(move_is_kept(gain, false, false));
+  EXPECT_TRUE(move_is_kept(gain, Kind::ShortEdge));
+  EXPECT_FALSE(move_is_kept(gain, Kind::Repair));  // a repair is kept for mending alone
   gain.skewed_after = 1;
-  EXPECT_FALSE(move_is_kept(gain, false, false));
-  EXPECT_TRUE(move_is_kept(gain, false, true));  // a sliver removal needs only that nothing fails
+  EXPECT_FALSE(move_is_kept(gain, Kind::ShortEdge));
+  EXPECT_TRUE(move_is_kept(gain, Kind::SliverRemoval));  // a sliver removal needs only that nothing fails
   MoveEffect step;  // a step against skewness: fewer skewed faces, or as many with a lower worst
   step.skewed_before = 2, step.skewed_after = 2, step.worst_skew_before = 5.0, step.worst_skew_after = 4.5;
-  EXPECT_TRUE(move_is_kept(step, true, false));
+  EXPECT_TRUE(move_is_kept(step, Kind::SkewStep));
   step.worst_skew_after = 5.5;
-  EXPECT_FALSE(move_is_kept(step, true, false));
+  EXPECT_FALSE(move_is_kept(step, Kind::SkewStep));
 }
 
 }  // namespace hm::testing
