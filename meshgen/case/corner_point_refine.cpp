@@ -256,31 +256,39 @@ ColumnSplits near_well_splits(const CornerPointModel& m, const std::vector<Refin
     if (wells[w].cell_size > 0) for_each_ask(m, wells[w], kRefineWiderThan, ask_of(w));
   // A well whose reach (or the slices next to it) the children of another well cross asks for every
   // slice there wider than its size: cells many times longer than wide beside its cavity give walls
-  // that no Gabriel repair clears. One pass: a well so refined that crosses a third is not followed.
+  // that no Gabriel repair clears. Its new children may cross a third well's reach, and so on: passes
+  // until no well is newly crossed (at most one per well, as a crossed well asks for no more).
   auto split_by_others = [&](const std::vector<Asks>& asks, size_t w, size_t slice) {
     std::vector<SliceRequest> others;
     for (size_t o = 0; o < wells.size(); ++o)
       if (o != w) others.insert(others.end(), asks[o][slice].begin(), asks[o][slice].end());
     return slice_bounds(others).size() > 2;
   };
-  std::vector<size_t> crossed;
-  for (size_t w = 0; w < wells.size() && wells.size() > 1; ++w) {
-    if (!(wells[w].cell_size > 0)) continue;
-    std::set<std::pair<bool, int>> near;  // slices within the well's reach, and the next ones (the cavity's walls)
-    for_each_ask(m, wells[w], 0.0, [&](int slice, bool along_i, const SliceRequest& q) {
-      if (q.d < wells[w].reach)
-        for (int next : {slice - 1, slice, slice + 1})
-          if (next >= 0 && next < (along_i ? m.nx : m.ny)) near.insert({along_i, next});
-    });
-    for (const auto& [along_i, slice] : near)
-      if (split_by_others(along_i ? ask_i : ask_j, w, slice)) {
-        crossed.push_back(w);
-        break;
-      }
-  }
-  for (size_t w : crossed) {
-    ask_i[w].assign(m.nx, {}), ask_j[w].assign(m.ny, {});
-    for_each_ask(m, wells[w], kRefineBesideChildrenWiderThan, ask_of(w));
+  std::vector<std::set<std::pair<bool, int>>> near(wells.size());  // slices within reach, and the next ones
+  for (size_t w = 0; w < wells.size() && wells.size() > 1; ++w)
+    if (wells[w].cell_size > 0)
+      for_each_ask(m, wells[w], 0.0, [&](int slice, bool along_i, const SliceRequest& q) {
+        if (q.d < wells[w].reach)
+          for (int next : {slice - 1, slice, slice + 1})
+            if (next >= 0 && next < (along_i ? m.nx : m.ny)) near[w].insert({along_i, next});
+      });
+  std::vector<char> crossed(wells.size(), 0);
+  for (bool more = wells.size() > 1; more;) {
+    std::vector<size_t> newly;
+    for (size_t w = 0; w < wells.size(); ++w) {
+      if (crossed[w] || !(wells[w].cell_size > 0)) continue;
+      for (const auto& [along_i, slice] : near[w])
+        if (split_by_others(along_i ? ask_i : ask_j, w, slice)) {
+          newly.push_back(w);
+          break;
+        }
+    }
+    for (size_t w : newly) {
+      crossed[w] = 1;
+      ask_i[w].assign(m.nx, {}), ask_j[w].assign(m.ny, {});
+      for_each_ask(m, wells[w], kRefineBesideChildrenWiderThan, ask_of(w));
+    }
+    more = !newly.empty();
   }
   Asks all_i(m.nx), all_j(m.ny);
   for (size_t w = 0; w < wells.size(); ++w) {

@@ -745,3 +745,42 @@ TEST(NearWellRefinement, ReekOp2MeshesWithItsPillarsTurnedUpright) {
               cs.reservoir.corner_point->nx, cs.reservoir.corner_point->ny,
               wall_moved ? "; a wall below 45 degrees moved away" : "");
 }
+
+// Three wells in a row of crossings: A's rows cross B's reach, so B's columns are split to its size;
+// those columns (whole columns of the model) cross C's reach, so C's rows are split to its size too.
+// One pass (A crossing B only) left C beside cells three times longer than wide. The result does not
+// depend on the order the wells are given in.
+TEST(NearWellRefinement, CrossingsAreFollowedFromWellToWell) {
+  TempDir tmp("cprefine3");
+  hmtest::LayeredModel g;
+  g.nx = 12, g.ny = 12, g.nz = 6, g.dx = 20, g.dy = 20;
+  const CornerPointModel m = read_model(tmp, g);
+  auto well = [&](double x, double y, double size) {
+    const double top = 1000 + std::tan(g.dip_deg * M_PI / 180) * x + 0.01 * y;
+    return RefinementRequest{{{x, y, top + 3}, {x, y, top + 15}}, size, 20, false};
+  };
+  const RefinementRequest a = well(110, 110, 4), b = well(30, 110, 5), c = well(30, 30, 5);
+  // Fail half: A alone does not come near C (rows and columns 0-2 whole), nor does C alone split them.
+  const ColumnSplits a_only = near_well_splits(m, {a});
+  const ColumnSplits a_and_c = near_well_splits(m, {a, c});
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(a_only.j[k], 1) << k;
+    EXPECT_EQ(a_and_c.j[k], 1) << k;  // C is not crossed by A's children: its rows stay whole
+  }
+  const ColumnSplits abc = near_well_splits(m, {a, b, c});
+  const ColumnSplits cba = near_well_splits(m, {c, b, a});
+  EXPECT_EQ(abc.i, cba.i);
+  EXPECT_EQ(abc.j, cba.j);
+  std::printf("[ figures  ] children per row j near C (y 0-60 m), A and C: %d %d %d; A, B and C: %d %d %d\n",
+              a_and_c.j[0], a_and_c.j[1], a_and_c.j[2], abc.j[0], abc.j[1], abc.j[2]);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GE(abc.i[k], 3) << k;  // B's columns, crossed by A's rows
+    EXPECT_GE(abc.j[k], 3) << k;  // C's rows, crossed by B's columns
+    for (size_t q = 0; q + 1 < abc.j_bounds[k].size(); ++q) {  // within C's reach: its size, to rounding
+      const double y0 = 20 * (k + abc.j_bounds[k][q]), y1 = 20 * (k + abc.j_bounds[k][q + 1]);
+      if (std::abs(y0 - 30) <= 20 && std::abs(y1 - 30) <= 20) {
+        EXPECT_LE(y1 - y0, 7.0) << k;
+      }
+    }
+  }
+}

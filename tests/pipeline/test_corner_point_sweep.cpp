@@ -29,11 +29,12 @@ struct CornerPointSweepCase {
   std::string label;
 };
 
-// `wells` = 2 adds an injector drawn after everything else (the model and the producer are those of
+// `wells` >= 2 adds an injector drawn after everything else (the model and the producer are those of
 // the one-well case of the same seed): vertical from 30 m above the top to 40-90 % of the thickness,
 // 2.5-7.5 of the larger drainage radius across the producer's path from its mid-point in plan (close
 // enough that the producer's refined columns pass beside it and that the cavities merge in some
-// cases), kept within the middle 70 % of the model.
+// cases), kept within the middle 70 % of the model; `wells` = 3 a second one drawn after it, across the
+// producer's path from the first (the same rule).
 CornerPointSweepCase make_corner_point_case(uint32_t seed, int wells = 1) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
@@ -81,6 +82,20 @@ CornerPointSweepCase make_corner_point_case(uint32_t seed, int wells = 1) {
     std::snprintf(text, sizeof text, "; injector R %4.1f m, %5.1f m away", r2,
                   std::hypot(xi - 0.5 * (x0 + x1), yi - 0.5 * (y0 + y1)));
     second = text;
+    if (wells >= 3) {
+      // A second injector across the producer from the first: the producer's refined columns pass
+      // beside both, and a well refined for one may cross the other's reach (near_well_splits' passes).
+      const double r3 = detail::log_uniform(rng, 5, std::max(5.0, std::min(20.0, 0.3 * thickness)));
+      const double apart3 = (2.5 + 5 * u(rng)) * std::max(radius, r3), depth3 = (0.4 + 0.5 * u(rng)) * thickness;
+      const double x3 = std::clamp(0.5 * (x0 + x1) - apart3 * std::cos(direction), 0.15 * lx, 0.85 * lx);
+      const double y3 = std::clamp(0.5 * (y0 + y1) - apart3 * std::sin(direction), 0.15 * ly, 0.85 * ly);
+      c.wells += "  - {name: I2, type: injector, trajectory: [[" + num(x3) + ", " + num(y3) + ", " +
+                 num(top(x3, y3) - 30) + "], [" + num(x3) + ", " + num(y3) + ", " + num(top(x3, y3) + depth3) +
+                 "]], radius: 0.1, drainage_radius: " + num(r3) + ", bhp: 250}\n";
+      std::snprintf(text, sizeof text, "; I2 R %4.1f m, %5.1f m away", r3,
+                    std::hypot(x3 - 0.5 * (x0 + x1), y3 - 0.5 * (y0 + y1)));
+      second += text;
+    }
   }
   char label[384];
   std::snprintf(label, sizeof label,
@@ -162,20 +177,22 @@ TEST(CornerPointSweep, CiSubsetMeshesSoundly) {
 }
 
 // HM_LONG_TESTS=1: every seed in a forked child; no crash, hang or mesh failing a check; the table.
-// HM_CP_SWEEP_CASES seeds (30) from HM_CP_SWEEP_FIRST (1), HM_CP_SWEEP_WELLS wells (1, or 2: the
-// producer and an injector beside it). Run it alone (--gtest_filter=...SweepTable):
+// HM_CP_SWEEP_CASES seeds (30) from HM_CP_SWEEP_FIRST (1), HM_CP_SWEEP_WELLS wells (1; 2: the
+// producer and an injector beside it; 3: and a second injector across the producer from the first),
+// HM_CP_SWEEP_LIMIT_S seconds per case (900). Run it alone (--gtest_filter=...SweepTable):
 // after a test that meshed in this process the thread pool exists, and a forked child can hang on it.
 TEST(CornerPointSweep, SweepTable) {
   if (!long_tests()) GTEST_SKIP() << "HM_LONG_TESTS=1 runs the sweep";
   const int n = std::getenv("HM_CP_SWEEP_CASES") ? std::atoi(std::getenv("HM_CP_SWEEP_CASES")) : 30;
   const int first = std::getenv("HM_CP_SWEEP_FIRST") ? std::atoi(std::getenv("HM_CP_SWEEP_FIRST")) : 1;
   const int wells = std::getenv("HM_CP_SWEEP_WELLS") ? std::atoi(std::getenv("HM_CP_SWEEP_WELLS")) : 1;
+  const int limit_s = std::getenv("HM_CP_SWEEP_LIMIT_S") ? std::atoi(std::getenv("HM_CP_SWEEP_LIMIT_S")) : 900;
   std::map<Outcome, int> count;
   for (uint32_t seed = first; seed < static_cast<uint32_t>(first + n); ++seed) {
     const CornerPointSweepCase c = make_corner_point_case(seed, wells);
     // 900 s: the largest seeds (thin layers split at a fault's steps: seeds 4 and 23, 1.5-1.7M cells) mesh in
     // about 5 minutes alone and take longer beside the test suites (docs/corner-point.md, sweep).
-    const CaseResult r = run_isolated([&] { return mesh_corner_point_case(c); }, 900);
+    const CaseResult r = run_isolated([&] { return mesh_corner_point_case(c); }, limit_s);
     ++count[r.outcome];
     std::printf("| %s | %s | %s | %.1f |\n", c.label.c_str(), outcome_name(r.outcome),
                 r.reason.substr(0, 300).c_str(), r.seconds);
