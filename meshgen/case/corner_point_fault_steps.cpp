@@ -103,20 +103,39 @@ double path_distance(Vec3 p, const FaultStepRequest& w) {
   return d;
 }
 
-// Per cell: whether its bounding sphere (about the mean of its corners) comes within reach of a well
-// that asked.
+// Whether a cell's bounding sphere (about the mean of its corners) comes within a well's reach.
+bool cell_within_reach(const std::array<Vec3, 8>& corners, const FaultStepRequest& w) {
+  Vec3 centre{0, 0, 0};
+  for (const Vec3& q : corners) centre += q / 8.0;
+  double radius = 0;
+  for (const Vec3& q : corners) radius = std::max(radius, norm(q - centre));
+  return path_distance(centre, w) <= w.reach + radius;
+}
+
+// Per cell: whether it comes within reach of a well that asked.
 std::vector<char> cells_near(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells,
                              const std::vector<char>& asked) {
   std::vector<char> near(m.corners.size(), 0);
-  for (size_t c = 0; c < m.corners.size(); ++c) {
-    Vec3 centre{0, 0, 0};
-    for (const Vec3& q : m.corners[c]) centre += q / 8.0;
-    double radius = 0;
-    for (const Vec3& q : m.corners[c]) radius = std::max(radius, norm(q - centre));
-    for (size_t w = 0; w < wells.size() && !near[c]; ++w)
-      near[c] = asked[w] && path_distance(centre, wells[w]) <= wells[w].reach + radius;
-  }
+  for (size_t c = 0; c < m.corners.size(); ++c)
+    for (size_t w = 0; w < wells.size() && !near[c]; ++w) near[c] = asked[w] && cell_within_reach(m.corners[c], wells[w]);
   return near;
+}
+
+// The wells that did not ask but have a split cell within reach: the edge of the split cells would
+// run through their cavity (a whole cell beside split ones has the children's nodes in the middle
+// of its face's edge, the wall no triangulation keeps every site in its cell).
+std::vector<size_t> wells_reaching_split_cells(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells,
+                                               const std::vector<char>& asked, const std::vector<char>& near) {
+  std::vector<size_t> out;
+  for (size_t w = 0; w < wells.size(); ++w) {
+    if (asked[w]) continue;
+    for (size_t c = 0; c < m.corners.size(); ++c)
+      if (near[c] && cell_within_reach(m.corners[c], wells[w])) {
+        out.push_back(w);
+        break;
+      }
+  }
+  return out;
 }
 
 // Split depths of one layer at one pillar side: n - 1 increasing depths strictly inside the layer.
@@ -167,7 +186,13 @@ FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<
           out.children[k] = std::max(out.children[k], 1 + static_cast<int>(n));
         }
     }
-  if (out.splits()) out.near = cells_near(m, wells, asked);
+  if (!out.splits()) return out;
+  // A well beside the split cells of another asks too, and so on until none is newly reached.
+  out.near = cells_near(m, wells, asked);
+  for (std::vector<size_t> more; !(more = wells_reaching_split_cells(m, wells, asked, out.near)).empty();) {
+    for (size_t w : more) asked[w] = 1;
+    out.near = cells_near(m, wells, asked);
+  }
   return out;
 }
 

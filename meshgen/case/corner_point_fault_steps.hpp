@@ -46,8 +46,9 @@ struct FaultPillar {
 /// What fault_step_children found.
 struct FaultStepSplit {
   std::vector<int> children;  ///< per layer of the input model, >= 1 (all 1: nothing to split)
-  /// Per cell of the input model: within reach of a well that asked for a split (its cells are split;
-  /// the others keep their whole thickness in their first child, the rest of zero thickness).
+  /// Per cell of the input model: within reach of a well that asked for a split, or of a well that has
+  /// such a cell within its own reach, and so on (its cells are split; the others keep their whole
+  /// thickness in their first child, the rest of zero thickness).
   std::vector<char> near;
   int64_t steps = 0;          ///< cell corners on a fault pillar within reach that asked for a split
   std::vector<FaultPillar> fault_pillars;  ///< every such pillar of the model, by increasing pillar

@@ -16,6 +16,7 @@
 #include "model_cell_volumes.hpp"
 #include "meshgen/case/corner_point_fault_steps.hpp"
 #include "meshgen/case/grdecl.hpp"
+#include "meshgen/case/segment_distance.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/local_frame.hpp"
@@ -64,6 +65,52 @@ TEST(FaultSteps, LayersNearAWellAcrossAFractionalThrowAreSplit) {
   hmtest::LayeredModel whole = faulted_model();
   whole.throw_m = 2 * whole.dz;
   EXPECT_FALSE(fault_step_children(read_model(tmp, whole), {{{{125, 75, 1000}, {125, 75, 1012}}, 20}}).splits());
+}
+
+// A well that did not ask (no step within its reach) but has split cells of another well within reach
+// gets its own cells split too, and so on from well to well: the edge between split and whole cells
+// (a whole cell beside split ones carries their nodes in the middle of its face's edges) never runs
+// through a cavity. Sweep seed 10 with three wells failed there: 34 wall triangles below 45 degrees
+// (docs/corner-point.md, "Fault steps").
+TEST(FaultSteps, WellsBesideSplitCellsGetTheirCellsSplitToo) {
+  TempDir tmp("cpsteps_beside");
+  const CornerPointModel m = read_model(tmp, faulted_model());
+  const FaultStepRequest a{{{125, 75, 1000}, {125, 75, 1012}}, 20};  // beside the fault (x = 120): asks
+  const FaultStepRequest b{{{70, 75, 1000}, {70, 75, 1012}}, 20};    // 50 m from it: A's split cells in reach
+  const FaultStepRequest c{{{15, 75, 1000}, {15, 75, 1012}}, 20};    // in reach of B's cells only
+  auto column_near = [&](const FaultStepSplit& s, int i) {
+    bool any = false;
+    for (int k = 0; k < m.nz; ++k) any = any || s.near[i + m.nx * (2 + m.ny * k)];
+    return any;
+  };
+  const FaultStepSplit a_only = fault_step_children(m, {a});
+  ASSERT_TRUE(a_only.splits());
+  const FaultStepSplit a_c = fault_step_children(m, {a, c});
+  const FaultStepSplit abc = fault_step_children(m, {a, b, c});
+  const FaultStepSplit cba = fault_step_children(m, {c, b, a});
+  EXPECT_EQ(abc.near, cba.near);
+  EXPECT_EQ(abc.children, a_only.children);  // the same children per layer: only where they are cut grows
+  for (int i : {0, 1}) {
+    EXPECT_FALSE(column_near(a_only, i)) << i;  // fail half: A's split cells stop short of columns 0-1
+    EXPECT_FALSE(column_near(a_c, i)) << i;     // and C alone does not reach them
+    EXPECT_TRUE(column_near(abc, i)) << i;      // through B, C's cells are split too
+  }
+  // The invariant: every well's reach holds split cells only or whole cells only.
+  const std::vector<std::pair<const FaultStepSplit*, std::vector<FaultStepRequest>>> runs{
+      {&a_only, {a}}, {&a_c, {a, c}}, {&abc, {a, b, c}}};
+  for (const auto& [s, given] : runs)
+    for (const FaultStepRequest& w : given) {
+      int split = 0, whole = 0;
+      for (size_t cell = 0; cell < m.corners.size(); ++cell) {
+        Vec3 centre{0, 0, 0};
+        for (const Vec3& q : m.corners[cell]) centre += q / 8.0;
+        double radius = 0;
+        for (const Vec3& q : m.corners[cell]) radius = std::max(radius, norm(q - centre));
+        if (segment_segment_distance(centre, centre, w.path[0], w.path[1]) > w.reach + radius) continue;
+        (s->near[cell] ? split : whole)++;
+      }
+      EXPECT_TRUE(split == 0 || whole == 0) << split << " split and " << whole << " whole cells in one well's reach";
+    }
 }
 
 // The split model: children tile their parents, the parents' tops and bottoms are kept bit for bit,
