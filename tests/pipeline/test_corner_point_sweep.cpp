@@ -176,6 +176,16 @@ TEST(CornerPointSweep, CiSubsetMeshesSoundly) {
   }
 }
 
+// Three wells in the model of seed 3 (a fault of 0.25 layer under the producer): an injector's reach
+// holds the producer's fault-step cells, so its cells are split too ("Fault steps", wells beside the
+// split cells); three cavities. About 10 s.
+TEST(CornerPointSweep, CiThreeWellCaseMeshesSoundly) {
+  const CornerPointSweepCase c = make_corner_point_case(3, 3);
+  const CaseResult r = mesh_corner_point_case(c);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << c.label << ": " << r.reason;
+  std::printf("[ cp sweep ] %s: %s %s (%.1f s)\n", c.label.c_str(), outcome_name(r.outcome), r.reason.c_str(), r.seconds);
+}
+
 // HM_LONG_TESTS=1: every seed in a forked child; no crash, hang or mesh failing a check; the table.
 // HM_CP_SWEEP_CASES seeds (30) from HM_CP_SWEEP_FIRST (1), HM_CP_SWEEP_WELLS wells (1; 2: the
 // producer and an injector beside it; 3: and a second injector across the producer from the first),
