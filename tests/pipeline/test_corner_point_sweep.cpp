@@ -178,7 +178,7 @@ TEST(CornerPointSweep, CiSubsetMeshesSoundly) {
 
 // Three wells in the model of seed 3 (a fault of 0.25 layer under the producer): an injector's reach
 // holds the producer's fault-step cells, so its cells are split too ("Fault steps", wells beside the
-// split cells); three cavities. About 10 s.
+// split cells). About 5 s.
 TEST(CornerPointSweep, CiThreeWellCaseMeshesSoundly) {
   const CornerPointSweepCase c = make_corner_point_case(3, 3);
   const CaseResult r = mesh_corner_point_case(c);
