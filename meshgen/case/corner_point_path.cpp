@@ -70,6 +70,47 @@ CornerPointInterior::CornerPointInterior(const CornerPointModel& m, Vec3 lo, Vec
   const double scale = std::max({1.0, std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x), std::abs(hi.y),
                                  std::abs(hi.z)});
   nudge_ = kFaceNudge * scale * normalized(Vec3{0.5772156649, 0.3183098862, -1.0});
+  if (cells_.empty()) return;
+  // Buckets of the cells' median extent per axis (thin layers: flat buckets), at most about 4 per cell.
+  origin_ = cells_[0].lo;
+  Vec3 top = cells_[0].hi;
+  for (const Cell& c : cells_)
+    for (int k = 0; k < 3; ++k) origin_[k] = std::min(origin_[k], c.lo[k]), top[k] = std::max(top[k], c.hi[k]);
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> extent;
+    for (const Cell& c : cells_) extent.push_back(c.hi[k] - c.lo[k]);
+    std::nth_element(extent.begin(), extent.begin() + extent.size() / 2, extent.end());
+    bucket_size_[k] = std::max(extent[extent.size() / 2], 1e-9 * std::max(1.0, top[k] - origin_[k]));
+  }
+  const double limit = 4.0 * static_cast<double>(cells_.size()) + 64;
+  for (;;) {
+    double count = 1;
+    for (int k = 0; k < 3; ++k) count *= std::floor((top[k] - origin_[k]) / bucket_size_[k]) + 1;
+    if (count <= limit) break;
+    bucket_size_ = 2.0 * bucket_size_;
+  }
+  for (int k = 0; k < 3; ++k) buckets_[k] = static_cast<int>(std::floor((top[k] - origin_[k]) / bucket_size_[k])) + 1;
+  const size_t n_buckets = size_t(buckets_[0]) * buckets_[1] * buckets_[2];
+  bucket_begin_.assign(n_buckets + 1, 0);
+  auto for_each_bucket = [&](const Cell& c, auto visit) {
+    const std::array<int, 3> a = bucket_index(c.lo), b = bucket_index(c.hi);
+    for (int z = a[2]; z <= b[2]; ++z)
+      for (int y = a[1]; y <= b[1]; ++y)
+        for (int x = a[0]; x <= b[0]; ++x) visit(x + buckets_[0] * (y + size_t(buckets_[1]) * z));
+  };
+  for (const Cell& c : cells_) for_each_bucket(c, [&](size_t b) { ++bucket_begin_[b + 1]; });
+  for (size_t b = 0; b < n_buckets; ++b) bucket_begin_[b + 1] += bucket_begin_[b];
+  bucket_cells_.resize(bucket_begin_.back());
+  std::vector<int32_t> fill(bucket_begin_.begin(), bucket_begin_.end() - 1);
+  for (size_t c = 0; c < cells_.size(); ++c)
+    for_each_bucket(cells_[c], [&](size_t b) { bucket_cells_[fill[b]++] = static_cast<int32_t>(c); });
+}
+
+std::array<int, 3> CornerPointInterior::bucket_index(Vec3 p) const {
+  std::array<int, 3> i{};
+  for (int k = 0; k < 3; ++k)
+    i[k] = static_cast<int>(std::clamp(std::floor((p[k] - origin_[k]) / bucket_size_[k]), -1.0, double(buckets_[k])));
+  return i;
 }
 
 bool CornerPointInterior::contains(Vec3 q) const {
@@ -77,7 +118,13 @@ bool CornerPointInterior::contains(Vec3 q) const {
   // kFaceNudge of the model's scale in a direction no face has (symbolic perturbation): on a face
   // between two cells it is then inside one of them, on the model's top outside it.
   const Vec3 p = q + nudge_;
-  for (const Cell& c : cells_) {
+  if (cells_.empty()) return false;
+  const std::array<int, 3> at = bucket_index(p);
+  for (int k = 0; k < 3; ++k)
+    if (at[k] < 0 || at[k] >= buckets_[k]) return false;  // beyond every cell's box
+  const size_t bucket = at[0] + buckets_[0] * (at[1] + size_t(buckets_[1]) * at[2]);
+  for (int32_t i = bucket_begin_[bucket]; i < bucket_begin_[bucket + 1]; ++i) {
+    const Cell& c = cells_[bucket_cells_[i]];
     bool in_box = true;
     for (int k = 0; k < 3; ++k) in_box = in_box && p[k] >= c.lo[k] && p[k] <= c.hi[k];
     if (!in_box) continue;

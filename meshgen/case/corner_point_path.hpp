@@ -43,7 +43,12 @@ class CornerPointInterior {
     Vec3 lo, hi;
     std::array<Vec3, 8> corners;
   };
+  // The cells by the buckets of a uniform grid their boxes overlap (a query tests one bucket's cells).
+  std::array<int, 3> bucket_index(Vec3 p) const;
   std::vector<Cell> cells_;
+  Vec3 origin_, bucket_size_{1, 1, 1};
+  std::array<int, 3> buckets_{0, 0, 0};
+  std::vector<int32_t> bucket_begin_, bucket_cells_;  // CSR over buckets (x fastest)
   Vec3 nudge_;
 };
 

@@ -67,24 +67,75 @@ double mean_sq_distance(Vec3 p, const std::vector<int32_t>& nodes, const std::ve
   return s / static_cast<double>(nodes.size());
 }
 
-// Condition (6) of paper 5.5.1 for site s against every other live site: where two spheres
-// overlap, the radical plane must not pass beyond the smaller-weight (internal) site. A free
-// site also keeps its clearance from every other sphere, and every sphere from it.
-bool centred(const SiteSet& set, int s) {
-  const Site& a = set.sites[s];
-  for (size_t j = 0; j < set.sites.size(); ++j) {
-    const Site& b = set.sites[j];
-    if (static_cast<int>(j) == s || !b.alive || b.kind == SiteKind::Guard) continue;
-    const double d2 = norm2(a.p - b.p);
-    if (a.kind == SiteKind::Free && b.kind != SiteKind::Free && std::sqrt(d2) < std::sqrt(b.w2) + a.clearance)
-      return false;
-    if (b.kind == SiteKind::Free && a.kind != SiteKind::Free && std::sqrt(d2) < std::sqrt(a.w2) + b.clearance)
-      return false;
-    if (d2 > std::max(a.w2, b.w2)) continue;
-    const Site& small = a.w2 > b.w2 ? b : a;
-    if (small.internal() && std::abs(a.w2 - b.w2) > d2) return false;
+// The live sites by their x at a round's start, for centred(): a site moved since then (a kept move)
+// is within the drift of its entry, so a window of the sorted list widened by the drift holds every
+// site near a point. Radii (sqrt w2) and clearances are bounded by their largest values so far.
+class SiteSlab {
+ public:
+  void reset(const SiteSet& set) {
+    by_x_.clear();
+    start_x_.assign(set.sites.size(), 0.0);
+    drift_ = max_radius_ = max_clearance_ = 0;
+    for (size_t j = 0; j < set.sites.size(); ++j) {
+      const Site& b = set.sites[j];
+      if (!b.alive || b.kind == SiteKind::Guard) continue;
+      by_x_.push_back({b.p.x, static_cast<int>(j)});
+      start_x_[j] = b.p.x;
+      max_radius_ = std::max(max_radius_, std::sqrt(b.w2));
+      max_clearance_ = std::max(max_clearance_, b.clearance);
+    }
+    std::sort(by_x_.begin(), by_x_.end());
   }
-  return true;
+  // Site j now where it is in `set` (a kept move or its undoing).
+  void moved(const SiteSet& set, int j) {
+    const Site& b = set.sites[j];
+    drift_ = std::max(drift_, std::abs(b.p.x - start_x_[j]));
+    max_radius_ = std::max(max_radius_, std::sqrt(b.w2));
+  }
+  // Calls f(j) for every live site j whose x may be within `reach` of x (and some beyond).
+  template <class F>
+  bool all_of_near(double x, double reach, F f) const {
+    const double w = reach + drift_ + 1e-9 * (reach + std::abs(x));  // |x_j - x| <= distance, to rounding
+    auto it = std::lower_bound(by_x_.begin(), by_x_.end(), std::make_pair(x - w, std::numeric_limits<int>::min()));
+    for (; it != by_x_.end() && it->first <= x + w; ++it)
+      if (!f(it->second)) return false;
+    return true;
+  }
+  double max_radius() const { return max_radius_; }
+  double max_clearance() const { return max_clearance_; }
+
+ private:
+  std::vector<std::pair<double, int>> by_x_;
+  std::vector<double> start_x_;
+  double drift_ = 0, max_radius_ = 0, max_clearance_ = 0;
+};
+
+// Condition (6) of paper 5.5.1 for sites a and b: where two spheres overlap, the radical plane must
+// not pass beyond the smaller-weight (internal) site. A free site also keeps its clearance from every
+// other sphere, and every sphere from it.
+bool centred_pair(const Site& a, const Site& b) {
+  const double d2 = norm2(a.p - b.p);
+  if (a.kind == SiteKind::Free && b.kind != SiteKind::Free && std::sqrt(d2) < std::sqrt(b.w2) + a.clearance) return false;
+  if (b.kind == SiteKind::Free && a.kind != SiteKind::Free && std::sqrt(d2) < std::sqrt(a.w2) + b.clearance) return false;
+  if (d2 > std::max(a.w2, b.w2)) return true;
+  const Site& small = a.w2 > b.w2 ? b : a;
+  return !(small.internal() && std::abs(a.w2 - b.w2) > d2);
+}
+
+// Condition (6) for site s (a trial position) against every other live site. Only sites within
+// max(radii) + max(clearances) of s can break it: those of the slab's window, where every site but
+// s and the mirror that moves with it stands as the slab knows; that mirror is checked by itself.
+bool centred(const SiteSet& set, int s, const SiteSlab& slab) {
+  const Site& a = set.sites[s];
+  const int mirror = a.kind == SiteKind::InternalPolygon ? set.external_of[a.polygon] : -1;
+  if (mirror >= 0 && set.sites[mirror].alive && set.sites[mirror].kind != SiteKind::Guard &&
+      !centred_pair(a, set.sites[mirror]))
+    return false;
+  const double reach = std::max(std::sqrt(a.w2), slab.max_radius()) + std::max(a.clearance, slab.max_clearance());
+  return slab.all_of_near(a.p.x, reach, [&](int j) {
+    const Site& b = set.sites[j];
+    return j == s || j == mirror || !b.alive || b.kind == SiteKind::Guard || centred_pair(a, b);
+  });
 }
 
 // Per cell: its faces shared with another transition cell whose OpenFOAM skewness exceeds
@@ -227,6 +278,14 @@ class SiteOptimizer {
     Site& site = set_.sites[s];
     if (site.kind == SiteKind::InternalPolygon) place_polygon_site(set_, s, st.t, cavity_, coords_, frames_);
     else site.p = st.p, site.w2 = st.w2;
+    track(s);
+  }
+  // The slab follows site s, and the mirror that moves with a polygon site.
+  void track(int s) {
+    slab_.moved(set_, s);
+    const Site& site = set_.sites[s];
+    if (site.kind == SiteKind::InternalPolygon && set_.external_of[site.polygon] >= 0)
+      slab_.moved(set_, set_.external_of[site.polygon]);
   }
   // The move of site d (or of its partner) that puts the power vertex it shares with
   // reference site a at x; false if it leaves the admissible range widened by `range_slack`
@@ -246,6 +305,7 @@ class SiteOptimizer {
   const TransitionOptions& opt_;
   const std::vector<Vec3>& outside_centres_;
   std::set<std::array<int, 9>> refused_;
+  SiteSlab slab_;  // the sites by x, for centred(): reset at each round's start
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   int skewed_left_ = 0;
   int proposed_last_ = 0;
@@ -298,7 +358,7 @@ bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, double ra
   } else {
     return false;
   }
-  const bool ok = centred(set_, mover);
+  const bool ok = centred(set_, mover, slab_);
   m->after = state(mover);
   restore(mover, m->before);
   return ok;
@@ -320,13 +380,14 @@ bool SiteOptimizer::trial_step(int s, int other, bool away, int size, Move* m) {
   } else {
     return false;
   }
-  const bool ok = centred(set_, s);
+  const bool ok = centred(set_, s, slab_);
   m->after = state(s);
   restore(s, m->before);
   return ok;
 }
 
 bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only) {
+  slab_.reset(set_);
   // The diagram's measurement: the one the previous round took of the diagram it left, if any.
   Measured now = next_ ? std::move(*next_) : measure(out);
   next_.reset();

@@ -351,20 +351,32 @@ TEST(NearWellRefinement, SplitsFollowTheWellWhereverTheModelSits) {
     for (size_t a = 0; a < s.i_bounds[i].size(); ++a) EXPECT_NEAR(moved.i_bounds[i][a], s.i_bounds[i][a], 1e-9) << i;
 }
 
+namespace {
+
+// 12 x 12 x 6 cells of 20 x 20 x 3 m, the layered model's dip.
+const hmtest::LayeredModel kTwentyMetreColumns = [] {
+  hmtest::LayeredModel g;
+  g.nx = 12, g.ny = 12, g.nz = 6, g.dx = 20, g.dy = 20;
+  return g;
+}();
+
+// A vertical well of model g at (x, y) through the middle four layers, asking for cells of `size`
+// within 20 m.
+RefinementRequest vertical_request(const hmtest::LayeredModel& g, double x, double y, double size) {
+  const double top = 1000 + std::tan(g.dip_deg * M_PI / 180) * x + 0.01 * y;
+  return RefinementRequest{{{x, y, top + 3}, {x, y, top + 15}}, size, 20, false};
+}
+
+}  // namespace
+
 // Two wells: a well whose columns are narrow for its own size keeps them alone, but where the children
 // of another well's columns cross its reach (or the slices next to it) its own slices there are split
 // to its size too: cells many times longer than wide beside its cavity gave walls no Gabriel repair
 // cleared (docs/corner-point.md, "Near-well refinement", two wells).
 TEST(NearWellRefinement, AWellCrossedByAnothersChildrenIsRefinedToItsSize) {
   TempDir tmp("cprefine2");
-  hmtest::LayeredModel g;
-  g.nx = 12, g.ny = 12, g.nz = 6, g.dx = 20, g.dy = 20;
-  const CornerPointModel m = read_model(tmp, g);
-  // A vertical well at (x, y) through the middle four layers, asking for cells of `size` within 20 m.
-  auto well = [&](double x, double y, double size) {
-    const double top = 1000 + std::tan(g.dip_deg * M_PI / 180) * x + 0.01 * y;
-    return RefinementRequest{{{x, y, top + 3}, {x, y, top + 15}}, size, 20, false};
-  };
+  const CornerPointModel m = read_model(tmp, kTwentyMetreColumns);
+  auto well = [](double x, double y, double size) { return vertical_request(kTwentyMetreColumns, x, y, size); };
   // A: 4 m cells asked in 20 m columns (split); B: 5 m cells in 20 m columns (not wider than 4 sizes).
   const RefinementRequest a = well(110, 110, 4), b_far = well(30, 30, 5), b_beside = well(30, 110, 5);
   EXPECT_FALSE(near_well_splits(m, {b_beside}).refines());  // fail half: alone, B's columns stay whole
@@ -752,13 +764,8 @@ TEST(NearWellRefinement, ReekOp2MeshesWithItsPillarsTurnedUpright) {
 // depend on the order the wells are given in.
 TEST(NearWellRefinement, CrossingsAreFollowedFromWellToWell) {
   TempDir tmp("cprefine3");
-  hmtest::LayeredModel g;
-  g.nx = 12, g.ny = 12, g.nz = 6, g.dx = 20, g.dy = 20;
-  const CornerPointModel m = read_model(tmp, g);
-  auto well = [&](double x, double y, double size) {
-    const double top = 1000 + std::tan(g.dip_deg * M_PI / 180) * x + 0.01 * y;
-    return RefinementRequest{{{x, y, top + 3}, {x, y, top + 15}}, size, 20, false};
-  };
+  const CornerPointModel m = read_model(tmp, kTwentyMetreColumns);
+  auto well = [](double x, double y, double size) { return vertical_request(kTwentyMetreColumns, x, y, size); };
   const RefinementRequest a = well(110, 110, 4), b = well(30, 110, 5), c = well(30, 30, 5);
   // Fail half: A alone does not come near C (rows and columns 0-2 whole), nor does C alone split them.
   const ColumnSplits a_only = near_well_splits(m, {a});
