@@ -67,8 +67,7 @@ CornerPointInterior::CornerPointInterior(const CornerPointModel& m, Vec3 lo, Vec
     for (int k = 0; k < 3; ++k) meets = meets && cell.lo[k] <= hi[k] && cell.hi[k] >= lo[k];
     if (meets && cell.hi.z > cell.lo.z) cells_.push_back(cell);
   }
-  const double scale = std::max({1.0, std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x), std::abs(hi.y),
-                                 std::abs(hi.z)});
+  const double scale = std::max({1.0, hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
   nudge_ = kFaceNudge * scale * normalized(Vec3{0.5772156649, 0.3183098862, -1.0});
   if (cells_.empty()) return;
   // Buckets of the cells' median extent per axis (thin layers: flat buckets), at most about 4 per cell.
@@ -115,7 +114,7 @@ std::array<int, 3> CornerPointInterior::bucket_index(Vec3 p) const {
 
 bool CornerPointInterior::contains(Vec3 q) const {
   // A point on a face (a path's end given on a layer boundary) is moved off it, up and sideways by
-  // kFaceNudge of the model's scale in a direction no face has (symbolic perturbation): on a face
+  // kFaceNudge of the region's extent in a direction no face has (symbolic perturbation): on a face
   // between two cells it is then inside one of them, on the model's top outside it.
   const Vec3 p = q + nudge_;
   if (cells_.empty()) return false;

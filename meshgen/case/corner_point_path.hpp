@@ -26,9 +26,11 @@ constexpr double kSurfaceGapMin = 0.25;
 /// triangles near it away from the surface: outside their diametral spheres with a margin.
 constexpr double kSurfaceGapMargin = 1.25;
 
-/// Relative size (of the coordinates) of the shift that moves a point off the faces it lies on before
-/// the inside test: far above rounding, far below any cell.
-constexpr double kFaceNudge = 1e-12;
+/// Relative size (of the extent of the region tested) of the shift that moves a point off the faces it
+/// lies on before the inside test: far above the rounding of field coordinates (1e-9 m at 1e7 m), far
+/// below any cell. Relative to the extent, not to the coordinates, so that a model at UTM values and the
+/// same model at the origin clip their wells at the same places.
+constexpr double kFaceNudge = 1e-8;
 
 /// Whether points lie inside the active, non-degenerate cells of a model whose corner box meets the
 /// box [lo, hi] (each cell the closed surface of its 6 faces cut into 2 triangles along a diagonal:

@@ -528,6 +528,25 @@ CornerPointCellFaces corner_point_cell_faces(const CornerPointModel& model, cons
   return mesher.cell_faces(boundary_patch);
 }
 
+namespace {
+
+using EpickPoint2 = CGAL::Exact_predicates_inexact_constructions_kernel::Point_2;
+
+// Ears whose qualities (smallest angle, radians) differ by less than this are a tie, decided by the
+// cycle's order; likewise a node within this fraction of the circle's radius from an ear's circle
+// counts as on it. A rectangle's two diagonals are such a tie, and rounding must not decide it: a
+// model moved by UTM-sized offsets reaches us with its nodes a few 1e-11 m off, and the same face
+// must get the same triangles wherever the model sits (CornerPointSweep.CiHorizontalSurveyWell...).
+constexpr double kEarTie = 1e-9;
+
+bool on_circle_within_tie(const EpickPoint2& a, const EpickPoint2& b, const EpickPoint2& c, const EpickPoint2& x) {
+  const EpickPoint2 o = CGAL::circumcenter(a, b, c);
+  const double r = std::sqrt(CGAL::to_double(CGAL::squared_distance(o, a)));
+  return std::abs(std::sqrt(CGAL::to_double(CGAL::squared_distance(o, x))) - r) <= kEarTie * r;
+}
+
+}  // namespace
+
 std::vector<std::array<int32_t, 3>> face_triangles(const std::vector<int32_t>& cycle, const std::vector<Vec3>& coords) {
   using K = CGAL::Exact_predicates_inexact_constructions_kernel;
   const size_t n = cycle.size();
@@ -549,8 +568,8 @@ std::vector<std::array<int32_t, 3>> face_triangles(const std::vector<int32_t>& c
     p2[i] = K::Point_2(dot(d, u), dot(d, v));
   }
   // Ear clipping in that plane: an ear is a strictly convex corner whose triangle holds no other
-  // node (closed); Delaunay ears go first, then the ear with the largest smallest angle (ties: the
-  // first in the cycle). The decisions are exact predicates on the projected nodes.
+  // node (closed); Delaunay ears go first, then the ear with the largest smallest angle (ties within
+  // kEarTie: the first in the cycle). Convexity and emptiness are exact predicates on the projected nodes.
   std::vector<size_t> left(n);
   for (size_t i = 0; i < n; ++i) left[i] = i;
   std::vector<std::array<int32_t, 3>> tris;
@@ -576,10 +595,11 @@ std::vector<std::array<int32_t, 3>> face_triangles(const std::vector<int32_t>& c
       for (size_t r = 0; r < m && delaunay; ++r) {
         const size_t x = left[r];
         if (x == a || x == b || x == c) continue;
-        delaunay = CGAL::side_of_oriented_circle(p2[a], p2[b], p2[c], p2[x]) != CGAL::ON_POSITIVE_SIDE;
+        delaunay = CGAL::side_of_oriented_circle(p2[a], p2[b], p2[c], p2[x]) != CGAL::ON_POSITIVE_SIDE ||
+                   on_circle_within_tie(p2[a], p2[b], p2[c], p2[x]);
       }
       const double q = (delaunay ? kPiValue : 0.0) + min_angle(coords[cycle[a]], coords[cycle[b]], coords[cycle[c]]);
-      if (q > best_q) best_q = q, best = k;
+      if (q > best_q + kEarTie) best_q = q, best = k;
     }
     if (best == m) throw std::logic_error("corner-point grid: a cell face has no ear to triangulate (degenerate face)");
     tris.push_back({cycle[left[(best + m - 1) % m]], cycle[left[best]], cycle[left[(best + 1) % m]]});

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -173,10 +174,31 @@ inline std::string region_multiplier_keywords(const TiltedModel& g) {
 /// parallel straight pillars inclined `pillar_deg` from the vertical toward azimuth `pillar_azimuth_deg`
 /// (0: +x, 90: +y), so every cell face is
 /// planar; an optional fault on pillar line I = fault_i (columns i >= fault_i down by throw_m).
-/// PERMX varies by cell; PERMY 120, PERMZ 12 mD; PORO 0.2.
+/// PERMX varies by cell; PERMY 120, PERMZ 12 mD; PORO 0.2. Optionally a model as a geomodeller
+/// exports it: in field coordinates (`x_origin`, `y_origin` added to COORD; or, with `map_axes`, COORD
+/// in the grid's own frame and MAPAXES placing it there turned `map_turn_deg` counter-clockwise) and
+/// with `rock` (per-cell rock: a log-normal PERMX = PERMY about a mean of its own per layer, PERMZ =
+/// kv_kh PERMX, PORO rising with log PERMX; drawn from `rock_seed`).
 struct LayeredModel {
   int nx = 7, ny = 7, nz = 40, fault_i = -1;
   double dx = 100, dy = 100, dz = 3, dip_deg = 5, pillar_deg = 0, pillar_azimuth_deg = 0, throw_m = 0;
+  double x_origin = 0, y_origin = 0, map_turn_deg = 0, kv_kh = 0.1;
+  bool map_axes = false, rock = false;
+  unsigned rock_seed = 1;
+
+  /// Map position of point (x, y) of the model's own frame (pillar (I, J) at depth 1000 is (dx I, dy J)).
+  std::array<double, 2> to_map(double x, double y) const {
+    if (!map_axes) return {x_origin + x, y_origin + y};
+    const double c = std::cos(map_turn_deg * M_PI / 180), s = std::sin(map_turn_deg * M_PI / 180);
+    return {x_origin + c * x - s * y, y_origin + s * x + c * y};
+  }
+  /// Depth of the top of layer k (of the columns before the fault) at grid-frame plan point (x, y): the
+  /// layer's surface is a plane through the leaning pillars.
+  double layer_top(int k, double x, double y) const {
+    const double lean = std::tan(pillar_deg * M_PI / 180), az = pillar_azimuth_deg * M_PI / 180;
+    const double sx = std::tan(dip_deg * M_PI / 180), sy = 0.01;
+    return 1000 + dz * k + (sx * x + sy * y) / (1 + sx * lean * std::cos(az) + sy * lean * std::sin(az));
+  }
 
   double depth(int i_col, int I, int J, int k) const {
     double z = 1000 + dz * k + std::tan(dip_deg * M_PI / 180) * dx * I + 0.01 * dy * J;
@@ -188,13 +210,40 @@ struct LayeredModel {
     const double lean = std::tan(pillar_deg * M_PI / 180), az = pillar_azimuth_deg * M_PI / 180;
     const double lx = lean * std::cos(az), ly = lean * std::sin(az);
     o << "SPECGRID\n " << nx << " " << ny << " " << nz << " 1 F /\nCOORD\n";
+    const double ox = map_axes ? 0 : x_origin, oy = map_axes ? 0 : y_origin;
     write_pillars(o, nx, ny, 900, 1300, [&](int I, int J) {
-      const double x = dx * I, y = dy * J;  // the pillar's point at depth 1000
+      const double x = ox + dx * I, y = oy + dy * J;  // the pillar's point at depth 1000
       return std::array<double, 4>{x - 100 * lx, y - 100 * ly, x + 300 * lx, y + 300 * ly};
     });
     o << "/\nZCORN\n";
     write_zcorn(o, nx, ny, nz, [&](int i, int I, int J, int k) { return depth(i, I, J, k); });
+    if (map_axes) {
+      const std::array<double, 2> y1 = to_map(0, 1), o0 = to_map(0, 0), x1 = to_map(1, 0);
+      o << "/\nMAPUNITS\n 'METRES' /\nMAPAXES\n " << grdecl_number(y1[0]) << " " << grdecl_number(y1[1]) << " "
+        << grdecl_number(o0[0]) << " " << grdecl_number(o0[1]) << " " << grdecl_number(x1[0]) << " "
+        << grdecl_number(x1[1]) << "\n";
+    }
     const int n = nx * ny * nz;
+    if (rock) {
+      std::vector<double> permx(n);
+      std::mt19937 rng(rock_seed);
+      std::uniform_real_distribution<double> layer_mean(-1, 3.5);
+      std::normal_distribution<double> noise(0, 0.3);
+      for (int k = 0; k < nz; ++k) {
+        const double m = layer_mean(rng);
+        for (int c = k * nx * ny; c < (k + 1) * nx * ny; ++c) permx[c] = std::pow(10.0, std::clamp(m + noise(rng), -2.0, 4.0));
+      }
+      auto write = [&](const char* key, auto value) {
+        o << "/\n" << key << "\n";
+        for (int c = 0; c < n; ++c) o << grdecl_number(value(c)) << "\n";
+      };
+      write("PERMX", [&](int c) { return permx[c]; });
+      write("PERMY", [&](int c) { return permx[c]; });
+      write("PERMZ", [&](int c) { return kv_kh * permx[c]; });
+      write("PORO", [&](int c) { return std::clamp(0.12 + 0.05 * std::log10(permx[c]), 0.03, 0.35); });
+      o << "/\n";
+      return o.str();
+    }
     o << "/\nPERMX\n";
     for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
     o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n" << n << "*0.2 /\n";
