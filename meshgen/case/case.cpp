@@ -296,7 +296,13 @@ ReservoirSpec read_grdecl_reservoir(const Fields& f, const std::string& base_dir
     if (f.get(k)) fail(f.path(k), "not with reservoir.grdecl (the model gives the grid and its rock)");
   std::string path = read_string(f.required("grdecl"), f.path("grdecl"));
   if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
-  auto shared = std::make_shared<const CornerPointModel>(read_corner_point_model(path, f.path("grdecl")));
+  CornerPointModel as_read = read_corner_point_model(path, f.path("grdecl"));
+  if (const int64_t merged = merge_rounded_depths(as_read); merged > 0)
+    notes.push_back(f.path("grdecl") + ": " + std::to_string(merged) +
+                    " corner depths within a rounding of another corner's on the same pillar made one (a fault whose "
+                    "throw is a whole number of layers, written with rounding): one node there, not a fault of "
+                    "1e-13 m (docs/corner-point.md, \"Depths equal up to a rounding\")");
+  auto shared = std::make_shared<const CornerPointModel>(std::move(as_read));
   const CornerPointModel& model = *shared;
   if (model.below_minpv > 0) {
     char pv[160];

@@ -151,54 +151,6 @@ std::vector<double> slice_bounds(const std::vector<SliceRequest>& asks) {
   return bounds;
 }
 
-// A new pillar on a model column edge gets its depths from the parents on either side, each
-// interpolating its own corners: where a fault's throw passes through zero between two model
-// pillars (a scissor fault) the two sides' depths are the same number mathematically and may
-// differ by a rounding. Depths on such a pillar within kSameDepthUlps units in the last place
-// are made one (the smallest), so that the mesh has one node there and not a fault of 1e-13 m.
-constexpr double kSameDepthUlps = 8;
-
-template <class Slot>
-void merge_rounded_depths(CornerPointModel& r, const std::vector<Slot>& si, const std::vector<Slot>& sj) {
-  auto on_model_line = [](const std::vector<Slot>& sl, int I) {
-    return I == 0 || I >= static_cast<int>(sl.size()) || sl[I].child == 0;
-  };
-  struct Corner {
-    double z;
-    size_t cell;
-    int q;
-    bool operator<(const Corner& o) const { return z < o.z || (z == o.z && (cell < o.cell || (cell == o.cell && q < o.q))); }
-  };
-  std::vector<Corner> at;  // the corners on one pillar
-  for (int J = 0; J <= r.ny; ++J)
-    for (int I = 0; I <= r.nx; ++I) {
-      const bool line_i = on_model_line(si, I), line_j = on_model_line(sj, J);
-      if (line_i == line_j) continue;  // a model pillar (bit for bit the parents') or inside one parent
-      at.clear();
-      for (int a = 0; a < 4; ++a) {
-        const int ci = I - 1 + (a & 1), cj = J - 1 + (a >> 1);
-        if (ci < 0 || cj < 0 || ci >= r.nx || cj >= r.ny) continue;
-        const int q = (a & 1 ? 0 : 1) | (a & 2 ? 0 : 2);
-        for (int k = 0; k < r.nz; ++k)
-          for (int side : {0, 4})
-            at.push_back({r.zcorn[zcorn_index(r, ci, cj, k, q | side)], ci + size_t(r.nx) * (cj + size_t(r.ny) * k), q | side});
-      }
-      std::sort(at.begin(), at.end());
-      for (size_t b = 0; b < at.size();) {
-        size_t e = b + 1;
-        const double limit = at[b].z + kSameDepthUlps * std::numeric_limits<double>::epsilon() * std::abs(at[b].z);
-        for (; e < at.size() && at[e].z <= limit; ++e) {
-          if (at[e].z == at[b].z) continue;
-          const Corner& c = at[e];
-          r.zcorn[zcorn_index(r, static_cast<int>(c.cell % r.nx), static_cast<int>(c.cell / r.nx % r.ny),
-                              static_cast<int>(c.cell / (size_t(r.nx) * r.ny)), c.q)] = at[b].z;
-          r.corners[c.cell][c.q] = pillar_point(r, I + (J * (r.nx + 1)), at[b].z);
-        }
-        b = e;
-      }
-    }
-}
-
 }  // namespace
 
 bool ColumnSplits::refines() const {
@@ -390,7 +342,10 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
         for (int d = 0; d < 6; ++d)
           if (!m.trans_mult[d].empty()) r.trans_mult[d][c] = at[d] ? m.trans_mult[d][pc] : 1.0;
       }
-  merge_rounded_depths(r, si, sj);
+  // A new pillar on a model column edge gets its depths from the parents on either side, each
+  // interpolating its own corners: where a fault's throw passes through zero between two model
+  // pillars (a scissor fault) the two sides' depths are the same number and may differ by a rounding.
+  merge_rounded_depths(r);
   return r;
 }
 

@@ -23,6 +23,7 @@
 #include <set>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "meshgen/case/case.hpp"
@@ -326,6 +327,44 @@ Vec3 pillar_point(const CornerPointModel& m, int p, double z) {
   if (dz == 0) return {a[0], a[1], z};
   const double t = (z - a[2]) / dz;
   return {a[0] + t * (a[3] - a[0]), a[1] + t * (a[4] - a[1]), z};
+}
+
+int64_t merge_rounded_depths(CornerPointModel& m) {
+  struct Corner {
+    double z;
+    size_t cell;
+    int q;
+    bool operator<(const Corner& o) const { return z < o.z || (z == o.z && (cell < o.cell || (cell == o.cell && q < o.q))); }
+  };
+  int64_t changed = 0;
+  std::vector<Corner> at;  // the corners on one pillar
+  for (int J = 0; J <= m.ny; ++J)
+    for (int I = 0; I <= m.nx; ++I) {
+      at.clear();
+      for (int a = 0; a < 4; ++a) {
+        const int ci = I - 1 + (a & 1), cj = J - 1 + (a >> 1);
+        if (ci < 0 || cj < 0 || ci >= m.nx || cj >= m.ny) continue;
+        const int q = (a & 1 ? 0 : 1) | (a & 2 ? 0 : 2);  // the corner of column (ci, cj) on this pillar
+        for (int k = 0; k < m.nz; ++k)
+          for (int side : {0, 4})
+            at.push_back({m.zcorn[zcorn_index(m, ci, cj, k, q | side)], ci + size_t(m.nx) * (cj + size_t(m.ny) * k), q | side});
+      }
+      std::sort(at.begin(), at.end());
+      for (size_t b = 0; b < at.size();) {
+        size_t e = b + 1;
+        const double limit = at[b].z + kSameDepthUlps * std::numeric_limits<double>::epsilon() * std::abs(at[b].z);
+        for (; e < at.size() && at[e].z <= limit; ++e) {
+          if (at[e].z == at[b].z) continue;
+          const Corner& c = at[e];
+          m.zcorn[zcorn_index(m, static_cast<int>(c.cell % m.nx), static_cast<int>(c.cell / m.nx % m.ny),
+                              static_cast<int>(c.cell / (size_t(m.nx) * m.ny)), c.q)] = at[b].z;
+          m.corners[c.cell][c.q] = pillar_point(m, I + J * (m.nx + 1), at[b].z);
+          ++changed;
+        }
+        b = e;
+      }
+    }
+  return changed;
 }
 
 double edit_nnc_multiplier(const CornerPointModel& m, int64_t a, int64_t b) {

@@ -157,6 +157,16 @@ double corner_depth(const CornerPointModel& m, int c, int q);
 /// COORD points have the same depth is vertical through its top point), as OPM places corners.
 Vec3 pillar_point(const CornerPointModel& m, int p, double z);
 
+/// Depths on one pillar within this many units in the last place of each other are one depth written
+/// with a rounding: a fault whose throw is a whole number of layers, or passes through zero.
+constexpr double kSameDepthUlps = 8;
+
+/// Makes the depths of the corners on each pillar that lie within kSameDepthUlps of the smallest of
+/// their run one depth (that smallest; the corners moved along the pillar with it), so that the mesh
+/// has one node there and not a fault of 1e-13 m whose faces overlap by slivers. Returns the number
+/// of corner depths changed.
+int64_t merge_rounded_depths(CornerPointModel& model);
+
 /// Geometry a model must have to be meshed as a corner-point reservoir: in every active cell the
 /// top corner is not below the bottom corner on any of its 4 pillars, and an active cell does not
 /// reach into the next active cell below it in its column (bottom depth <= that cell's top depth on

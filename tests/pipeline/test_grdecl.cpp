@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -494,6 +495,49 @@ TEST(CornerPoint, FaultFacesAreTheOverlapsOfTheTwoCellsFaces) {
   EXPECT_GT(pairs, 20);
   EXPECT_GT(crossing_pairs, 0);
   EXPECT_LT(worst, 1e-9);
+}
+
+// A fault whose throw is a whole layer: both sides' layer boundaries are one depth, written with a
+// rounding (1000 + dz k + throw against 1000 + dz (k + 1)). As read they are up to a few ulps apart and
+// the fault's faces overlapped by 1e-13 m slivers, with nodes the self-check finds hanging (the
+// horizontal sweep's seeds 9 and 15, session 28); made one, the two sides meet face to face.
+TEST(CornerPoint, DepthsEqualUpToARoundingAreOneNode) {
+  TempDir tmp;
+  hmtest::LayeredModel g;
+  g.nx = 6, g.ny = 4, g.nz = 10, g.dx = g.dy = 107.4, g.dz = 1.95, g.dip_deg = 6.5, g.fault_i = 3, g.throw_m = g.dz;
+  write(tmp.path / "CPG.GRDECL", g.text());
+  const CornerPointModel as_read = read_corner_point_model((tmp.path / "CPG.GRDECL").string(), "reservoir.grdecl");
+  // Depth pairs across the fault's pillars that are one number but for a rounding.
+  auto rounded_pairs = [&](const CornerPointModel& m) {
+    int n = 0;
+    for (int j = 0; j < m.ny; ++j)
+      for (int k = 0; k + 1 < m.nz; ++k)
+        for (int b : {0, 2}) {
+          const double left = m.zcorn[zcorn_index(m, g.fault_i - 1, j, k + 1, 1 | b)];
+          const double right = m.zcorn[zcorn_index(m, g.fault_i, j, k, b)];
+          n += left != right && std::abs(left - right) <= 8 * std::numeric_limits<double>::epsilon() * left;
+        }
+    return n;
+  };
+  ASSERT_GT(rounded_pairs(as_read), 0) << "the model no longer has rounded depths: the test tests nothing";
+  CornerPointModel merged = as_read;
+  EXPECT_GT(merge_rounded_depths(merged), 0);
+  EXPECT_EQ(rounded_pairs(merged), 0);
+  EXPECT_EQ(merge_rounded_depths(merged), 0);  // idempotent
+  // The model as read fails the conformity check; as load_case gives it (merged), the mesh is sound.
+  const CpgRun r = mesh_of(tmp, g.text());
+  EXPECT_TRUE(check_conformity(r.out.mesh, r.out.geometry).ok());
+  const auto [mesh_volume, opm_volume] = volumes(r);
+  EXPECT_NEAR(mesh_volume / opm_volume, 1.0, 1e-9);
+  CaseSpec raw = r.cs;
+  raw.reservoir.corner_point = std::make_shared<const CornerPointModel>(as_read);
+  try {
+    build_hybrid_mesh(raw);
+    ADD_FAILURE() << "the model as read meshed soundly: the test tests nothing";
+  } catch (const std::exception& e) {
+    std::printf("[ figures  ] %d rounded depth pairs across the fault; as read: %s\n", rounded_pairs(as_read), e.what());
+    EXPECT_NE(std::string(e.what()).find("conformity"), std::string::npos) << e.what();
+  }
 }
 
 // The mesh does not depend on where the model sits: moved by UTM-sized offsets, the same cells
