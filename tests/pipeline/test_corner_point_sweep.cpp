@@ -38,6 +38,26 @@ struct CornerPointSweepCase {
   std::vector<GeneratedSurvey> surveys;  ///< the survey wells, as in `wells`
 };
 
+// The layered model both generators draw, in this order (a seed keeps its model): square columns of
+// 25-150 m, about `across` m in all (min_columns to max_columns per side), layers of 0.5-5 m making
+// thick_lo + U(0, thick_span) m (6 to 60 layers), dip 0-8 degrees, half of them on pillars leaning 0-40
+// degrees along x or y.
+hmtest::LayeredModel draw_layered_model(std::mt19937& rng, double across, int min_columns, int max_columns,
+                                        double thick_lo, double thick_span) {
+  std::uniform_real_distribution<double> u(0, 1);
+  hmtest::LayeredModel g;
+  g.dx = g.dy = detail::log_uniform(rng, 25, 150);
+  g.nx = g.ny = std::clamp(static_cast<int>(std::lround(across / g.dx)), min_columns, max_columns);
+  g.dz = detail::log_uniform(rng, 0.5, 5);
+  g.nz = std::clamp(static_cast<int>(std::lround((thick_lo + thick_span * u(rng)) / g.dz)), 6, 60);
+  g.dip_deg = 8 * u(rng);
+  if (u(rng) < 0.5) {
+    g.pillar_deg = 40 * u(rng);
+    g.pillar_azimuth_deg = u(rng) < 0.5 ? 0 : 90;
+  }
+  return g;
+}
+
 // `wells` >= 2 adds an injector drawn after everything else (the model and the producer are those of
 // the one-well case of the same seed): vertical from 30 m above the top to 40-90 % of the thickness,
 // 2.5-7.5 of the larger drainage radius across the producer's path from its mid-point in plan (close
@@ -49,15 +69,7 @@ CornerPointSweepCase make_corner_point_case(uint32_t seed, int wells = 1) {
   std::uniform_real_distribution<double> u(0, 1);
   CornerPointSweepCase c;
   hmtest::LayeredModel& g = c.model;
-  g.dx = g.dy = detail::log_uniform(rng, 25, 150);
-  g.nx = g.ny = std::clamp(static_cast<int>(std::lround(500 / g.dx)), 4, 12);
-  g.dz = detail::log_uniform(rng, 0.5, 5);
-  g.nz = std::clamp(static_cast<int>(std::lround((20 + 30 * u(rng)) / g.dz)), 6, 60);
-  g.dip_deg = 8 * u(rng);
-  if (u(rng) < 0.5) {
-    g.pillar_deg = 40 * u(rng);
-    g.pillar_azimuth_deg = u(rng) < 0.5 ? 0 : 90;
-  }
+  g = draw_layered_model(rng, 500, 4, 12, 20, 30);
   if (u(rng) < 0.3) g.fault_i = g.nx / 2, g.throw_m = (0.2 + 0.6 * u(rng)) * g.dz;
   const double thickness = g.nz * g.dz;
   // R up to 0.3 of the thickness: the block's flat ends keep one R from the top and the bottom.
@@ -173,15 +185,7 @@ CornerPointSweepCase make_horizontal_case(uint32_t seed, int wells = 1, bool at_
   std::uniform_real_distribution<double> u(0, 1);
   CornerPointSweepCase c;
   hmtest::LayeredModel& g = c.model;
-  g.dx = g.dy = detail::log_uniform(rng, 25, 150);
-  g.nx = g.ny = std::clamp(static_cast<int>(std::lround(700 / g.dx)), 5, 20);
-  g.dz = detail::log_uniform(rng, 0.5, 5);
-  g.nz = std::clamp(static_cast<int>(std::lround((15 + 35 * u(rng)) / g.dz)), 6, 60);
-  g.dip_deg = 8 * u(rng);
-  if (u(rng) < 0.5) {
-    g.pillar_deg = 40 * u(rng);
-    g.pillar_azimuth_deg = u(rng) < 0.5 ? 0 : 90;
-  }
+  g = draw_layered_model(rng, 700, 5, 20, 15, 35);
   const double thickness = g.nz * g.dz, width = g.nx * g.dx;
   // A throw the horizontal section crosses without leaving the reservoir's middle: at most a tenth of it.
   if (u(rng) < 0.3) g.fault_i = g.nx / 2, g.throw_m = std::min(0.1 * thickness, (0.2 + 2.8 * u(rng)) * g.dz);
