@@ -58,6 +58,15 @@ hmtest::LayeredModel draw_layered_model(std::mt19937& rng, double across, int mi
   return g;
 }
 
+// "seed N: the model's cells, dip, pillars[, fault]" (the sweep tables' first column).
+std::string model_label(uint32_t seed, const hmtest::LayeredModel& g) {
+  char label[256];
+  std::snprintf(label, sizeof label, "seed %3u: %2d x %2d x %2d cells of %5.1f m x %4.2f m, dip %3.1f, pillars %4.1f deg along %s%s",
+                seed, g.nx, g.ny, g.nz, g.dx, g.dz, g.dip_deg, g.pillar_deg, g.pillar_azimuth_deg == 0 ? "x" : "y",
+                g.fault_i > 0 ? (", fault " + std::to_string(g.throw_m / g.dz).substr(0, 4) + " layer").c_str() : "");
+  return label;
+}
+
 // `wells` >= 2 adds an injector drawn after everything else (the model and the producer are those of
 // the one-well case of the same seed): vertical from 30 m above the top to 40-90 % of the thickness,
 // 2.5-7.5 of the larger drainage radius across the producer's path from its mid-point in plan (close
@@ -118,14 +127,10 @@ CornerPointSweepCase make_corner_point_case(uint32_t seed, int wells = 1) {
       second += text;
     }
   }
-  char label[384];
-  std::snprintf(label, sizeof label,
-                "seed %3u: %2d x %2d x %2d cells of %5.1f m x %4.2f m, dip %3.1f, pillars %4.1f deg along %s%s, R %4.1f m, "
-                "inclination %4.1f deg, %s",
-                seed, g.nx, g.ny, g.nz, g.dx, g.dz, g.dip_deg, g.pillar_deg, g.pillar_azimuth_deg == 0 ? "x" : "y",
-                g.fault_i > 0 ? (", fault " + std::to_string(g.throw_m / g.dz).substr(0, 4) + " layer").c_str() : "",
-                radius, inclination, bottom_depth > thickness ? "through the bottom" : "ends inside");
-  c.label = label + second;
+  char label[128];
+  std::snprintf(label, sizeof label, ", R %4.1f m, inclination %4.1f deg, %s", radius, inclination,
+                bottom_depth > thickness ? "through the bottom" : "ends inside");
+  c.label = model_label(seed, g) + label + second;
   return c;
 }
 
@@ -225,16 +230,12 @@ CornerPointSweepCase make_horizontal_case(uint32_t seed, int wells = 1, bool at_
     c.wells += survey_yaml(c.surveys.back(), "I1", "injector", 250);
     std::snprintf(second, sizeof second, "; injector R %4.1f m, %5.1f m to the side", q.radius, apart);
   }
-  char label[384];
-  std::snprintf(label, sizeof label,
-                "seed %3u: %2d x %2d x %2d cells of %5.1f m x %4.2f m, dip %3.1f, pillars %4.1f deg along %s%s, %s, "
-                "kv/kh %4.2f; R %4.1f m, %3.0f m at %5.1f deg, build %3.1f deg/30 m%s",
-                seed, g.nx, g.ny, g.nz, g.dx, g.dz, g.dip_deg, g.pillar_deg, g.pillar_azimuth_deg == 0 ? "x" : "y",
-                g.fault_i > 0 ? (", fault " + std::to_string(g.throw_m / g.dz).substr(0, 4) + " layer").c_str() : "",
+  char label[256];
+  std::snprintf(label, sizeof label, ", %s, kv/kh %4.2f; R %4.1f m, %3.0f m at %5.1f deg, build %3.1f deg/30 m%s",
                 g.map_axes ? ("MAPAXES " + std::to_string(static_cast<int>(std::lround(g.map_turn_deg))) + " deg").c_str()
                            : "UTM COORD",
                 g.kv_kh, p.radius, p.length, p.hold_deg, p.build_deg_per_30m, second);
-  c.label = label;
+  c.label = model_label(seed, g) + label;
   return c;
 }
 
