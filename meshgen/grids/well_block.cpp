@@ -228,6 +228,32 @@ double flat_end_min_segment(const std::vector<double>& radii, int sectors) {
   return 2.0 * offset * std::tan(kFlatEndAngle);
 }
 
+// The trajectory the block follows: meshed_well_spec's, less the trajectory point next to a flat
+// end (one facing the transition) whose leg is too short to hold the end's minimum segment
+// beside the bend there (leg - the bend's smallest tangent < flat_end_min_segment): that end
+// segment came out shorter, its ring cells' FV centres too close to the end face, and the end faces'
+// orthogonality fell below fvcheck's 45 degrees (a survey well clipped 1.3 m before a station:
+// 24 degrees, docs/corner-point.md, "Horizontal wells from surveys"). Without the point the leg
+// runs straight to the next one, off the trajectory by at most the short leg times the bend's
+// sine. The rule takes the requested sectors, so that the block and its exact volumes agree.
+WellSpec block_well_spec(const CaseSpec& cs, int w) {
+  WellSpec ws = meshed_well_spec(cs, w);
+  if (ws.end_caps != EndCaps::Flat) return ws;
+  const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, cs.wells[w], well_key(w), false);
+  const double end_min = flat_end_min_segment(ring_radii(ws), std::max(3, ws.sectors));
+  std::vector<Vec3>& p = ws.trajectory;
+  auto too_short = [&](Vec3 end, Vec3 at, Vec3 next) {
+    const Vec3 d1 = normalized(at - end), d2 = normalized(next - at);
+    const double angle = std::atan2(norm(cross(d1, d2)), dot(d1, d2));
+    return angle > 0 && norm(at - end) - kMinFilletFactor * ws.drainage_radius * std::tan(0.5 * angle) < end_min;
+  };
+  if (mt.ends[0] != WellEndKind::Boundary)
+    while (p.size() > 2 && too_short(p[0], p[1], p[2])) p.erase(p.begin() + 1);
+  if (mt.ends[1] != WellEndKind::Boundary)
+    while (p.size() > 2 && too_short(p[p.size() - 1], p[p.size() - 2], p[p.size() - 3])) p.erase(p.end() - 2);
+  return ws;
+}
+
 // Positions (distances from the start, increasing, the last = length) of the stations that
 // split a straight part of `length` into segments of about `seg`, the first at least
 // first_min long and the last at least last_min (0: no minimum). Where the minima leave less
@@ -513,7 +539,7 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   validate_well(cs.wells[w], w, sectors);
   // Only the part of the trajectory inside the reservoir is meshed (meshed_trajectory.hpp).
   const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, cs.wells[w], well_key(w), false);
-  const WellSpec ws = meshed_well_spec(cs, w);
+  const WellSpec ws = block_well_spec(cs, w);
 
   WellBlock block;
   block.well = w;
@@ -753,7 +779,7 @@ int count_gabriel_violations(const WellBlock& block) {
 WellBlock make_gabriel_well_block(const CaseSpec& cs, int w) {
   if (w < 0 || w >= static_cast<int>(cs.wells.size()))
     throw std::out_of_range("make_gabriel_well_block: no well " + std::to_string(w));
-  const WellSpec ws = meshed_well_spec(cs, w);
+  const WellSpec ws = block_well_spec(cs, w);
   const int requested = ws.sectors;
   int sectors = requested;
   WellBlock block;
@@ -842,7 +868,7 @@ std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder
 }
 
 double well_block_prism_length(const CaseSpec& cs, int w) {
-  const WellSpec ws = meshed_well_spec(cs, w);
+  const WellSpec ws = block_well_spec(cs, w);
   const std::vector<Leg> legs = make_legs(ws, w);
   double length = 0;
   for (const Leg& g : legs) length += g.length;
@@ -877,7 +903,7 @@ double hemisphere_cap_volume(double radius, int sectors) {
 }
 
 double exact_well_block_volume(const CaseSpec& cs, int w, int sectors) {
-  const WellSpec ws = meshed_well_spec(cs, w);
+  const WellSpec ws = block_well_spec(cs, w);
   const double annulus = regular_polygon_area(sectors, ws.drainage_radius) - regular_polygon_area(sectors, ws.radius);
   const double caps = ws.end_caps == EndCaps::Hemisphere
                           ? 2.0 * (hemisphere_cap_volume(ws.drainage_radius, sectors) -
@@ -887,7 +913,7 @@ double exact_well_block_volume(const CaseSpec& cs, int w, int sectors) {
 }
 
 double exact_wellbore_hole_volume(const CaseSpec& cs, int w, int sectors) {
-  const WellSpec ws = meshed_well_spec(cs, w);
+  const WellSpec ws = block_well_spec(cs, w);
   const double caps = ws.end_caps == EndCaps::Hemisphere ? 2.0 * hemisphere_cap_volume(ws.radius, sectors) : 0.0;
   return regular_polygon_area(sectors, ws.radius) * well_block_prism_length(cs, w) + caps;
 }

@@ -136,6 +136,36 @@ TEST(Bends, OptimisedFlatEndKeepsItsPolygonFacesOrthogonalEnough) {
   }
 }
 
+// A flat end 1.2 m before a gentle bend (a survey well clipped just before a station): the end
+// segment would be 1.2 m less the bend's tangent, and the end faces of its outer ring cells fell
+// below fvcheck's 45 degrees (24 degrees on the horizontal sweep's seed 20). The block drops the point:
+// it runs straight from the end to the next one, and the mesh is sound (volume: the box less the
+// exact hole of the block as built).
+TEST(Bends, FlatEndJustBeforeABendDropsThePoint) {
+  const double turn = 7.3 * M_PI / 180;
+  auto axis = [](double lo, double hi, double h) {
+    std::string a = "[";
+    for (double v = lo; v <= hi + 1e-9; v += h) a += (a.size() > 1 ? ", " : "") + std::to_string(static_cast<int>(v));
+    return a + "]";
+  };
+  char well[256];
+  std::snprintf(well, sizeof well,
+                "wells:\n  - {name: P1, trajectory: [[60, 100, 1030], [61.2, 100, 1030], [%.6f, %.6f, 1030]], radius: 0.1,"
+                " drainage_radius: 8.5, rings: 6, sectors: 12, end_caps: flat, bhp: 150}\n",
+                61.2 + 78.8 * std::cos(turn), 100 + 78.8 * std::sin(turn));
+  const std::string yaml = "name: short_end_leg\nreservoir:\n  x: " + axis(0, 200, 10) + "\n  y: " + axis(0, 200, 10) +
+                           "\n  z: " + axis(1000, 1060, 5) + "\n  permeability: [100, 100, 10]\n  porosity: 0.2\n" + well;
+  RealisticCase rc;
+  rc.spec = parse_case(yaml);
+  rc.spec.transition.optimize = false;
+  const CaseResult r = mesh_and_check(rc);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << r.reason;
+  const WellBlock block = make_well_block(rc.spec, 0, 12);
+  ASSERT_EQ(block.trajectory.size(), 2u);  // the point 1.2 m from the end is gone
+  EXPECT_EQ(block.trajectory.front(), rc.spec.wells[0].trajectory.front());
+  EXPECT_EQ(block.trajectory.back(), rc.spec.wells[0].trajectory.back());
+}
+
 // Free sites on a bend's focal line: a nominal position within some sphere's clearance moves
 // toward the line's middle to where the line leaves that sphere (transition_tips.cpp,
 // kBendAxisShifts). Three cases of the bend sweep whose raw diagram failed conformity (free sites
