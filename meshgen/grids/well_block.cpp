@@ -243,14 +243,18 @@ WellSpec block_well_spec(const CaseSpec& cs, int w) {
   const double end_min = flat_end_min_segment(ring_radii(ws), std::max(3, ws.sectors));
   std::vector<Vec3>& p = ws.trajectory;
   auto too_short = [&](Vec3 end, Vec3 at, Vec3 next) {
-    const Vec3 d1 = normalized(at - end), d2 = normalized(next - at);
-    const double angle = std::atan2(norm(cross(d1, d2)), dot(d1, d2));
+    const double angle = bend_degrees(at - end, next - at) * kPi / 180;
     return angle > 0 && norm(at - end) - kMinFilletFactor * ws.drainage_radius * std::tan(0.5 * angle) < end_min;
   };
+  const bool with_md = ws.trajectory_md.size() == p.size();
+  auto drop = [&](size_t i) {
+    p.erase(p.begin() + static_cast<std::ptrdiff_t>(i));
+    if (with_md) ws.trajectory_md.erase(ws.trajectory_md.begin() + static_cast<std::ptrdiff_t>(i));
+  };
   if (mt.ends[0] != WellEndKind::Boundary)
-    while (p.size() > 2 && too_short(p[0], p[1], p[2])) p.erase(p.begin() + 1);
+    while (p.size() > 2 && too_short(p[0], p[1], p[2])) drop(1);
   if (mt.ends[1] != WellEndKind::Boundary)
-    while (p.size() > 2 && too_short(p[p.size() - 1], p[p.size() - 2], p[p.size() - 3])) p.erase(p.end() - 2);
+    while (p.size() > 2 && too_short(p[p.size() - 1], p[p.size() - 2], p[p.size() - 3])) drop(p.size() - 2);
   return ws;
 }
 
