@@ -15,6 +15,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -490,6 +491,11 @@ void refine_near_wells(CaseSpec& cs) {
   auto refine_and_turn = [&] {
     refined_m.reset();
     const ColumnSplits splits = near_well_splits(*r.corner_point, requests);
+    // Refused before the model is built: a refinement past the limit would not fit in memory.
+    const double cells = splits.cells(r.corner_point->nz);
+    if (cells > kMaxCells)
+      fail("reservoir.near_well_cell_size", "refining the model near the wells gives " + fmt_count(cells) +
+                                                " cells > " + fmt_count(kMaxCells) + ": give a larger size, or off");
     if (splits.refines()) refined_m = refined_model(*r.corner_point, splits);
     outcomes.clear();
     if (r.upright_pillars == ReservoirSpec::Upright::Off) return;
@@ -524,12 +530,7 @@ void refine_near_wells(CaseSpec& cs) {
                          "pillars near wells\")");
   }
   if (!refined_m) return;
-  auto refined = std::make_shared<const CornerPointModel>(std::move(*refined_m));
-  const double cells = double(refined->nx) * refined->ny * refined->nz;
-  if (cells > kMaxCells)
-    fail("reservoir.near_well_cell_size", "refining the model near the wells gives " + fmt_count(cells) + " cells > " +
-                                              fmt_count(kMaxCells) + ": give a larger size, or off");
-  use_model(r, refined);
+  use_model(r, std::make_shared<const CornerPointModel>(std::move(*refined_m)));
 }
 
 // A corner-point model whose faults step by a fraction of a layer near a well: its layers split there
@@ -542,6 +543,11 @@ void split_fault_steps_near_wells(CaseSpec& cs) {
     requests.push_back({w.trajectory, kFaultStepReach * (cs.transition.dilation + 2) * w.drainage_radius});
   const FaultStepSplit split = fault_step_children(*r.corner_point, requests);
   if (!split.splits()) return;
+  const double cells = double(r.corner_point->nx) * r.corner_point->ny *
+                       std::accumulate(split.children.begin(), split.children.end(), 0.0);
+  if (cells > kMaxCells)
+    fail("reservoir.grdecl", "splitting the layers at the fault steps near the wells gives " + fmt_count(cells) +
+                                 " cells > " + fmt_count(kMaxCells));
   auto model = std::make_shared<const CornerPointModel>(layers_split_at_fault_steps(*r.corner_point, split));
   int split_layers = 0;
   for (int n : split.children) split_layers += n > 1;
@@ -549,10 +555,6 @@ void split_fault_steps_near_wells(CaseSpec& cs) {
                      "fraction of a layer: " + std::to_string(split_layers) + " layers split there, " +
                      std::to_string(r.corner_point->nz) + " -> " + std::to_string(model->nz) +
                      " layers, so that the faults' two sides meet face to face (docs/corner-point.md, \"Fault steps\")");
-  const double cells = double(model->nx) * model->ny * model->nz;
-  if (cells > kMaxCells)
-    fail("reservoir.grdecl", "splitting the layers at the fault steps near the wells gives " + fmt_count(cells) +
-                                 " cells > " + fmt_count(kMaxCells));
   use_model(r, model);
 }
 

@@ -1,6 +1,7 @@
 #include "corner_point_refine.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -156,6 +157,11 @@ std::vector<double> slice_bounds(const std::vector<SliceRequest>& asks) {
 bool ColumnSplits::refines() const {
   return std::any_of(i.begin(), i.end(), [](int n) { return n > 1; }) ||
          std::any_of(j.begin(), j.end(), [](int n) { return n > 1; });
+}
+
+double ColumnSplits::cells(int nz) const {
+  const double ni = std::accumulate(i.begin(), i.end(), 0.0), nj = std::accumulate(j.begin(), j.end(), 0.0);
+  return ni * nj * nz;
 }
 
 namespace {

@@ -22,6 +22,8 @@ struct ColumnSplits {
   /// exactly 1.
   std::vector<std::vector<double>> i_bounds, j_bounds;
   bool refines() const;
+  /// The refined model's cells (nz layers), known before it is built.
+  double cells(int nz) const;
 };
 
 /// What a well asks of the columns around it: its path in the grid frame, the size its nearby

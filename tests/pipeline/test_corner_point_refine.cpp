@@ -77,6 +77,7 @@ TEST(NearWellRefinement, ChildrenTileTheirParents) {
   ASSERT_EQ(r.ny, 8);
   ASSERT_EQ(r.nz, m.nz);
   ASSERT_EQ(r.parent_cell.size(), r.corners.size());
+  EXPECT_EQ(splits.cells(m.nz), double(r.corners.size()));  // what the case checks before building
 
   const std::vector<double> parent_volume = cell_volumes(m), child_volume = cell_volumes(r);
   std::vector<double> sum(parent_volume.size(), 0.0);
@@ -488,6 +489,11 @@ TEST(NearWellRefinement, CaseKeyIsChecked) {
                 .find("reservoir.near_well_cell_size: only with reservoir.grdecl"),
             std::string::npos);
   EXPECT_EQ(error_of(well_case("M.GRDECL", ", near_well_cell_size: 5", 10)), "");
+  // A refinement too large for memory is refused before the refined model is built (built, it would
+  // not fit: a bad_alloc, not this refusal; the two-well horizontal sweep's seed 4 was killed so).
+  const std::string huge = error_of(well_case("M.GRDECL", ", near_well_cell_size: 0.001, near_well_grading: off", 10));
+  EXPECT_EQ(huge.rfind("reservoir.near_well_cell_size: refining the model near the wells gives ", 0), 0u) << huge;
+  EXPECT_NE(huge.find("give a larger size, or off"), std::string::npos) << huge;
 }
 
 // The table of docs/corner-point.md, "Near-well refinement": the thin-layer model of
