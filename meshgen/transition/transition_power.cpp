@@ -201,6 +201,38 @@ void triangulate(const SiteSet& set, Regular& rt) {
   rt.insert(points.begin(), points.end());
 }
 
+// An RT edge as one cell holding it and the edge's two vertex indices in that cell.
+struct FiniteEdge {
+  Regular::Cell_handle cell;
+  int i, j;
+};
+
+// Every finite RT edge with an internal endpoint, once: from the star of each internal site (an edge
+// between two internal sites from the smaller id's). Cheaper than the triangulation's edge iterator,
+// which circulates around every edge of the whole triangulation to find its representative cell.
+template <class IsInternal>
+std::vector<FiniteEdge> edges_of_internal_sites(const Regular& rt, const std::vector<Regular::Vertex_handle>& vertex_of,
+                                                const IsInternal& is_internal) {
+  std::vector<FiniteEdge> edges;
+  std::vector<Regular::Cell_handle> star;
+  std::vector<Regular::Vertex_handle> seen;
+  for (size_t s = 0; s < vertex_of.size(); ++s) {
+    const Regular::Vertex_handle v = vertex_of[s];
+    if (v == Regular::Vertex_handle() || !is_internal(static_cast<int>(s))) continue;
+    star.clear(), seen.clear();
+    rt.incident_cells(v, std::back_inserter(star));
+    for (const Regular::Cell_handle& c : star)
+      for (int k = 0; k < 4; ++k) {
+        const Regular::Vertex_handle w = c->vertex(k);
+        if (w == v || rt.is_infinite(w) || std::find(seen.begin(), seen.end(), w) != seen.end()) continue;
+        seen.push_back(w);
+        if (is_internal(w->info()) && w->info() < static_cast<int>(s)) continue;  // listed from w's star
+        edges.push_back({c, c->index(v), k});
+      }
+  }
+  return edges;
+}
+
 // Power cells of the internal sites of `set` (the real sites first, n_real of them, then
 // their images) from its regular triangulation `rt`: what build_power_cells returns.
 std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real, const Cavity& cavity,
@@ -316,13 +348,12 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
 
   // ---- faces: one per RT edge with an internal endpoint, from the cells around it
   std::vector<RawFace> faces;
-  for (auto e : rt.finite_edges()) {
-    const Regular::Cell_handle c = e.first;
-    int s = c->vertex(e.second)->info(), t = c->vertex(e.third)->info();
+  for (const FiniteEdge& e : edges_of_internal_sites(rt, vertex_of, is_internal)) {
+    const Regular::Cell_handle c = e.cell;
+    int s = c->vertex(e.i)->info(), t = c->vertex(e.j)->info();
     const bool si = is_internal(s), ti = is_internal(t);
-    if (!si && !ti) continue;
     RawFace f;
-    auto circ = rt.incident_cells(e), done = circ;
+    auto circ = rt.incident_cells(c, e.i, e.j), done = circ;
     bool unbounded = false;
     do {
       if (rt.is_infinite(circ)) { unbounded = true; break; }
@@ -369,10 +400,14 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
   // kCoincidence x (cavity size) are one vertex (the same point is the same vertex of a
   // power diagram).
   constexpr double kCoincidence = 1e-9;
-  std::vector<int> used;
-  for (const RawFace& f : faces) used.insert(used.end(), f.classes.begin(), f.classes.end());
-  std::sort(used.begin(), used.end());
-  used.erase(std::unique(used.begin(), used.end()), used.end());
+  std::vector<int> used;  // ascending
+  {
+    std::vector<char> is_used(nc, 0);
+    for (const RawFace& f : faces)
+      for (int cls : f.classes) is_used[cls] = 1;
+    for (int cls = 0; cls < nc; ++cls)
+      if (is_used[cls]) used.push_back(cls);
+  }
   double scale = 0;
   {
     Vec3 clo = coords[cavity.vertices.front()], chi = clo;
@@ -675,13 +710,17 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
       if (rep.notes.size() < 50) rep.notes.push_back(os.str());
     }
   }
-  // Distinct power vertices used by the cells.
+  // Distinct power vertices used by the cells: every free vertex (numbered only if used) and the
+  // constrained nodes the cells reach.
   {
-    std::vector<int32_t> used;
+    std::vector<int32_t> constrained;
     for (const auto& cell : out.cells)
-      for (const CellFace& cf : cell) used.insert(used.end(), cf.nodes.begin(), cf.nodes.end());
-    std::sort(used.begin(), used.end());
-    rep.power_vertices = static_cast<int>(std::unique(used.begin(), used.end()) - used.begin());
+      for (const CellFace& cf : cell)
+        for (int32_t v : cf.nodes)
+          if (v < out.base_node_id) constrained.push_back(v);
+    std::sort(constrained.begin(), constrained.end());
+    rep.power_vertices = static_cast<int>(out.new_nodes.size()) +
+                         static_cast<int>(std::unique(constrained.begin(), constrained.end()) - constrained.begin());
   }
   (void)frames;
   return {};
