@@ -675,7 +675,8 @@ int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Ve
   SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, true);
   while (rep.rounds < kSliverRounds) {
     ++rep.rounds;
-    if (!optimizer.round(out, rep, false)) break;
+    // A round whose removals were all refused has tagged them: the next tries each sliver's next site.
+    if (!optimizer.round(out, rep, false) && optimizer.proposed_last() == 0) break;
   }
   out.h_ref = h_ref;
   return rep.kept;
