@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "scaling_case.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 
@@ -26,34 +27,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-std::vector<double> lattice(double lo, double hi, int n) {
-  std::vector<double> v(n + 1);
-  for (int i = 0; i <= n; ++i) v[i] = lo + (hi - lo) * i / n;
-  return v;
-}
-
-hm::CaseSpec scaling_case(int lateral) {
-  hm::CaseSpec cs;
-  cs.name = "scaling_" + std::to_string(lateral);
-  cs.reservoir.x = lattice(0, 2240, lateral);
-  cs.reservoir.y = lattice(0, 2240, lateral);
-  cs.reservoir.z = lattice(2000, 2100, 20);
-  for (int k = 0; k < 10; ++k) {
-    hm::WellSpec w;
-    w.name = "W" + std::to_string(k + 1);
-    const double x = 320 + 400 * (k % 5), y = 620 + 1000 * (k / 5);
-    // Deviated: 60 m of horizontal offset over 60 m of depth, alternating directions.
-    const double dx = k % 2 ? 40 : -40, dy = k % 3 ? 45 : -45;
-    w.trajectory = {{x, y, 2020}, {x + dx, y + dy, 2080}};
-    w.radius = 0.1;
-    w.drainage_radius = 6;
-    w.rings = 6;
-    w.sectors = 12;
-    cs.wells.push_back(w);
-  }
-  return cs;
-}
 
 // Raw CGAL on the same sites: the regular triangulation of the internal sites of all
 // cavities (weights as built) plus every power vertex (weighted circumcentre of each finite
@@ -149,7 +122,7 @@ StageUse run_fvcheck_binary(const std::string& vtu, bool* ok) {
 }
 
 void run_case(int lateral) {
-  const hm::CaseSpec cs = scaling_case(lateral);
+  const hm::CaseSpec cs = hm::bench::scaling_case(lateral);
   StageMeter meter;
   hm::PipelineOptions opts;
   opts.on_stage = [&](const std::string& stage) { meter.mark(stage); };

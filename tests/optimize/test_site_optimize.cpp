@@ -11,6 +11,7 @@
 #include "meshgen/core/fv_quality.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/local_frame.hpp"
+#include "scaling_case.hpp"
 #include "uniform_nodes.hpp"
 
 using namespace hm;
@@ -135,30 +136,14 @@ TEST(SiteOptimizer, IsDeterministic) {
   }
 }
 
-// The 1M benchmark's well W9 (bench/bench_scaling.cpp) in its 165 x 165 x 20 grid of 13.6 m cells (545k
+// The 1M benchmark's well W9 (bench/scaling_case.hpp) in its 165 x 165 x 20 grid of 13.6 m cells (545k
 // cells), meshed as meshgen does (local frame). There the sliver pass's first removal was refused (a cell
 // would newly fail a shape check) and the pass stopped, leaving an edge of 1.6e-7 m between two free
 // vertices, at 2 degrees to a neighbouring face: fvcheck's conformity read its end as a hanging node
 // (5e-9 m from that face) and the self-check refused the mesh. The pass now tries the sliver's next site.
 TEST(SiteOptimizer, SliverPassTriesTheNextSiteWhenARemovalIsRefused) {
-  auto lattice = [](double lo, double hi, int n) {
-    std::vector<double> v(n + 1);
-    for (int i = 0; i <= n; ++i) v[i] = lo + (hi - lo) * i / n;
-    return v;
-  };
-  CaseSpec cs;
-  cs.name = "bench_w9";
-  cs.reservoir.x = lattice(0, 2240, 165);
-  cs.reservoir.y = lattice(0, 2240, 165);
-  cs.reservoir.z = lattice(2000, 2100, 20);
-  WellSpec w;
-  w.name = "W9";
-  w.trajectory = {{1520, 1620, 2020}, {1480, 1665, 2080}};
-  w.radius = 0.1;
-  w.drainage_radius = 6;
-  w.rings = 6;
-  w.sectors = 12;
-  cs.wells.push_back(w);
+  CaseSpec cs = bench::scaling_case(165);
+  cs.wells = {cs.wells[8]};
   HybridMesh h;
   ASSERT_NO_THROW(h = build_hybrid_mesh(translated_case(cs, -case_origin(cs)))) << "the self-check refused the mesh";
   int slivers_removed = 0;
