@@ -303,14 +303,24 @@ TransitionCells build_transition(const Cavity& cavity, const std::vector<Vec3>& 
 
 PolyMesh transition_submesh(const TransitionCells& t, const std::vector<Vec3>& node_coords,
                             std::vector<int32_t>* global_node) {
-  std::vector<int32_t> used;
+  // The nodes used, ascending: the constrained ones (below base_node_id), then the new ones used.
+  std::vector<int32_t> used, new_local(t.new_nodes.size(), -1);
   for (const auto& cell : t.cells)
-    for (const CellFace& f : cell) used.insert(used.end(), f.nodes.begin(), f.nodes.end());
+    for (const CellFace& f : cell)
+      for (int32_t v : f.nodes)
+        if (v >= t.base_node_id) new_local[v - t.base_node_id] = 0;
+        else used.push_back(v);
   std::sort(used.begin(), used.end());
   used.erase(std::unique(used.begin(), used.end()), used.end());
+  const size_t n_constrained = used.size();
+  for (size_t k = 0; k < new_local.size(); ++k)
+    if (new_local[k] == 0) new_local[k] = static_cast<int32_t>(used.size()), used.push_back(t.base_node_id + static_cast<int32_t>(k));
   MeshBuilder builder;
   for (int32_t v : used) builder.add_node(v >= t.base_node_id ? t.new_nodes[v - t.base_node_id] : node_coords[v]);
-  auto local = [&](int32_t v) { return static_cast<int32_t>(std::lower_bound(used.begin(), used.end(), v) - used.begin()); };
+  auto local = [&](int32_t v) {
+    if (v >= t.base_node_id) return new_local[v - t.base_node_id];
+    return static_cast<int32_t>(std::lower_bound(used.begin(), used.begin() + static_cast<long>(n_constrained), v) - used.begin());
+  };
   for (size_t c = 0; c < t.cells.size(); ++c) {
     std::vector<CellFace> faces = t.cells[c];
     for (CellFace& f : faces) {

@@ -203,6 +203,48 @@ ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& gl
   return out;
 }
 
+// Node -> cells (CSR, cells ascending) and edge -> cells ((a, b, cell) with a < b, sorted) over a
+// submesh's node ids: built per node in cell order, so only each node's short list is sorted.
+struct Incidence {
+  std::vector<int> node_ptr, node_cells;
+  std::vector<std::array<int32_t, 3>> edge_cell;
+};
+Incidence incidence_of(const PolyMesh& sub) {
+  const int nc = sub.n_cells(), nn = sub.n_nodes();
+  Incidence inc;
+  std::vector<int> count(nn + 1, 0), last_cell(nn, -1), edge_count(nn + 1, 0);
+  auto for_each_corner = [&](auto&& visit) {  // (cell, node, next node of the face)
+    for (int c = 0; c < nc; ++c)
+      for (const int32_t* f = sub.cell_begin(c); f != sub.cell_end(c); ++f) {
+        const int k = sub.face_size(*f);
+        const int32_t* v = sub.face_begin(*f);
+        for (int i = 0; i < k; ++i) visit(c, v[i], v[(i + 1) % k]);
+      }
+  };
+  for_each_corner([&](int c, int32_t a, int32_t b) {
+    if (last_cell[a] != c) last_cell[a] = c, ++count[a + 1];
+    ++edge_count[std::min(a, b) + 1];
+  });
+  for (int v = 0; v < nn; ++v) count[v + 1] += count[v], edge_count[v + 1] += edge_count[v];
+  inc.node_ptr = count;
+  inc.node_cells.resize(count[nn]);
+  std::vector<std::pair<int32_t, int32_t>> edges(edge_count[nn]);  // per smaller node: (larger node, cell)
+  std::fill(last_cell.begin(), last_cell.end(), -1);
+  for_each_corner([&](int c, int32_t a, int32_t b) {
+    if (last_cell[a] != c) last_cell[a] = c, inc.node_cells[count[a]++] = c;
+    edges[edge_count[std::min(a, b)]++] = {std::max(a, b), c};
+  });
+  inc.edge_cell.reserve(edges.size());
+  for (int a = 0, first = 0; a < nn; ++a) {
+    const int last = edge_count[a];  // filled: now the end of node a's range
+    std::sort(edges.begin() + first, edges.begin() + last);
+    for (int i = first; i < last; ++i)
+      if (i == first || edges[i] != edges[i - 1]) inc.edge_cell.push_back({a, edges[i].first, edges[i].second});
+    first = last;
+  }
+  return inc;
+}
+
 // Appends cell c and its face neighbours to the sorted set `cells`.
 void add_cell_and_neighbours(const PolyMesh& sub, int c, std::vector<int>& cells) {
   cells.push_back(c);
@@ -404,30 +446,10 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   };
   skewed_left_ = static_cast<int>(skewed_faces.size());
   const int nc = sub.n_cells();
-  // node -> cells and edge -> cells over local node ids (sorted incidence lists)
-  std::vector<std::pair<int32_t, int32_t>> node_cell;
-  std::vector<std::array<int32_t, 3>> edge_cell;
-  for (int c = 0; c < nc; ++c)
-    for (const int32_t* f = sub.cell_begin(c); f != sub.cell_end(c); ++f) {
-      const int k = sub.face_size(*f);
-      const int32_t* v = sub.face_begin(*f);
-      for (int i = 0; i < k; ++i) {
-        node_cell.push_back({v[i], c});
-        const int32_t a = std::min(v[i], v[(i + 1) % k]), b = std::max(v[i], v[(i + 1) % k]);
-        edge_cell.push_back({a, b, c});
-      }
-    }
-  std::sort(node_cell.begin(), node_cell.end());
-  node_cell.erase(std::unique(node_cell.begin(), node_cell.end()), node_cell.end());
-  std::sort(edge_cell.begin(), edge_cell.end());
-  edge_cell.erase(std::unique(edge_cell.begin(), edge_cell.end()), edge_cell.end());
-  std::vector<int> node_ptr(sub.n_nodes() + 1, 0);
-  for (const auto& [v, c] : node_cell) ++node_ptr[v + 1];
-  for (int v = 0; v < sub.n_nodes(); ++v) node_ptr[v + 1] += node_ptr[v];
+  const Incidence inc = incidence_of(sub);
+  const std::vector<std::array<int32_t, 3>>& edge_cell = inc.edge_cell;
   auto cells_of_node = [&](int32_t v) {
-    std::vector<int> cs;
-    for (int i = node_ptr[v]; i < node_ptr[v + 1]; ++i) cs.push_back(node_cell[i].second);
-    return cs;
+    return std::vector<int>(inc.node_cells.begin() + inc.node_ptr[v], inc.node_cells.begin() + inc.node_ptr[v + 1]);
   };
   const int ns = static_cast<int>(set_.sites.size());
   std::vector<int> cell_of_site(ns, -1);

@@ -12,7 +12,9 @@
 // at their own position, |P - F|^2 >= 0 for F).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
+#include <numeric>
 
 #include "transition_internal.hpp"
 
@@ -411,46 +413,82 @@ int drop_blocked_tip_sites(SiteSet& set, const std::vector<MirrorPlane>& planes)
   return dropped;
 }
 
-std::vector<int> tip_sites_in_bad_cells(const SiteSet& set, const TransitionCells& out) {
+namespace {
+// The internal sites in cell order (the cells of a diagram are those of its live internal sites).
+std::vector<int> sites_of_cells(const SiteSet& set) {
   std::vector<int> site_of_cell;
   for (size_t s = 0; s < set.sites.size(); ++s)
     if (set.sites[s].alive && set.sites[s].internal()) site_of_cell.push_back(static_cast<int>(s));
-  std::map<std::vector<int32_t>, std::vector<int>> cells_of_face;
-  std::vector<int> bad;
-  for (size_t c = 0; c < out.cells.size() && c < site_of_cell.size(); ++c) {
-    if (out.cells[c].size() < 4 && set.sites[site_of_cell[c]].kind == SiteKind::Free) bad.push_back(site_of_cell[c]);
+  return site_of_cell;
+}
+
+// Calls visit(cells) once per distinct face of the first n_cells cells (a face: its set of nodes),
+// in no particular order, `cells` holding each cell once per face it has with that node set, ascending.
+template <class Visit>
+void for_each_face_group(const TransitionCells& out, size_t n_cells, const Visit& visit) {
+  std::vector<int32_t> nodes;  // each face's nodes, sorted, one after the other
+  std::vector<size_t> begin;
+  std::vector<int> cell;
+  for (size_t c = 0; c < n_cells; ++c)
     for (const CellFace& f : out.cells[c]) {
-      std::vector<int32_t> key = f.nodes;
-      std::sort(key.begin(), key.end());
-      cells_of_face[key].push_back(static_cast<int>(c));
+      begin.push_back(nodes.size());
+      nodes.insert(nodes.end(), f.nodes.begin(), f.nodes.end());
+      std::sort(nodes.begin() + static_cast<long>(begin.back()), nodes.end());
+      cell.push_back(static_cast<int>(c));
     }
+  begin.push_back(nodes.size());
+  auto first = [&](int k) { return nodes.begin() + static_cast<long>(begin[k]); };
+  auto last = [&](int k) { return nodes.begin() + static_cast<long>(begin[k + 1]); };
+  auto same = [&](int a, int b) { return std::equal(first(a), last(a), first(b), last(b)); };
+  // By a hash of the node set first (equal sets are then adjacent), the sets themselves on ties.
+  std::vector<uint64_t> hash(cell.size());
+  for (size_t k = 0; k < cell.size(); ++k) {
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (auto it = first(static_cast<int>(k)); it != last(static_cast<int>(k)); ++it)
+      h = (h ^ static_cast<uint32_t>(*it)) * 0x100000001b3ULL;
+    hash[k] = h;
   }
-  for (const auto& [key, cells] : cells_of_face) {
-    if (cells.size() <= 2) continue;
+  std::vector<int> order(cell.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    if (hash[a] != hash[b]) return hash[a] < hash[b];
+    if (std::lexicographical_compare(first(a), last(a), first(b), last(b))) return true;
+    return !std::lexicographical_compare(first(b), last(b), first(a), last(a)) && a < b;
+  });
+  std::vector<int> cells;
+  for (size_t i = 0; i < order.size();) {
+    size_t j = i;
+    cells.clear();
+    while (j < order.size() && same(order[i], order[j])) cells.push_back(cell[order[j++]]);
+    visit(cells);
+    i = j;
+  }
+}
+}  // namespace
+
+std::vector<int> tip_sites_in_bad_cells(const SiteSet& set, const TransitionCells& out) {
+  const std::vector<int> site_of_cell = sites_of_cells(set);
+  const size_t n_cells = std::min(out.cells.size(), site_of_cell.size());
+  std::vector<int> bad;
+  for (size_t c = 0; c < n_cells; ++c)
+    if (out.cells[c].size() < 4 && set.sites[site_of_cell[c]].kind == SiteKind::Free) bad.push_back(site_of_cell[c]);
+  for_each_face_group(out, n_cells, [&](const std::vector<int>& cells) {
+    if (cells.size() <= 2) return;
     for (int c : cells)
       if (set.sites[site_of_cell[c]].kind == SiteKind::Free) bad.push_back(site_of_cell[c]);
-  }
+  });
   std::sort(bad.begin(), bad.end());
   bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
   return bad;
 }
 
 std::vector<int> sites_in_duplicate_faces(const SiteSet& set, const TransitionCells& out) {
-  std::vector<int> site_of_cell;
-  for (size_t s = 0; s < set.sites.size(); ++s)
-    if (set.sites[s].alive && set.sites[s].internal()) site_of_cell.push_back(static_cast<int>(s));
-  std::map<std::vector<int32_t>, std::vector<int>> cells_of_face;
-  for (size_t c = 0; c < out.cells.size() && c < site_of_cell.size(); ++c)
-    for (const CellFace& f : out.cells[c]) {
-      std::vector<int32_t> key = f.nodes;
-      std::sort(key.begin(), key.end());
-      cells_of_face[key].push_back(static_cast<int>(c));
-    }
+  const std::vector<int> site_of_cell = sites_of_cells(set);
   std::vector<int> bad;
-  for (const auto& [key, cells] : cells_of_face) {
-    if (cells.size() <= 2 && (cells.size() < 2 || cells[0] != cells[1])) continue;
+  for_each_face_group(out, std::min(out.cells.size(), site_of_cell.size()), [&](const std::vector<int>& cells) {
+    if (cells.size() <= 2 && (cells.size() < 2 || cells[0] != cells[1])) return;
     for (int c : cells) bad.push_back(site_of_cell[c]);
-  }
+  });
   std::sort(bad.begin(), bad.end());
   bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
   return bad;
