@@ -202,13 +202,19 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
                                    const std::vector<PolygonFrame>& frames, TransitionCells& out,
                                    const BoundaryImages& images = {});
 
+/// The pairs (i, j), i < j, of `points` at most eps apart, each once, ascending: the power
+/// vertices that rounding split (extraction). Near-linear: buckets, not all pairs.
+std::vector<std::pair<int, int>> coincident_pairs(const std::vector<Vec3>& points, double eps);
+
 /// A cavity's regular triangulation kept across the optimiser's rounds (CGAL inside the
 /// .cpp): each call brings it to the sites of `set` by removing and inserting again only the
 /// sites whose point or weight changed since the last call (from scratch the first time, when
 /// the live sites changed, or after a site was hidden), then extracts the cells as
 /// build_power_cells does (no boundary images). RT cells that no move touched keep their power
-/// centres. Same result as build_power_cells on the same sites, up to the choice among equal
-/// triangulations of co-spherical sites.
+/// centres and their comparisons with their neighbours. The same result as build_power_cells on
+/// the same sites, bit for bit: the regular triangulation does not depend on the order of
+/// insertions and removals (CGAL's symbolic perturbation), and a power vertex is computed from
+/// its cell's points taken in the order of their site ids.
 class PowerDiagram {
  public:
   PowerDiagram();
@@ -218,10 +224,13 @@ class PowerDiagram {
   std::vector<int> cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                          const std::vector<PolygonFrame>& frames, TransitionCells& out);
   int moved_last() const { return moved_; }  ///< sites moved incrementally by the last call
+  /// Keeps a copy of the triangulation as it is: a later call starts from the copy when it is
+  /// nearer the sites (fewer sites to move), as when a round's refused moves are undone.
+  void save();
 
  private:
   struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<Impl> impl_, saved_;
   int moved_ = 0;
 };
 

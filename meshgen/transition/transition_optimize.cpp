@@ -589,6 +589,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   // Rebuild with the moves; an invalid diagram keeps the first half of them, down to none.
   TransitionCells fresh;
   size_t keep = moves.size();
+  diagram_.save();  // the diagram of `out`: the rebuild with the kept moves alone starts from it
   while (!rebuild(fresh, out.base_node_id)) {
     const size_t half = keep / 2;
     for (size_t i = half; i < keep; ++i) restore(moves[i].site, moves[i].before);

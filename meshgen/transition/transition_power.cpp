@@ -5,10 +5,9 @@
 // spheres coincide (exact predicate across a facet) are one vertex (union-find), and a
 // vertex whose four sites share exactly one constrained node IS that node. Only what is
 // left on the external faces is snapped to the nearest constrained vertex (5.7).
-#include <CGAL/Cartesian_converter.h>
-#include <CGAL/Exact_rational.h>
-#include <CGAL/Simple_cartesian.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Mpzf.h>
+#include <CGAL/mpq_class.h>
 #include <CGAL/Regular_triangulation_3.h>
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
@@ -16,6 +15,8 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <atomic>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <memory>
@@ -45,36 +46,68 @@ struct CellInfo {
   std::array<int, 4> key{};
   int n_common = 0;          // 0, 1 or 2 (two or more: recomputed when used, rare)
   int32_t common_node = -1;  // the shared node when n_common == 1
+  // A number no other cell of any triangulation has had (0: none yet), and per facet the number of
+  // the neighbour whose power sphere was compared with this one's, and whether they coincide.
+  uint64_t serial = 0;
+  std::array<uint64_t, 4> compared_with{};
+  std::array<bool, 4> same_sphere{};
 };
+std::atomic<uint64_t> next_cell_serial{1};
+uint64_t serial_of(CellInfo& ci) {
+  if (ci.serial == 0) ci.serial = next_cell_serial.fetch_add(1, std::memory_order_relaxed);
+  return ci.serial;
+}
 using Cb = CGAL::Triangulation_cell_base_with_info_3<CellInfo, K, Cbb>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb, Cb>;
 using Regular = CGAL::Regular_triangulation_3<K, Tds>;
 using WPoint = K::Weighted_point_3;
 using BPoint = K::Point_3;
-// Exact rational arithmetic, without the lazy kernel's bookkeeping (the point is rounded at once).
-using QK = CGAL::Simple_cartesian<CGAL::Exact_rational>;
 
 // The power vertex of a cell. Co-spherical sites make many nearly flat cells, on which the
 // double formula loses up to 1e-8 relative; those (|det| of the edge vectors below 1e-4 of
 // the product of their lengths) are computed exactly and rounded once. Well-shaped cells
 // keep the fast double formula (error about cond x 1e-16).
+//
+// Exactly: the determinants of the weighted circumcentre (CGAL's weighted_circumcenterC3, the
+// origin at the first point) in Mpzf, exact for + - x and much cheaper than rationals, then one
+// rational division per coordinate. The exact centre is unique: this is the double that CGAL's
+// rational kernel (Exact_rational = mpq_class here) gives, to_double truncating as mpq_get_d does.
 Vec3 exact_power_center(const Regular::Cell_handle& c) {
-  const CGAL::Cartesian_converter<K, QK> to_exact;
-  const QK::Point_3 p = QK().construct_weighted_circumcenter_3_object()(
-      to_exact(c->vertex(0)->point()), to_exact(c->vertex(1)->point()), to_exact(c->vertex(2)->point()),
-      to_exact(c->vertex(3)->point()));
-  return Vec3{CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
+  using Z = CGAL::Mpzf;
+  const WPoint& w0 = c->vertex(0)->point();
+  const Z px(w0.x()), py(w0.y()), pz(w0.z()), pw(w0.weight());
+  std::array<std::array<Z, 4>, 3> d;  // per other point: x, y, z and squared norm minus weight, from point 0
+  for (int i = 0; i < 3; ++i) {
+    const WPoint& w = c->vertex(i + 1)->point();
+    d[i][0] = Z(w.x()) - px, d[i][1] = Z(w.y()) - py, d[i][2] = Z(w.z()) - pz;
+    d[i][3] = d[i][0] * d[i][0] + d[i][1] * d[i][1] + d[i][2] * d[i][2] - (Z(w.weight()) - pw);
+  }
+  auto det = [&](int a, int b, int e) {  // columns a, b, e of the three rows
+    return d[0][a] * (d[1][b] * d[2][e] - d[2][b] * d[1][e]) - d[1][a] * (d[0][b] * d[2][e] - d[2][b] * d[0][e]) +
+           d[2][a] * (d[0][b] * d[1][e] - d[1][b] * d[0][e]);
+  };
+  const mpq_class two_den = 2 * static_cast<mpq_class>(det(0, 1, 2));
+  const mpq_class x = static_cast<mpq_class>(px) + static_cast<mpq_class>(det(1, 2, 3)) / two_den;
+  const mpq_class y = static_cast<mpq_class>(py) - static_cast<mpq_class>(det(0, 2, 3)) / two_den;
+  const mpq_class z = static_cast<mpq_class>(pz) + static_cast<mpq_class>(det(0, 1, 3)) / two_den;
+  return Vec3{CGAL::to_double(x), CGAL::to_double(y), CGAL::to_double(z)};
 }
 
+// The four points in the order of their site ids: the rounded centre then depends on the cell
+// alone, not on the order a triangulation's history gave its vertices.
 Vec3 computed_power_center(const Regular& rt, const Regular::Cell_handle& c, bool* exact) {
-  auto at = [&](int i) {
-    const auto& p = c->vertex(i)->point().point();
-    return Vec3{p.x(), p.y(), p.z()};
-  };
+  std::array<const WPoint*, 4> w;
+  {
+    std::array<std::pair<int, int>, 4> order;
+    for (int i = 0; i < 4; ++i) order[i] = {c->vertex(i)->info(), i};
+    std::sort(order.begin(), order.end());
+    for (int i = 0; i < 4; ++i) w[i] = &c->vertex(order[i].second)->point();
+  }
+  auto at = [&](int i) { return Vec3{w[i]->x(), w[i]->y(), w[i]->z()}; };
   const Vec3 p0 = at(0), r1 = at(1) - p0, r2 = at(2) - p0, r3 = at(3) - p0;
   const double det = dot(r1, cross(r2, r3));
   if (std::abs(det) > 1e-4 * norm(r1) * norm(r2) * norm(r3)) {
-    const BPoint p = rt.dual(c);
+    const BPoint p = rt.geom_traits().construct_weighted_circumcenter_3_object()(*w[0], *w[1], *w[2], *w[3]);
     return Vec3{p.x(), p.y(), p.z()};
   }
   *exact = true;
@@ -215,17 +248,17 @@ std::vector<FiniteEdge> edges_of_internal_sites(const Regular& rt, const std::ve
                                                 const IsInternal& is_internal) {
   std::vector<FiniteEdge> edges;
   std::vector<Regular::Cell_handle> star;
-  std::vector<Regular::Vertex_handle> seen;
+  std::vector<int> seen_from(vertex_of.size(), -1);  // per vertex id: the last star it was met in
   for (size_t s = 0; s < vertex_of.size(); ++s) {
     const Regular::Vertex_handle v = vertex_of[s];
     if (v == Regular::Vertex_handle() || !is_internal(static_cast<int>(s))) continue;
-    star.clear(), seen.clear();
+    star.clear();
     rt.incident_cells(v, std::back_inserter(star));
     for (const Regular::Cell_handle& c : star)
       for (int k = 0; k < 4; ++k) {
         const Regular::Vertex_handle w = c->vertex(k);
-        if (w == v || rt.is_infinite(w) || std::find(seen.begin(), seen.end(), w) != seen.end()) continue;
-        seen.push_back(w);
+        if (w == v || rt.is_infinite(w) || seen_from[w->info()] == static_cast<int>(s)) continue;
+        seen_from[w->info()] = static_cast<int>(s);
         if (is_internal(w->info()) && w->info() < static_cast<int>(s)) continue;  // listed from w's star
         edges.push_back({c, c->index(v), k});
       }
@@ -262,15 +295,24 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
   UnionFind uf(nc);
   const auto power_side = rt.geom_traits().power_side_of_oriented_power_sphere_3_object();
   int merged_count = 0;
+  // A pair of cells that a rebuild left in place keeps its answer (the optimiser's rounds).
+  auto same_sphere = [&](const Regular::Cell_handle& c, int i, const Regular::Cell_handle& n) {
+    CellInfo& ci = c->info();
+    const uint64_t other = serial_of(n->info());
+    if (ci.compared_with[i] != other) {
+      const Regular::Vertex_handle opp = n->vertex(n->index(c));
+      ci.same_sphere[i] = power_side(c->vertex(0)->point(), c->vertex(1)->point(), c->vertex(2)->point(),
+                                     c->vertex(3)->point(), opp->point()) == CGAL::ON_ORIENTED_BOUNDARY;
+      ci.compared_with[i] = other;
+    }
+    return ci.same_sphere[i];
+  };
   for (int a = 0; a < nc; ++a) {
     const Regular::Cell_handle c = cells[a];
     for (int i = 0; i < 4; ++i) {
       const Regular::Cell_handle n = c->neighbor(i);
-      if (rt.is_infinite(n) || n->info().index < a) continue;
-      const Regular::Vertex_handle opp = n->vertex(n->index(c));
-      if (power_side(c->vertex(0)->point(), c->vertex(1)->point(), c->vertex(2)->point(), c->vertex(3)->point(),
-                        opp->point()) == CGAL::ON_ORIENTED_BOUNDARY)
-        merged_count += uf.unite(a, n->info().index) ? 1 : 0;
+      if (n->info().index < a || rt.is_infinite(n)) continue;  // an infinite cell has no index (-1)
+      if (same_sphere(c, i, n)) merged_count += uf.unite(a, n->info().index) ? 1 : 0;
     }
   }
   rep.merged_cells = merged_count;
@@ -284,7 +326,10 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
     int32_t node = -1;     // identified constrained node, -1 if free
     int ambiguous = 0;
   };
-  std::vector<ClassInfo> info(nc);
+  // Only the classes in use get one (lazily): an index per class, not a record.
+  std::vector<int> info_index(nc, -1);
+  std::vector<ClassInfo> infos;
+  infos.reserve(nc);  // references into it stay valid
   int exact_centers = 0;
   // The cells of each class (CSR over class roots, cells ascending).
   std::vector<int> class_begin(nc + 1, 0), class_members(nc), root_of(nc);
@@ -295,7 +340,8 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
     for (int a = 0; a < nc; ++a) class_members[fill[root_of[a]]++] = a;
   }
   auto cell_class_info = [&](int cls) -> ClassInfo& {
-    ClassInfo& ci = info[cls];
+    if (info_index[cls] < 0) info_index[cls] = static_cast<int>(infos.size()), infos.emplace_back();
+    ClassInfo& ci = infos[info_index[cls]];
     if (ci.done) return ci;
     ci.done = true;
     bool first = true;
@@ -416,48 +462,25 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
     scale = norm(chi - clo);
   }
   const double eps = kCoincidence * scale;
-  // Buckets of side eps (a lattice puts many vertices on one coordinate plane, so a sweep
-  // along one axis would compare them all): each vertex meets those of the 27 buckets around.
-  struct Bucketed {
-    std::array<int64_t, 3> cell;
-    int cls;
-    bool operator<(const Bucketed& o) const { return cell != o.cell ? cell < o.cell : cls < o.cls; }
-  };
-  std::vector<Bucketed> grid;
-  grid.reserve(used.size());
-  for (int cls : used) {
-    const Vec3 p = cell_class_info(cls).point;
-    grid.push_back({{static_cast<int64_t>(std::floor(p.x / eps)), static_cast<int64_t>(std::floor(p.y / eps)),
-                     static_cast<int64_t>(std::floor(p.z / eps))},
-                    cls});
-  }
-  std::sort(grid.begin(), grid.end());
+  std::vector<Vec3> used_points;
+  used_points.reserve(used.size());
+  for (int cls : used) used_points.push_back(cell_class_info(cls).point);
   int coincident = 0;
-  for (const Bucketed& b : grid) {
-    const Vec3 pi = cell_class_info(b.cls).point;
-    for (int64_t dx = -1; dx <= 1; ++dx)
-      for (int64_t dy = -1; dy <= 1; ++dy) {
-        const Bucketed lo{{b.cell[0] + dx, b.cell[1] + dy, b.cell[2] - 1}, std::numeric_limits<int>::min()};
-        for (auto it = std::lower_bound(grid.begin(), grid.end(), lo);
-             it != grid.end() && it->cell[0] == lo.cell[0] && it->cell[1] == lo.cell[1] && it->cell[2] <= b.cell[2] + 1; ++it)
-          if (it->cls > b.cls && norm(cell_class_info(it->cls).point - pi) <= eps)
-            coincident += uf.unite(b.cls, it->cls) ? 1 : 0;
-      }
-  }
+  for (const auto& [a, b] : coincident_pairs(used_points, eps)) coincident += uf.unite(used[a], used[b]) ? 1 : 0;
   rep.coincident_vertices = coincident;
   // Merged classes: smallest key, its point; identified node if any member has one.
-  // (indexed by class root; has_merged tells which roots have one)
-  std::vector<ClassInfo> merged(nc);
-  std::vector<char> has_merged(nc, 0);
+  // (per class root: its index in `merged`, -1 for roots of no class in use)
+  std::vector<ClassInfo> merged;
+  std::vector<int> merged_index(nc, -1);
   for (int cls : used) {
     const ClassInfo& ci = cell_class_info(cls);
     const int root = uf.find(cls);
-    if (!has_merged[root]) {
-      merged[root] = ci;
-      has_merged[root] = 1;
+    if (merged_index[root] < 0) {
+      merged_index[root] = static_cast<int>(merged.size());
+      merged.push_back(ci);
       continue;
     }
-    ClassInfo& m = merged[root];
+    ClassInfo& m = merged[merged_index[root]];
     if (ci.node >= 0 && m.node >= 0 && ci.node != m.node) ++m.ambiguous;
     if (ci.key < m.key) {
       const int32_t node = m.node >= 0 ? m.node : ci.node;
@@ -469,8 +492,8 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
     }
   }
   auto class_info = [&](int cls) -> ClassInfo& {
-    if (cls < 0 || cls >= nc || !has_merged[cls]) throw std::out_of_range("transition: power vertex class without info");
-    return merged[cls];
+    if (cls < 0 || cls >= nc || merged_index[cls] < 0) throw std::out_of_range("transition: power vertex class without info");
+    return merged[merged_index[cls]];
   };
   {
     std::vector<RawFace> kept;
@@ -749,11 +772,34 @@ struct PowerDiagram::Impl {
 PowerDiagram::PowerDiagram() : impl_(std::make_unique<Impl>()) {}
 PowerDiagram::~PowerDiagram() = default;
 
+void PowerDiagram::save() {
+  const Impl& d = *impl_;
+  if (!d.ready) return saved_.reset();
+  if (!saved_) saved_ = std::make_unique<Impl>();
+  Impl& c = *saved_;
+  c.rt = d.rt;  // the cells' cached centres and comparisons come along
+  c.vertex.assign(d.vertex.size(), Regular::Vertex_handle());
+  for (auto v : c.rt.finite_vertex_handles())
+    if (v->info() < static_cast<int>(c.vertex.size())) c.vertex[v->info()] = v;
+  c.p = d.p, c.w2 = d.w2, c.alive = d.alive, c.ready = true;
+}
+
 std::vector<int> PowerDiagram::cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                      const std::vector<PolygonFrame>& frames, TransitionCells& out) {
-  Impl& d = *impl_;
   const int ns = static_cast<int>(set.sites.size());
   auto live = [&](int s) { return set.sites[s].alive && set.sites[s].kind != SiteKind::Guard; };
+  // The sites to move in a triangulation (ns + 1 where it must start from scratch).
+  auto updates = [&](const Impl& t) {
+    if (!t.ready || static_cast<int>(t.p.size()) != ns) return ns + 1;
+    int n = 0;
+    for (int s = 0; s < ns; ++s) {
+      if ((live(s) ? 1 : 0) != t.alive[s]) return ns + 1;
+      n += t.alive[s] && !(set.sites[s].p == t.p[s] && set.sites[s].w2 == t.w2[s]);
+    }
+    return n;
+  };
+  if (saved_ && updates(*saved_) < updates(*impl_)) std::swap(impl_, saved_);
+  Impl& d = *impl_;
   bool fresh = !d.ready || static_cast<int>(d.p.size()) != ns;
   for (int s = 0; s < ns && !fresh; ++s) fresh = (live(s) ? 1 : 0) != d.alive[s];
   moved_ = 0;
@@ -787,6 +833,54 @@ std::vector<int> PowerDiagram::cells(const SiteSet& set, const Cavity& cavity, c
   // Hidden sites after a fresh triangulation: the next call starts from scratch again.
   d.ready = static_cast<int>(d.rt.number_of_vertices()) == expected;
   return extract_power_cells(d.rt, set, ns, cavity, coords, frames, out, {});
+}
+
+// Buckets of side kBucket x eps: two points within eps share a bucket, or each lies within eps of
+// the bucket face between them, so a point meets the points of its own bucket and, only where it
+// lies that near a face, those of the buckets beyond it.
+std::vector<std::pair<int, int>> coincident_pairs(const std::vector<Vec3>& points, double eps) {
+  constexpr double kBucket = 1024;
+  const double side = kBucket * eps;
+  struct Bucketed {
+    std::array<int64_t, 3> cell;
+    int index;
+    bool operator<(const Bucketed& o) const { return cell != o.cell ? cell < o.cell : index < o.index; }
+  };
+  std::vector<Bucketed> grid(points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+    grid[i] = {{static_cast<int64_t>(std::floor(points[i].x / side)), static_cast<int64_t>(std::floor(points[i].y / side)),
+                static_cast<int64_t>(std::floor(points[i].z / side))},
+               static_cast<int>(i)};
+  std::sort(grid.begin(), grid.end());
+  std::vector<std::pair<int, int>> pairs;
+  auto meet = [&](int a, int b) {
+    if (norm(points[a] - points[b]) <= eps) pairs.emplace_back(std::min(a, b), std::max(a, b));
+  };
+  const double near = 2 * eps / side;  // twice eps: a bucket comes from a rounded quotient
+  for (size_t i = 0; i < grid.size(); ++i) {
+    const Bucketed& b = grid[i];
+    for (size_t k = i + 1; k < grid.size() && grid[k].cell == b.cell; ++k) meet(b.index, grid[k].index);
+    // Per axis: the neighbouring buckets whose face lies within eps.
+    std::array<std::array<int, 3>, 3> steps;
+    std::array<int, 3> n_steps;
+    for (int a = 0; a < 3; ++a) {
+      const double f = points[b.index][a] / side - static_cast<double>(b.cell[a]);
+      steps[a][0] = 0, n_steps[a] = 1;
+      if (f < near) steps[a][n_steps[a]++] = -1;
+      if (f > 1 - near) steps[a][n_steps[a]++] = 1;
+    }
+    for (int x = 0; x < n_steps[0]; ++x)
+      for (int y = 0; y < n_steps[1]; ++y)
+        for (int z = 0; z < n_steps[2]; ++z) {
+          if (x == 0 && y == 0 && z == 0) continue;
+          const Bucketed lo{{b.cell[0] + steps[0][x], b.cell[1] + steps[1][y], b.cell[2] + steps[2][z]}, -1};
+          for (auto it = std::lower_bound(grid.begin(), grid.end(), lo); it != grid.end() && it->cell == lo.cell; ++it)
+            meet(b.index, it->index);
+        }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
 }
 
 }  // namespace hm::transition_detail
