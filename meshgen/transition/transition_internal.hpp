@@ -202,8 +202,8 @@ std::vector<int> build_power_cells(const SiteSet& set, const Cavity& cavity, con
                                    const std::vector<PolygonFrame>& frames, TransitionCells& out,
                                    const BoundaryImages& images = {});
 
-/// The pairs (i, j), i < j, of `points` at most eps apart, each once, ascending: the power
-/// vertices that rounding split (extraction). Near-linear: buckets, not all pairs.
+/// The pairs (i, j), i < j, of `points` at most eps apart, each once, in no particular order: the
+/// power vertices that rounding split (extraction). Near-linear: buckets, not all pairs.
 std::vector<std::pair<int, int>> coincident_pairs(const std::vector<Vec3>& points, double eps);
 
 /// A cavity's regular triangulation kept across the optimiser's rounds (CGAL inside the

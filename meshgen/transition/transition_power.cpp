@@ -854,11 +854,12 @@ std::vector<std::pair<int, int>> coincident_pairs(const std::vector<Vec3>& point
   std::sort(grid.begin(), grid.end());
   std::vector<std::pair<int, int>> pairs;
   auto meet = [&](int a, int b) {
-    if (norm(points[a] - points[b]) <= eps) pairs.emplace_back(std::min(a, b), std::max(a, b));
+    if (norm(points[a] - points[b]) <= eps) pairs.emplace_back(a, b);
   };
   const double near = 2 * eps / side;  // twice eps: a bucket comes from a rounded quotient
   for (size_t i = 0; i < grid.size(); ++i) {
     const Bucketed& b = grid[i];
+    // In one bucket: from the pair's first point in bucket order (ascending index).
     for (size_t k = i + 1; k < grid.size() && grid[k].cell == b.cell; ++k) meet(b.index, grid[k].index);
     // Per axis: the neighbouring buckets whose face lies within eps.
     std::array<std::array<int, 3>, 3> steps;
@@ -874,12 +875,11 @@ std::vector<std::pair<int, int>> coincident_pairs(const std::vector<Vec3>& point
         for (int z = 0; z < n_steps[2]; ++z) {
           if (x == 0 && y == 0 && z == 0) continue;
           const Bucketed lo{{b.cell[0] + steps[0][x], b.cell[1] + steps[1][y], b.cell[2] + steps[2][z]}, -1};
+          // Across a face: both points lie near it and each sees the other; the smaller index keeps it.
           for (auto it = std::lower_bound(grid.begin(), grid.end(), lo); it != grid.end() && it->cell == lo.cell; ++it)
-            meet(b.index, it->index);
+            if (b.index < it->index) meet(b.index, it->index);
         }
   }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   return pairs;
 }
 
