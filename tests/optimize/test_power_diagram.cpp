@@ -59,6 +59,21 @@ void expect_same(const TransitionCells& a, const TransitionCells& b, double tol)
   EXPECT_LE(worst, tol);
 }
 
+// Moves `count` polygon sites (every `stride`-th polygon with a mirror) to `factor` x their
+// distance along their dual lines, each with its reflection; returns the polygons moved.
+std::vector<int> move_polygon_sites(Sites& s, int count, size_t stride, double factor) {
+  std::vector<int> moved;
+  for (size_t q = 0; q < s.set.internal_of.size() && static_cast<int>(moved.size()) < count; q += stride) {
+    const int i = s.set.internal_of[q];
+    if (i < 0 || s.set.sites[i].kind != SiteKind::InternalPolygon || s.set.external_of[q] < 0 ||
+        s.set.sites[s.set.external_of[q]].kind != SiteKind::ExternalMirror)
+      continue;
+    place_polygon_site(s.set, i, factor * s.set.sites[i].t, s.cavity, s.coords, s.frames);
+    moved.push_back(static_cast<int>(q));
+  }
+  return moved;
+}
+
 TransitionCells from_scratch(const Sites& s) {
   TransitionCells out;
   out.base_node_id = 100;
@@ -82,16 +97,7 @@ TEST(PowerDiagram, MovedSitesGiveTheDiagramBuiltFromScratch) {
   // Move three polygon sites along their dual lines (each moves its reflection too: six
   // sites), incrementally, then back.
   const std::vector<Site> before = s.set.sites;
-  int moved = 0;
-  for (size_t q = 0; q < s.set.internal_of.size() && moved < 3; q += 7) {
-    const int i = s.set.internal_of[q];
-    if (i < 0 || s.set.sites[i].kind != SiteKind::InternalPolygon || s.set.external_of[q] < 0 ||
-        s.set.sites[s.set.external_of[q]].kind != SiteKind::ExternalMirror)
-      continue;
-    place_polygon_site(s.set, i, 0.9 * s.set.sites[i].t, s.cavity, s.coords, s.frames);
-    ++moved;
-  }
-  ASSERT_EQ(moved, 3);
+  ASSERT_EQ(move_polygon_sites(s, 3, 7, 0.9).size(), 3u);
   TransitionCells after;
   after.base_node_id = 100;
   ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, after).empty());
@@ -123,15 +129,7 @@ TEST(PowerDiagram, SavedCopyServesTheCallItIsNearerTo) {
   ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, out).empty());
   d.save();
   const std::vector<Site> before = s.set.sites;
-  std::vector<int> moved;
-  for (size_t q = 0; q < s.set.internal_of.size() && moved.size() < 3; q += 5) {
-    const int i = s.set.internal_of[q];
-    if (i < 0 || s.set.sites[i].kind != SiteKind::InternalPolygon || s.set.external_of[q] < 0 ||
-        s.set.sites[s.set.external_of[q]].kind != SiteKind::ExternalMirror)
-      continue;
-    place_polygon_site(s.set, i, 0.85 * s.set.sites[i].t, s.cavity, s.coords, s.frames);
-    moved.push_back(static_cast<int>(q));
-  }
+  const std::vector<int> moved = move_polygon_sites(s, 3, 5, 0.85);
   ASSERT_EQ(moved.size(), 3u);
   ASSERT_TRUE(d.cells(s.set, s.cavity, s.coords, s.frames, out).empty());
   EXPECT_EQ(d.moved_last(), 6);
