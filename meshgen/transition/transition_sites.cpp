@@ -21,6 +21,9 @@ constexpr double kShrink = 0.7;  // alpha of 5.5.3 (paper: 0.7 <= alpha < 1)
 // A polygon site never comes closer to its polygon than this fraction of the circumradius:
 // at t = 0 it would coincide with its reflection (same weighted point, one of them hidden).
 constexpr double kMinT = 1e-3;
+// Below kMinT rho a site moves only to the distance one violating pair asks for
+// (deep_t_satisfying), never closer than this fraction of the circumradius.
+constexpr double kMinDeepT = 1e-8;
 // Height of an end-face polygon's site above its polygon, in lengths of the block's end
 // segment: the mirror image of the ring cell's FV centre, which lies half a segment behind the
 // face (docs/transition.md "Tip sites").
@@ -178,6 +181,27 @@ bool grow_satisfies(const SiteSet& set, int small, int large, const std::vector<
   const double disc = h * h - 2 * c;
   if (disc < 0) return true;
   return 0.5 * (h + std::sqrt(disc)) <= max_t(set, s.polygon, frames);
+}
+
+// Where moving the smaller site `small` of a violating pair toward its polygon satisfies (6) when
+// its minimal distance kMinT rho is not close enough: f(t) = 2 t^2 - 2 h t + c (grow_satisfies) holds
+// for t up to its lower root c / (h + sqrt(h^2 - 2 c)), which lies below kMinT rho when c, f at the
+// polygon, is tiny: c is an affine mean of the larger site's powers at the smaller polygon's vertices,
+// and a sliver triangle (the wall of a thin split layer, 0.08 x 1.2 m, horizontal sweep seed 6) has
+// its circumcentre almost on its long edge, which lies on the sphere of the ceiling or floor triangle
+// of the same cell, its third vertex just outside that sphere. Returns half that root (a margin for
+// the other pairs), or NaN when there is none (c <= 0, the pair fails at the polygon itself) or it
+// would be closer than kMinDeepT rho (the site would all but coincide with its reflection).
+double deep_t_satisfying(const SiteSet& set, int small, int large, const std::vector<PolygonFrame>& frames) {
+  const Site& s = set.sites[small];
+  const Site& l = set.sites[large];
+  const PolygonFrame& f = frames[s.polygon];
+  const double h = dot(l.p - f.center, f.normal);
+  const double c = norm2(l.p - f.center) - l.w2 + (s.w2 - s.t * s.t);
+  const double disc = h * h - 2 * c;
+  if (!(h > 0) || !(c > 0) || disc < 0) return std::nan("");
+  const double t = 0.5 * c / (h + std::sqrt(disc));
+  return t >= kMinDeepT * f.radius ? t : std::nan("");
 }
 
 bool can_grow(const SiteSet& set, int s, const std::vector<PolygonFrame>& frames) {
@@ -568,6 +592,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
     std::vector<double> xs(order.size());
     for (size_t k = 0; k < order.size(); ++k) xs[k] = set.sites[order[k]].p.x;
     std::vector<char> fix(set.sites.size(), 0), grow(set.sites.size(), 0), involved(set.sites.size(), 0);
+    std::vector<double> deep(set.sites.size(), kInf);  // below the minimal distance (deep_t_satisfying)
     int n = 0;
     for (size_t a = 0; a < order.size(); ++a) {
       const int i = order[a];
@@ -602,6 +627,8 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
           if (set.sites[small].kind != SiteKind::InternalPolygon) fix[small] = 1;  // a box: split
           else if (small_may_grow && grow_satisfies(set, small, large, frames)) grow[small] = 1;
           else if (can_shrink(set, small, frames)) fix[small] = 1;
+          else if (const double t = deep_t_satisfying(set, small, large, frames); !std::isnan(t))
+            deep[small] = std::min(deep[small], t);
           else if (small_may_grow) grow[small] = 1;
           else fix[large] = 1;
         }
@@ -619,7 +646,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
     }
     if (it == max_iterations) {
       stuck.assign(fix.size(), 0);
-      for (size_t s = 0; s < fix.size(); ++s) stuck[s] = fix[s] || grow[s] || involved[s];
+      for (size_t s = 0; s < fix.size(); ++s) stuck[s] = fix[s] || grow[s] || involved[s] || deep[s] < kInf;
       break;
     }
     for (size_t s = 0; s < fix.size(); ++s)
@@ -633,8 +660,13 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
         if (site.kind == SiteKind::ExternalMirror && site.polygon >= 0 && set.internal_of[site.polygon] >= 0)
           shrunk_at[set.internal_of[site.polygon]] = it;
       }
+    for (size_t s = 0; s < deep.size(); ++s)
+      if (deep[s] < set.sites[s].t && !fix[s] && set.sites[s].alive && set.sites[s].kind == SiteKind::InternalPolygon) {
+        place_polygon_site(set, static_cast<int>(s), deep[s], cavity, coords, frames);
+        shrunk_at[s] = it;
+      }
     for (size_t s = 0; s < grow.size(); ++s)
-      if (grow[s] && !fix[s] && set.sites[s].alive && set.sites[s].kind == SiteKind::InternalPolygon) {
+      if (grow[s] && !fix[s] && !(deep[s] < kInf) && set.sites[s].alive && set.sites[s].kind == SiteKind::InternalPolygon) {
         const Site& site = set.sites[s];
         place_polygon_site(set, static_cast<int>(s), std::min(site.t / kShrink, max_t(set, site.polygon, frames)),
                            cavity, coords, frames);
