@@ -185,13 +185,12 @@ bool grow_satisfies(const SiteSet& set, int small, int large, const std::vector<
 
 // Where moving the smaller site `small` of a violating pair toward its polygon satisfies (6) when
 // its minimal distance kMinT rho is not close enough: f(t) = 2 t^2 - 2 h t + c (grow_satisfies) holds
-// for t up to its lower root c / (h + sqrt(h^2 - 2 c)), which lies below kMinT rho when c, f at the
-// polygon, is tiny: c is an affine mean of the larger site's powers at the smaller polygon's vertices,
-// and a sliver triangle (the wall of a thin split layer, 0.08 x 1.2 m, horizontal sweep seed 6) has
-// its circumcentre almost on its long edge, which lies on the sphere of the ceiling or floor triangle
-// of the same cell, its third vertex just outside that sphere. Returns half that root (a margin for
-// the other pairs), or NaN when there is none (c <= 0, the pair fails at the polygon itself) or it
-// would be closer than kMinDeepT rho (the site would all but coincide with its reflection).
+// for t up to its lower root c / (h + sqrt(h^2 - 2 c)), below kMinT rho when c, f at the polygon, is
+// tiny (c is an affine mean of the larger site's powers at the smaller polygon's vertices: a sliver
+// triangle whose long edge lies on the larger site's sphere; docs/transition.md, "Below the minimal
+// distance"). Returns half that root (a margin for the other pairs), or NaN when there is none
+// (c <= 0: the pair fails at the polygon itself) or it would be closer than kMinDeepT rho (the site
+// would all but coincide with its reflection).
 double deep_t_satisfying(const SiteSet& set, int small, int large, const std::vector<PolygonFrame>& frames) {
   const Site& s = set.sites[small];
   const Site& l = set.sites[large];
