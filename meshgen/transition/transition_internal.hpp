@@ -237,7 +237,7 @@ class PowerDiagram {
 /// What one site move did to the cells of its region (its cell and their face neighbours), measured on
 /// the diagram before and after the round's rebuild.
 struct MoveEffect {
-  bool newly_failing = false;  ///< a cell of the region (or of no move's region) fails a shape check it passed
+  bool newly_failing = false;  ///< a cell of the region, or one sharing a node with the moved site's cell, fails a shape check it passed
   double q_s_before = 0, q_s_after = 0;          ///< sum of Q_S over the region
   int skewed_before = 0, skewed_after = 0;       ///< faces above checkMesh's skewness limit
   double worst_skew_before = 0, worst_skew_after = 0;
@@ -247,7 +247,8 @@ struct MoveEffect {
 /// failing cell's site or of a neighbour's (repair), the removal of a sliver edge (remove_sliver_edges).
 enum class MoveKind { ShortEdge, SkewStep, Repair, SliverRemoval };
 /// Whether a move is kept: never when it makes a cell fail a shape check; a sliver removal whenever
-/// nothing fails; else when it leaves fewer cells around it failing one (mending the raw diagram's
+/// nothing fails and no face around it newly exceeds checkMesh's skewness limit (which fails the mesh
+/// there); else when it leaves fewer cells around it failing one (mending the raw diagram's
 /// failures is a gain in itself); a repair for nothing else; a step against skewness must lower the
 /// count of skewed faces or their worst, a short-edge move must raise Q_S without adding a skewed face.
 bool move_is_kept(const MoveEffect& e, MoveKind kind);

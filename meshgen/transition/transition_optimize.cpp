@@ -245,6 +245,31 @@ Incidence incidence_of(const PolyMesh& sub) {
   return inc;
 }
 
+// The moved sites whose cells share a node, in `before` or in `after` (two diagrams of the same
+// sites: cell c is the same site's in both), with a cell flagged in `cells`. Sets *unattributed when
+// a flagged cell has no such neighbour.
+std::vector<char> moved_sites_sharing_a_node(const std::vector<char>& cells, const PolyMesh& before, const PolyMesh& after,
+                                             const std::vector<int>& cell_site, const std::vector<char>& moved,
+                                             bool* unattributed) {
+  std::vector<char> blamed(moved.size(), 0), found(cells.size(), 0);
+  *unattributed = false;
+  if (std::find(cells.begin(), cells.end(), 1) == cells.end()) return blamed;
+  for (const PolyMesh* m : {&before, &after}) {
+    const Incidence inc = incidence_of(*m);
+    for (size_t c = 0; c < cells.size(); ++c) {
+      if (!cells[c]) continue;
+      for (const int32_t* f = m->cell_begin(static_cast<int>(c)); f != m->cell_end(static_cast<int>(c)); ++f)
+        for (const int32_t* v = m->face_begin(*f); v != m->face_end(*f); ++v)
+          for (int k = inc.node_ptr[*v]; k < inc.node_ptr[*v + 1]; ++k) {
+            const int site = cell_site[inc.node_cells[k]];
+            if (moved[site]) blamed[site] = 1, found[c] = 1;
+          }
+    }
+  }
+  for (size_t c = 0; c < cells.size(); ++c) *unattributed = *unattributed || (cells[c] && !found[c]);
+  return blamed;
+}
+
 // Appends cell c and its face neighbours to the sorted set `cells`.
 void add_cell_and_neighbours(const PolyMesh& sub, int c, std::vector<int>& cells) {
   cells.push_back(c);
@@ -612,18 +637,21 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   const std::vector<double>& max_skew2 = after.max_skew;
   const std::vector<char>& failing2 = after.failing.cell;
   // No move may make a cell fail a shape check of the self-check (shape_failures): one whose
-  // region holds a newly failing cell is refused, and all of them when such a cell lies in no
-  // move's region.
+  // region holds a newly failing cell is refused. A newly failing cell in no move's region changed
+  // through a power vertex it shares with a moved site's cell: the moves whose cells share a node
+  // with it are refused, and all of them only when no moved site's cell does.
   const std::vector<char> worse = new_failures(out, now, fresh, after);
-  std::vector<char> covered(worse.size(), 0);
+  std::vector<char> stray(worse);
   for (const Move& m : moves)
-    for (int c : m.region) covered[c] = 1;
-  bool stray = false;
-  for (size_t c = 0; c < worse.size(); ++c) stray = stray || (worse[c] && !covered[c]);
+    for (int c : m.region) stray[c] = 0;
+  std::vector<char> applied(ns, 0);  // the moves in this rebuild (the halving may have undone some)
+  for (const Move& m : moves) applied[m.site] = 1;
+  bool unattributed = false;
+  const std::vector<char> blamed = moved_sites_sharing_a_node(stray, now.sub, after.sub, out.cell_site, applied, &unattributed);
   std::vector<Move> kept;
   for (const Move& m : moves) {
     MoveEffect e;
-    e.newly_failing = stray;
+    e.newly_failing = unattributed || blamed[m.site];
     for (int c : m.region) {
       e.newly_failing = e.newly_failing || worse[c];
       e.q_s_before += qs[c], e.q_s_after += qs2[c], e.skewed_before += skewed[c], e.skewed_after += skewed2[c];
@@ -662,7 +690,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
 
 bool move_is_kept(const MoveEffect& e, MoveKind kind) {
   if (e.newly_failing) return false;
-  if (kind == MoveKind::SliverRemoval) return true;
+  if (kind == MoveKind::SliverRemoval) return e.skewed_after <= e.skewed_before;  // checkMesh fails above its skewness limit
   if (e.failing_after < e.failing_before) return true;
   if (kind == MoveKind::Repair) return false;
   if (kind == MoveKind::SkewStep)

@@ -411,7 +411,13 @@ TEST(SiteOptimizer, MoveIsKeptForWhatItDoesToTheCellsAroundIt) {
   EXPECT_FALSE(move_is_kept(gain, Kind::Repair));  // a repair is kept for mending alone
   gain.skewed_after = 1;
   EXPECT_FALSE(move_is_kept(gain, Kind::ShortEdge));
-  EXPECT_TRUE(move_is_kept(gain, Kind::SliverRemoval));  // a sliver removal needs only that nothing fails
+  // A sliver removal needs that nothing fails and no face around it newly exceeds checkMesh's
+  // skewness limit (accuracy_bent: a removal made a face of skewness 21, session 30).
+  EXPECT_FALSE(move_is_kept(gain, Kind::SliverRemoval));
+  gain.skewed_before = 1;
+  EXPECT_TRUE(move_is_kept(gain, Kind::SliverRemoval));
+  gain.q_s_after = 0.5;  // whatever it does to Q_S
+  EXPECT_TRUE(move_is_kept(gain, Kind::SliverRemoval));
   MoveEffect step;  // a step against skewness: fewer skewed faces, or as many with a lower worst
   step.skewed_before = 2, step.skewed_after = 2, step.worst_skew_before = 5.0, step.worst_skew_after = 4.5;
   EXPECT_TRUE(move_is_kept(step, Kind::SkewStep));
