@@ -800,8 +800,7 @@ std::vector<int> PowerDiagram::cells(const SiteSet& set, const Cavity& cavity, c
   };
   if (saved_ && updates(*saved_) < updates(*impl_)) std::swap(impl_, saved_);
   Impl& d = *impl_;
-  bool fresh = !d.ready || static_cast<int>(d.p.size()) != ns;
-  for (int s = 0; s < ns && !fresh; ++s) fresh = (live(s) ? 1 : 0) != d.alive[s];
+  bool fresh = updates(d) > ns;
   moved_ = 0;
   // Incrementally: remove and insert again each site whose point or weight changed. A move
   // that hides a site (or whose site is hidden) changes the vertex count: then from scratch
