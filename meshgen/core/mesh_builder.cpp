@@ -205,6 +205,7 @@ PolyMesh MeshBuilder::finish(BuildReport* report) {
   // Compact nodes: keep only those referenced by a face, in their original order.
   std::vector<int32_t> new_id(nodes_.size(), -1);
   for (int32_t v : face_nodes_) new_id[v] = 0;
+  m.nodes.reserve(nodes_.size());
   for (size_t i = 0; i < nodes_.size(); ++i) {
     if (new_id[i] == 0) {
       new_id[i] = static_cast<int32_t>(m.nodes.size());

@@ -27,6 +27,11 @@ struct CellFace {
   bool by_id_only = false;
 };
 
+/// Room to reserve in a MeshBuilder: cells, distinct faces, and nodes over those faces' cycles.
+struct BuilderCapacity {
+  size_t cells = 0, faces = 0, face_nodes = 0;
+};
+
 struct BuildReport {
   bool ok = true;
   int unmatched_faces = 0;      ///< faces declared interior that no second cell named

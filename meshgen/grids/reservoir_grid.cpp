@@ -60,7 +60,7 @@ std::vector<int32_t> add_reservoir_nodes(const ReservoirGrid& grid, MeshBuilder&
 
 std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const ReservoirSpec& spec,
                                          const std::vector<int32_t>& node_ids, const std::vector<char>& active,
-                                         MeshBuilder& builder) {
+                                         MeshBuilder& builder, const BuilderCapacity& added_after) {
   std::vector<int32_t> cell_id(grid.n_cells(), -1);
   std::vector<CellFace> faces(6);  // reused: no allocation per cell
   std::vector<int32_t> face_ids;
@@ -68,7 +68,7 @@ std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const Reserv
   const size_t n_outer = 2 * (static_cast<size_t>(grid.nx()) * grid.ny() + static_cast<size_t>(grid.ny()) * grid.nz() +
                               static_cast<size_t>(grid.nx()) * grid.nz());
   const size_t n_faces = 3 * n_active + n_outer;  // each cell's three low faces, and the far sides
-  builder.reserve(n_active, n_faces, 4 * n_faces);
+  builder.reserve(n_active + added_after.cells, n_faces + added_after.faces, 4 * n_faces + added_after.face_nodes);
   // A face between two active cells is named by id by the second (the structure pairs them);
   // only faces toward inactive (cavity) cells are looked up by their nodes, by the transition.
   std::array<std::vector<int32_t>, 3> high_face;  // per axis: the face id of each cell's + side

@@ -43,9 +43,11 @@ std::vector<int32_t> add_reservoir_nodes(const ReservoirGrid& grid, MeshBuilder&
 /// Adds the active cells (active[c] != 0) as hexahedra with (i,j,k), perm and porosity.
 /// Outer-box faces get patch kOuterBoundary; faces toward an inactive cell are
 /// interior (the transition mesh must claim them). Returns the mesh cell id per
-/// reservoir cell (-1 when inactive).
+/// reservoir cell (-1 when inactive). `added_after`: what the caller adds next, reserved now so
+/// that the builder's million-entry arrays are not grown (copied) again for a few more cells.
 std::vector<int32_t> add_reservoir_cells(const ReservoirGrid& grid, const ReservoirSpec& spec,
                                          const std::vector<int32_t>& node_ids,
-                                         const std::vector<char>& active, MeshBuilder& builder);
+                                         const std::vector<char>& active, MeshBuilder& builder,
+                                         const BuilderCapacity& added_after = {});
 
 }  // namespace hm

@@ -337,7 +337,8 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
 
   {
     Progress progress("reservoir cells");
-    add_reservoir_cells(out.grid, cs.reservoir, res_nodes, out.cavities.reservoir_active, builder);
+    add_reservoir_cells(out.grid, cs.reservoir, res_nodes, out.cavities.reservoir_active, builder,
+                        transition_capacity(transitions));
   }
   timer.mark("reservoir_cells");
 

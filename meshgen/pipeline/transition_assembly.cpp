@@ -31,6 +31,17 @@ std::optional<std::vector<TransitionCells>> all_transitions(std::vector<std::opt
   return cells;
 }
 
+BuilderCapacity transition_capacity(const std::vector<TransitionCells>& transitions) {
+  BuilderCapacity c;
+  for (const TransitionCells& t : transitions)
+    for (const auto& cell : t.cells) {
+      ++c.cells;
+      c.faces += cell.size();
+      for (const CellFace& f : cell) c.face_nodes += f.nodes.size();
+    }
+  return c;
+}
+
 TransitionCellMaps add_transition_cells(const std::vector<TransitionCells>& transitions,
                                         const std::function<void(CellAttributes&)>& set_rock, MeshBuilder& builder,
                                         std::vector<TransitionReport>& reports) {

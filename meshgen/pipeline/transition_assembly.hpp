@@ -27,6 +27,9 @@ void build_transitions(const std::vector<int>& to_build, const std::vector<Cavit
 /// Every cavity's cells in cavity order (moved out of `outcomes`) when none was refused, else nothing.
 std::optional<std::vector<TransitionCells>> all_transitions(std::vector<std::optional<TransitionOutcome>>& outcomes);
 
+/// At most what add_transition_cells adds to a builder (a face shared by two cells counted twice).
+BuilderCapacity transition_capacity(const std::vector<TransitionCells>& transitions);
+
 /// Adds every cavity's new nodes (renumbered cavity by cavity from the builder's next id) and cells
 /// (region kTransition, FV centre = site, rock from `set_rock`), and appends each cavity's report.
 TransitionCellMaps add_transition_cells(const std::vector<TransitionCells>& transitions,
