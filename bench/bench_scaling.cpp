@@ -21,6 +21,7 @@
 
 #include "scaling_case.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
+#include "meshgen/core/malloc_tunables.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 
 namespace {
@@ -183,6 +184,7 @@ void run_case(int lateral) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  hm::rerun_with_malloc_tunables(argv, hm::kMallocHugePages);  // as meshgen runs (and fvcheck its own)
   std::vector<int> laterals;
   for (int i = 1; i < argc; ++i) laterals.push_back(std::atoi(argv[i]));
   if (laterals.empty()) laterals = {22, 70, 224};

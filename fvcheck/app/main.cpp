@@ -2,7 +2,6 @@
 //         [-j N] [--quiet]
 // Checks the finite-volume properties of a mesh (docs/fvcheck.md).
 // Exit codes: 0 every check holds, 1 a check fails, 2 unreadable input or bad arguments.
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -17,6 +16,7 @@
 #include "fvcheck/lib/report.hpp"
 #include "fvcheck/lib/report_json.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/core/malloc_tunables.hpp"
 #include "meshgen/core/parallel.hpp"
 #include "meshgen/core/progress.hpp"
 
@@ -43,36 +43,10 @@ bool parse_degrees(const std::string& s, double* out) {
   return true;
 }
 
-// glibc's malloc tunables for fvcheck's large arrays (a large mesh is a few dozen arrays of tens
-// of megabytes): transparent huge pages for the heap and its big blocks (`hugetlb=1`: the kernel
-// faults and clears huge pages instead of small ones, and the TLB covers more), and big blocks
-// taken from the heap rather than mapped and unmapped one by one, so that an array freed early is
-// reused instead of being cleared again by the kernel (`mmap_threshold`). Tunables are read when
-// a process starts, so fvcheck runs itself again (execv: same process id) with them appended to
-// GLIBC_TUNABLES. Left alone when GLIBC_TUNABLES already names glibc.malloc.hugetlb (set it, e.g.
-// to 0, to keep glibc's defaults or to profile under valgrind). They change the speed, never a
-// result; docs/performance.md has the measurements.
-void rerun_with_malloc_tunables(char** argv) {
-#if defined(__GLIBC__) && defined(__linux__)
-  const char* old = std::getenv("GLIBC_TUNABLES");
-  std::string tunables = old ? old : "";
-  if (tunables.find("glibc.malloc.hugetlb") != std::string::npos) return;
-  std::error_code ec;
-  const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
-  if (ec || self.empty()) return;
-  tunables += std::string(tunables.empty() ? "" : ":") +
-              "glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=4294967295";
-  if (::setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
-  ::execv(self.c_str(), argv);  // returns only on failure: go on as we are
-#else
-  (void)argv;
-#endif
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  rerun_with_malloc_tunables(argv);
+  hm::rerun_with_malloc_tunables(argv, hm::kMallocHugePagesHeapReuse);  // meshgen/core/malloc_tunables.hpp
   std::string mesh_path, json_path, html_path;
   bool render_pictures = false;
   hm::CheckOptions opt;

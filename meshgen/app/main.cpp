@@ -17,6 +17,7 @@
 #include "fvcheck/lib/quality.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/core/cli.hpp"
+#include "meshgen/core/malloc_tunables.hpp"
 #include "meshgen/core/parallel.hpp"
 #include "meshgen/core/progress.hpp"
 #include "meshgen/core/text_file.hpp"
@@ -46,6 +47,7 @@ int usage(const std::string& why) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  hm::rerun_with_malloc_tunables(argv, hm::kMallocHugePages);  // meshgen/core/malloc_tunables.hpp
   std::string case_path, out_dir;
   hm::PipelineOptions opts;
   bool export_eclipse = false, export_openfoam = false, pictures = false, quiet = false;
