@@ -626,26 +626,57 @@ std::vector<CavityTriangle> cavity_triangles(const CornerPointCellFaces& cells, 
   return out;
 }
 
+namespace {
+
+// At most what add_corner_point_cells adds for the cells it keeps: a face toward another kept cell
+// counted once, every other face (boundary, toward a cavity) as one; a cavity's triangles are few.
+BuilderCapacity corner_point_capacity(const CornerPointCellFaces& cells, const std::vector<char>& active) {
+  BuilderCapacity c;
+  for (size_t m = 0; m < cells.faces.size(); ++m) {
+    if (!cells.meshed[m] || !active[m]) continue;
+    ++c.cells;
+    for (size_t f = 0; f < cells.faces[m].size(); ++f) {
+      const int32_t nb = cells.neighbour[m][f];
+      const bool shared = nb >= 0 && cells.meshed[nb] && active[nb];
+      if (shared && nb < static_cast<int32_t>(m)) continue;  // the face is the first cell's
+      ++c.faces;
+      c.face_nodes += cells.faces[m][f].nodes.size();
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
 CornerPointCells add_corner_point_cells(const CornerPointModel& model, const CornerPointCellFaces& cells,
                                         const ReservoirSpec& rock, const std::vector<char>& active,
-                                        MeshBuilder& builder) {
+                                        MeshBuilder& builder, const BuilderCapacity& added_after) {
   const int n = model.nx * model.ny * model.nz;
   std::vector<Vec3> coords(builder.n_nodes());
   for (int32_t i = 0; i < builder.n_nodes(); ++i) coords[i] = builder.node(i);
+  const BuilderCapacity own = corner_point_capacity(cells, active);
+  builder.reserve(own.cells + added_after.cells, own.faces + added_after.faces,
+                  own.face_nodes + added_after.face_nodes);
   CornerPointCells out;
   out.cell_id.assign(n, -1);
   out.zero_volume_cells = cells.zero_volume_cells;
   out.fault_faces = cells.fault_faces;
   out.crossing_nodes = cells.crossing_nodes;
+  std::vector<CellFace> faces;  // reused: its node lists keep their storage from cell to cell
   for (int c = 0; c < n; ++c) {
     if (!cells.meshed[c] || !active[c]) continue;
-    std::vector<CellFace> faces;
+    size_t k = 0;
+    auto next = [&]() -> CellFace& {
+      if (k == faces.size()) faces.emplace_back();
+      return faces[k++];
+    };
     for (size_t f = 0; f < cells.faces[c].size(); ++f) {
       const int32_t nb = cells.neighbour[c][f];
-      if (!(nb >= 0 && !active[nb])) faces.push_back(cells.faces[c][f]);
+      if (!(nb >= 0 && !active[nb])) next() = cells.faces[c][f];
     }
     for (CavityTriangle& t : cavity_triangles(cells, c, active, coords))  // toward a cavity
-      faces.push_back(CellFace{std::move(t.nodes), kInteriorFace});
+      next() = CellFace{std::move(t.nodes), kInteriorFace};
+    faces.resize(k);
     CellAttributes at;
     at.region = kReservoir;
     Vec3 centre{0, 0, 0};

@@ -58,10 +58,11 @@ std::vector<CavityTriangle> cavity_triangles(const CornerPointCellFaces& cells, 
                                              const std::vector<Vec3>& coords);
 
 /// Adds the meshed cells with active[c] != 0 (attributes as below); a face toward a meshed cell
-/// that is not active (a cavity's) is added as its cavity_triangles, interior.
+/// that is not active (a cavity's) is added as its cavity_triangles, interior. `added_after`: what
+/// the caller adds next (the transition cells), reserved with these cells (no regrowth of the arrays).
 CornerPointCells add_corner_point_cells(const CornerPointModel& model, const CornerPointCellFaces& cells,
                                         const ReservoirSpec& rock, const std::vector<char>& active,
-                                        MeshBuilder& builder);
+                                        MeshBuilder& builder, const BuilderCapacity& added_after = {});
 
 /// Adds the nodes and the cells with active[c] != 0 of the model (region kReservoir, ijk, the rock of
 /// `rock` (per cell), FV centre = the mean of the 8 corners). A face part toward no active cell

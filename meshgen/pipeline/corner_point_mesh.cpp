@@ -348,7 +348,8 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
     for (CellAttributes& at : b.cell_attrs) set_rock(at);
 
   for (size_t w = 0; w < out.blocks.size(); ++w) add_well_block_cells(out.blocks[w], well_nodes[w], builder);
-  add_corner_point_cells(model, faces, cs.reservoir, out.cavities.reservoir_active, builder);
+  add_corner_point_cells(model, faces, cs.reservoir, out.cavities.reservoir_active, builder,
+                         transition_capacity(transitions));
   stage.mark("reservoir_cells");
   const TransitionCellMaps maps = add_transition_cells(transitions, set_rock, builder, out.transition_reports);
   out.mesh = builder.finish(&out.build_report);
