@@ -130,17 +130,66 @@ CornerPointLocator::CornerPointLocator(const CornerPointModel& model, const Corn
       for (const auto& t : face_triangles(f.nodes, coords)) cell.triangles.push_back({coords[t[0]], coords[t[1]], coords[t[2]]});
     cells_.push_back(std::move(cell));
   }
+  index_buckets();
+}
+
+// About one bucket per cell, cubes as far as the extent allows (a flat model gets few layers of them).
+void CornerPointLocator::index_buckets() {
+  constexpr int kMaxDim = 256;
+  if (cells_.empty()) return;
+  Vec3 lo = cells_[0].lo, hi = cells_[0].hi;
+  for (const Cell& c : cells_)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c.lo[a]), hi[a] = std::max(hi[a], c.hi[a]);
+  double volume = 1;
+  for (int a = 0; a < 3; ++a) volume *= std::max(hi[a] - lo[a], 1e-300);
+  const double side = std::cbrt(volume / static_cast<double>(cells_.size()));
+  origin_ = lo;
+  for (int a = 0; a < 3; ++a) {
+    const double extent = hi[a] - lo[a];
+    dims_[a] = std::isfinite(extent / side) ? std::clamp(static_cast<int>(std::ceil(extent / side)), 1, kMaxDim) : 1;
+    step_[a] = extent > 0 ? extent / dims_[a] : 1.0;
+  }
+  auto index = [&](int a, double v) { return std::clamp(static_cast<int>(std::floor((v - origin_[a]) / step_[a])), 0, dims_[a] - 1); };
+  const size_t nb = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
+  std::vector<std::array<int, 6>> range(cells_.size());
+  bucket_ptr_.assign(nb + 1, 0);
+  for (size_t k = 0; k < cells_.size(); ++k) {
+    for (int a = 0; a < 3; ++a) range[k][a] = index(a, cells_[k].lo[a]), range[k][3 + a] = index(a, cells_[k].hi[a]);
+    for (int z = range[k][2]; z <= range[k][5]; ++z)
+      for (int y = range[k][1]; y <= range[k][4]; ++y)
+        for (int x = range[k][0]; x <= range[k][3]; ++x) ++bucket_ptr_[(static_cast<size_t>(z) * dims_[1] + y) * dims_[0] + x + 1];
+  }
+  for (size_t b = 0; b < nb; ++b) bucket_ptr_[b + 1] += bucket_ptr_[b];
+  bucket_cells_.resize(bucket_ptr_[nb]);
+  std::vector<int32_t> fill(bucket_ptr_.begin(), bucket_ptr_.end() - 1);
+  for (size_t k = 0; k < cells_.size(); ++k)  // ascending k: each bucket keeps the order of `among`
+    for (int z = range[k][2]; z <= range[k][5]; ++z)
+      for (int y = range[k][1]; y <= range[k][4]; ++y)
+        for (int x = range[k][0]; x <= range[k][3]; ++x)
+          bucket_cells_[fill[(static_cast<size_t>(z) * dims_[1] + y) * dims_[0] + x]++] = static_cast<int32_t>(k);
+}
+
+int CornerPointLocator::bucket_of(Vec3 x) const {
+  int b[3];
+  for (int a = 0; a < 3; ++a) b[a] = std::clamp(static_cast<int>(std::floor((x[a] - origin_[a]) / step_[a])), 0, dims_[a] - 1);
+  return (b[2] * dims_[1] + b[1]) * dims_[0] + b[0];
+}
+
+bool CornerPointLocator::holds(const Cell& c, Vec3 x) const {
+  for (int a = 0; a < 3; ++a)
+    if (x[a] < c.lo[a] || x[a] > c.hi[a]) return false;
+  double w = 0;
+  for (const auto& t : c.triangles) w += solid_angle(x, t);
+  return std::abs(w) > 2.0 * kPi;  // winding number 1 (4 pi), not 0
 }
 
 int CornerPointLocator::cell_at(Vec3 x) const {
-  for (const Cell& c : cells_) {
-    bool out = false;
-    for (int a = 0; a < 3; ++a) out = out || x[a] < c.lo[a] || x[a] > c.hi[a];
-    if (out) continue;
-    double w = 0;
-    for (const auto& t : c.triangles) w += solid_angle(x, t);
-    if (std::abs(w) > 2.0 * kPi) return c.id;  // winding number 1 (4 pi), not 0
-  }
+  // A cell holding x has x in its box, so it is in x's bucket (a point outside every box, or not
+  // finite, is held by none).
+  if (cells_.empty() || !(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z))) return -1;
+  const int b = bucket_of(x);
+  for (int32_t i = bucket_ptr_[b]; i < bucket_ptr_[b + 1]; ++i)
+    if (holds(cells_[bucket_cells_[i]], x)) return cells_[bucket_cells_[i]].id;
   return -1;
 }
 

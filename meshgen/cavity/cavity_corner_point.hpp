@@ -14,7 +14,9 @@
 namespace hm {
 
 /// Which model cell holds a point, among a set of meshed model cells: inside the closed surface of
-/// the cell's triangulated faces (winding number from solid angles).
+/// the cell's triangulated faces (winding number from solid angles). The first such cell in the
+/// order of `among`; only the cells whose bounding box holds the point are tried (a uniform grid
+/// of buckets over the boxes), so a query costs a few cells, not all of them.
 class CornerPointLocator {
  public:
   CornerPointLocator(const CornerPointModel& model, const CornerPointCellFaces& cells, const std::vector<int32_t>& among,
@@ -30,7 +32,15 @@ class CornerPointLocator {
     Vec3 lo, hi, centre;
     std::vector<std::array<Vec3, 3>> triangles;
   };
+  bool holds(const Cell& c, Vec3 x) const;
+  void index_buckets();
+  int bucket_of(Vec3 x) const;
   std::vector<Cell> cells_;
+  // Buckets: a grid of dims_ cells of size step_ from origin_; bucket b holds the indices into cells_
+  // (ascending) of the cells whose box meets it: bucket_cells_[bucket_ptr_[b] .. bucket_ptr_[b + 1]).
+  Vec3 origin_, step_{1, 1, 1};
+  std::array<int, 3> dims_{1, 1, 1};
+  std::vector<int32_t> bucket_ptr_, bucket_cells_;
 };
 
 /// Makes the boundary of the deactivated meshed cells (active[c] == 0) a 2-manifold where the model's

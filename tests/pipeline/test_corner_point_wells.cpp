@@ -867,3 +867,58 @@ TEST(CornerPointSurface, WellEndingNearTheBottomIsMovedBackAsACrossingEnd) {
   ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
   expect_sound_mesh(cs, out);
 }
+
+// CornerPointLocator tries only the cells of the query's bucket: the same answers as trying every
+// cell in order (each cell alone in a locator of its own), on a faulted model with inclined, bent
+// pillars and a pinch-out, at random points and at every cell's corner mean.
+TEST(CornerPointLocator, BucketsGiveTheAnswerOfTryingEveryCell) {
+  TempDir tmp("cplocate");
+  TiltedModel g;
+  g.nx = 7, g.ny = 6, g.nz = 8, g.fault_i = 3, g.throw_m = 7, g.inclined_pillars = true, g.pillar_twist = 0.3;
+  g.pinch_k = 5;
+  const CaseSpec cs = case_of(tmp, g, "");
+  const CornerPointModel& model = *cs.reservoir.corner_point;
+  MeshBuilder scratch;
+  const CornerPointCellFaces faces = corner_point_cell_faces(model, std::vector<char>(model.actnum.size(), 1), scratch);
+  std::vector<Vec3> coords(scratch.n_nodes());
+  for (int32_t i = 0; i < scratch.n_nodes(); ++i) coords[i] = scratch.node(i);
+  std::vector<int32_t> among;
+  for (int32_t c = 0; c < static_cast<int32_t>(faces.meshed.size()); ++c)
+    if (faces.meshed[c]) among.push_back(c);
+  std::reverse(among.begin(), among.end());  // the order of `among` decides between cells sharing a face
+  const CornerPointLocator locate(model, faces, among, coords);
+  std::vector<CornerPointLocator> alone;
+  for (int32_t c : among) alone.emplace_back(model, faces, std::vector<int32_t>{c}, coords);
+  auto every_cell = [&](Vec3 x) {
+    for (const CornerPointLocator& l : alone)
+      if (int c = l.cell_at(x); c >= 0) return c;
+    return -1;
+  };
+  Vec3 lo = coords[0], hi = coords[0];
+  for (const Vec3& p : coords)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  std::vector<Vec3> points;
+  uint64_t state = 12345;
+  auto uniform = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int i = 0; i < 600; ++i) {  // the box and a margin around it
+    Vec3 x;
+    for (int a = 0; a < 3; ++a) x[a] = lo[a] - 0.1 * (hi[a] - lo[a]) + 1.2 * (hi[a] - lo[a]) * uniform();
+    points.push_back(x);
+  }
+  for (int32_t c : among) {
+    Vec3 mean{0, 0, 0};
+    for (int q = 0; q < 8; ++q) mean += model_cell_corner(model, c, q) / 8.0;
+    points.push_back(mean);
+  }
+  int held = 0;
+  for (const Vec3& x : points) {
+    const int expected = every_cell(x);
+    held += expected >= 0;
+    EXPECT_EQ(locate.cell_at(x), expected) << x.x << " " << x.y << " " << x.z;
+  }
+  EXPECT_GT(held, static_cast<int>(among.size()));  // the corner means, and random points inside
+  EXPECT_EQ(locate.cell_at(Vec3{NAN, 0, 0}), -1);
+}
