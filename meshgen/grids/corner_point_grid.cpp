@@ -332,6 +332,38 @@ class CornerPointMesher {
     return cyc;
   }
 
+  // A band's depth range over the strip: its shallowest top end and its deepest bottom end.
+  struct Envelope {
+    double top, bottom;
+  };
+  static Envelope envelope(const PillarPair& pp, Band b) {
+    return {std::min(depth(pp, b.top, 0), depth(pp, b.top, 1)), std::max(depth(pp, b.bottom, 0), depth(pp, b.bottom, 1))};
+  }
+  // The envelopes of a column side's bands (or gaps), in the column's order, and whether they go
+  // down both pillars, as a column's bands do (check_corner_point_geometry).
+  struct Envelopes {
+    std::vector<Envelope> e;
+    bool ordered = true;
+  };
+  static Envelopes envelopes(const PillarPair& pp, const std::vector<Band>& bands) {
+    Envelopes out;
+    for (const Band& b : bands) out.e.push_back(envelope(pp, b));
+    for (size_t i = 1; i < out.e.size() && out.ordered; ++i)
+      out.ordered = out.e[i - 1].top <= out.e[i].top && out.e[i - 1].bottom <= out.e[i].bottom;
+    return out;
+  }
+  // The bands of `ys` that can share area with band x: band_polygon is empty unless some end of
+  // y's bottom is deeper than the same end of x's top and some end of x's bottom deeper than y's top,
+  // hence unless y.bottom > x.top and x.bottom > y.top for the envelopes. Ordered envelopes make
+  // these bands one range, found by bisection: a pair of columns then costs its faces, not the
+  // product of the columns' cells. All of them when ys is not ordered.
+  static std::pair<size_t, size_t> overlapping(const Envelopes& ys, Envelope x) {
+    if (!ys.ordered) return {0, ys.e.size()};
+    const auto lo = std::partition_point(ys.e.begin(), ys.e.end(), [&](const Envelope& y) { return !(y.bottom > x.top); });
+    const auto hi = std::partition_point(ys.e.begin(), ys.e.end(), [&](const Envelope& y) { return y.top < x.bottom; });
+    return {static_cast<size_t>(lo - ys.e.begin()), static_cast<size_t>(std::max(lo, hi) - ys.e.begin())};
+  }
+
   // The meshed cells of a column (bottom to top order is k), and the gap bands between them.
   std::vector<int> column_cells(int i, int j) const {
     std::vector<int> cells;
@@ -395,8 +427,13 @@ class CornerPointMesher {
       group_[c].resize(faces[c].size(), -1);
       neighbour[c].resize(faces[c].size(), across);
     };
-    for (int a : ca)
-      for (int b : cb) {
+    std::vector<Band> bands_b;
+    for (int b : cb) bands_b.push_back(band(b, side_b));
+    const Envelopes env_b = envelopes(pp, bands_b);
+    for (int a : ca) {
+      const auto [first, last] = overlapping(env_b, envelope(pp, band(a, side_a)));
+      for (size_t k = first; k < last; ++k) {
+        const int b = cb[k];
         std::vector<int32_t> poly = band_polygon(pp, band(a, side_a), band(b, side_b));
         if (poly.empty()) continue;
         if (!(band(a, side_a).top == band(b, side_b).top && band(a, side_a).bottom == band(b, side_b).bottom)) ++fault_faces_;
@@ -406,23 +443,24 @@ class CornerPointMesher {
         add(a, true, poly, kInteriorFace, split, corner, centre, b);
         add(b, false, std::move(poly), kInteriorFace, split, corner, centre, a);
       }
+    }
     const std::vector<Band> ga = gaps(ca, side_a), gb = gaps(cb, side_b);
-    for (int a : ca)
-      for (const Band& g : gb)
-        if (auto poly = band_polygon(pp, band(a, side_a), g); !poly.empty()) {
-          std::array<int32_t, 4> corner;
-          Vec3 centre;
-          const bool split = whole(poly, band(a, side_a), &corner, &centre);
-          add(a, true, std::move(poly), boundary_patch, split, corner, centre, -1);
-        }
-    for (int b : cb)
-      for (const Band& g : ga)
-        if (auto poly = band_polygon(pp, band(b, side_b), g); !poly.empty()) {
-          std::array<int32_t, 4> corner;
-          Vec3 centre;
-          const bool split = whole(poly, band(b, side_b), &corner, &centre);
-          add(b, false, std::move(poly), boundary_patch, split, corner, centre, -1);
-        }
+    // Each cell's face parts toward the other column's gaps (boundary faces).
+    auto toward_gaps = [&](const std::vector<int>& cells, int side, const std::vector<Band>& other_gaps, bool is_a) {
+      const Envelopes env = envelopes(pp, other_gaps);
+      for (int c : cells) {
+        const auto [first, last] = overlapping(env, envelope(pp, band(c, side)));
+        for (size_t k = first; k < last; ++k)
+          if (auto poly = band_polygon(pp, band(c, side), other_gaps[k]); !poly.empty()) {
+            std::array<int32_t, 4> corner;
+            Vec3 centre;
+            const bool split = whole(poly, band(c, side), &corner, &centre);
+            add(c, is_a, std::move(poly), boundary_patch, split, corner, centre, -1);
+          }
+      }
+    };
+    toward_gaps(ca, side_a, gb, true);
+    toward_gaps(cb, side_b, ga, false);
   }
 
   // Top {0, 2, 3, 1} and bottom {4, 5, 7, 6} faces (outward), every station of their edges named.
