@@ -48,6 +48,16 @@ CaseSpec case_of(const TempDir& tmp, const TiltedModel& m, const std::string& we
 
 std::string vertical_well(double x, double y, double z0, double z1) { return hmtest::vertical_well_yaml(x, y, z0, z1); }
 
+// Every present cell's faces as the pipeline makes them, and the builder's node coordinates (the
+// model's nodes keep their ids in the pipeline).
+CornerPointCellFaces all_cell_faces(const CornerPointModel& m, std::vector<Vec3>* coords) {
+  MeshBuilder scratch;
+  CornerPointCellFaces faces = corner_point_cell_faces(m, std::vector<char>(m.actnum.size(), 1), scratch);
+  coords->resize(scratch.n_nodes());
+  for (int32_t v = 0; v < scratch.n_nodes(); ++v) (*coords)[v] = scratch.node(v);
+  return faces;
+}
+
 // The properties of a meshed case with wells (see the file's comment).
 void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
   ASSERT_TRUE(out.self_check.ok()) << out.self_check.message;
@@ -155,10 +165,8 @@ void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
   // here from the model's faces, not from the cavity.
   std::set<int32_t> dead_cells;
   for (const Cavity& cav : out.cavities.cavities) dead_cells.insert(cav.deactivated_cells.begin(), cav.deactivated_cells.end());
-  MeshBuilder scratch;
-  const CornerPointCellFaces model_faces = corner_point_cell_faces(m, std::vector<char>(m.actnum.size(), 1), scratch);
-  std::vector<Vec3> builder_coords(scratch.n_nodes());
-  for (int32_t v = 0; v < scratch.n_nodes(); ++v) builder_coords[v] = scratch.node(v);
+  std::vector<Vec3> builder_coords;
+  const CornerPointCellFaces model_faces = all_cell_faces(m, &builder_coords);
   ASSERT_LE(builder_coords.size(), out.cavity_node_coords.size());
   for (size_t v = 0; v < builder_coords.size(); ++v)  // the model's nodes have the pipeline's ids
     ASSERT_EQ(builder_coords[v], out.cavity_node_coords[v]) << v;
@@ -586,10 +594,8 @@ TEST(CornerPointWells, CavityAcrossAZeroThicknessLayerIsMadeAManifold) {
   g.nx = 5, g.ny = 4, g.nz = 5, g.pinch_k = 2, g.pinch_x = -100;  // layer 2 of no thickness anywhere
   const CaseSpec cs = case_of(tmp, g, "");
   const CornerPointModel& m = *cs.reservoir.corner_point;
-  MeshBuilder builder;
-  const CornerPointCellFaces cells = corner_point_cell_faces(m, std::vector<char>(m.actnum.size(), 1), builder);
-  std::vector<Vec3> coords(builder.n_nodes());
-  for (int32_t v = 0; v < builder.n_nodes(); ++v) coords[v] = builder.node(v);
+  std::vector<Vec3> coords;
+  const CornerPointCellFaces cells = all_cell_faces(m, &coords);
   auto cell = [&](int i, int j, int k) { return i + m.nx * (j + m.ny * k); };
   ASSERT_FALSE(cells.meshed[cell(1, 1, 2)]);
   std::vector<char> active(m.actnum.size(), 1);
@@ -687,10 +693,8 @@ TEST(CornerPointWells, ModelMultipliersAreOnTheModelFacesAndTheCavityWalls) {
   const PolyMesh& m = out.mesh;
   ASSERT_EQ(m.face_trans_mult.size(), static_cast<size_t>(m.n_faces()));
 
-  MeshBuilder scratch;
-  const CornerPointCellFaces faces = corner_point_cell_faces(model, std::vector<char>(model.actnum.size(), 1), scratch);
-  std::vector<Vec3> coords(scratch.n_nodes());
-  for (int32_t i = 0; i < scratch.n_nodes(); ++i) coords[i] = scratch.node(i);
+  std::vector<Vec3> coords;
+  const CornerPointCellFaces faces = all_cell_faces(model, &coords);
   std::vector<int32_t> dead;
   for (const Cavity& cav : out.cavities.cavities) dead.insert(dead.end(), cav.deactivated_cells.begin(), cav.deactivated_cells.end());
   std::sort(dead.begin(), dead.end());
@@ -878,10 +882,8 @@ TEST(CornerPointLocator, BucketsGiveTheAnswerOfTryingEveryCell) {
   g.pinch_k = 5;
   const CaseSpec cs = case_of(tmp, g, "");
   const CornerPointModel& model = *cs.reservoir.corner_point;
-  MeshBuilder scratch;
-  const CornerPointCellFaces faces = corner_point_cell_faces(model, std::vector<char>(model.actnum.size(), 1), scratch);
-  std::vector<Vec3> coords(scratch.n_nodes());
-  for (int32_t i = 0; i < scratch.n_nodes(); ++i) coords[i] = scratch.node(i);
+  std::vector<Vec3> coords;
+  const CornerPointCellFaces faces = all_cell_faces(model, &coords);
   std::vector<int32_t> among;
   for (int32_t c = 0; c < static_cast<int32_t>(faces.meshed.size()); ++c)
     if (faces.meshed[c]) among.push_back(c);
