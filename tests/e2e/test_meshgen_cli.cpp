@@ -59,6 +59,22 @@ TEST(MeshgenCli, UnwritableOutputExitsWithCode2) {
   EXPECT_NE(r.err.find("-o: cannot create directory"), std::string::npos) << r.err;
 }
 
+// meshgen runs itself again with glibc's huge pages (meshgen/core/malloc_tunables.hpp) unless the
+// environment already says otherwise: the run that does and the one that keeps glibc's defaults
+// write the same mesh.vtu, byte for byte.
+TEST(MeshgenCli, HugePagesChangeNoResult) {
+  const fs::path d = fresh_dir("hugepages");
+  std::ofstream(d / "case.yaml") << kSmallCase;
+  const std::string args = " '" + (d / "case.yaml").string() + "' --quiet -o '";
+  const auto with = run_command(kMeshgen + args + (d / "with").string() + "'");
+  const auto without = run_command("env GLIBC_TUNABLES=glibc.malloc.hugetlb=0 " + kMeshgen + args + (d / "without").string() + "'");
+  ASSERT_EQ(with.exit_code, 0) << with.err;
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  const std::string a = slurp(d / "with" / "mesh.vtu"), b = slurp(d / "without" / "mesh.vtu");
+  EXPECT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == b) << "mesh.vtu differs with and without huge pages";
+}
+
 // solver_demo --mesh: the mesh file meshgen wrote is solved without re-meshing and gives the same
 // pressures (cell by cell, read back from pressure.vtu) and well rates as the run that meshes, to
 // the iterative solver's tolerance (relative residual 1e-12; the faces are numbered differently,
