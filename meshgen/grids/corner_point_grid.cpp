@@ -666,8 +666,8 @@ std::vector<CavityTriangle> cavity_triangles(const CornerPointCellFaces& cells, 
 
 namespace {
 
-// At most what add_corner_point_cells adds for the cells it keeps: a face toward another kept cell
-// counted once, every other face (boundary, toward a cavity) as one; a cavity's triangles are few.
+// About what add_corner_point_cells adds for the cells it keeps: a face toward another kept cell
+// counted once (by the first), every other face once (one toward a cavity becomes a few triangles).
 BuilderCapacity corner_point_capacity(const CornerPointCellFaces& cells, const std::vector<char>& active) {
   BuilderCapacity c;
   for (size_t m = 0; m < cells.faces.size(); ++m) {
