@@ -5,17 +5,23 @@
 // stage beside raw CGAL Regular_triangulation_3 + power cells on the same weighted sites (the
 // internal sites of every cavity) in the same run, and fvcheck (the executable) on the written
 // VTU. Usage: bench_scaling [LATERAL_CELLS ...] (default 22 70 224: about 10k, 100k, 1M cells).
+// bench_scaling --per-well [LATERAL_CELLS ...] (default 80 112 160 224, 128k-1M cells): cells of
+// 10 m at every size, each size without wells and with the ten wells; per stage, the CPU time per
+// reservoir cell and the time each well adds (the issue's "time added per well independent of the
+// reservoir size").
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Regular_triangulation_3.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -181,12 +187,115 @@ void run_case(int lateral) {
   std::fflush(stdout);
 }
 
+// One run of `cs` (mesh + optimise + self-check + VTU) in a child process, for the per-well table:
+// the stages' wall, CPU and peak as the child measured them, sent back through a pipe.
+struct ChildRun {
+  bool ok = false;
+  std::string error;
+  long cells = 0;
+  std::vector<StageUse> uses;
+};
+
+ChildRun run_in_child(const hm::CaseSpec& cs) {
+  int fd[2];
+  ChildRun run;
+  if (pipe(fd) != 0) return run.error = "pipe failed", run;
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fd[0]);
+    FILE* out = fdopen(fd[1], "w");
+    StageMeter meter;
+    hm::PipelineOptions opts;
+    opts.on_stage = [&](const std::string& stage) { meter.mark(stage); };
+    try {
+      const hm::HybridMesh h = hm::build_hybrid_mesh(cs, opts);
+      const std::string vtu = (std::filesystem::temp_directory_path() / ("hm_bench_" + std::to_string(getpid()) + ".vtu")).string();
+      const hm::WriteStatus st = hm::write_vtu(vtu, h.mesh);
+      meter.mark("write_vtu");
+      std::error_code ec;
+      std::filesystem::remove(vtu, ec);
+      if (!st.ok) throw std::runtime_error("write_vtu: " + st.message);
+      std::fprintf(out, "cells %d\n", h.mesh.n_cells());
+      for (const StageUse& u : meter.uses) std::fprintf(out, "%s %.6f %.6f %.1f\n", u.stage.c_str(), u.wall, u.cpu, u.peak_mb);
+    } catch (const std::exception& e) {
+      std::fprintf(out, "failed %s\n", e.what());
+    }
+    std::fclose(out);
+    std::_Exit(0);
+  }
+  close(fd[1]);
+  FILE* in = fdopen(fd[0], "r");
+  char line[4096];
+  while (std::fgets(line, sizeof line, in)) {
+    char name[256];
+    StageUse u;
+    if (std::sscanf(line, "cells %ld", &run.cells) == 1) run.ok = true;
+    else if (std::strncmp(line, "failed ", 7) == 0) run.error = line + 7;
+    else if (std::sscanf(line, "%255s %lf %lf %lf", name, &u.wall, &u.cpu, &u.peak_mb) == 4) u.stage = name, run.uses.push_back(u);
+  }
+  std::fclose(in);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) run.ok = false, run.error = "crashed (status " + std::to_string(status) + ")";
+  return run;
+}
+
+double cpu_of(const ChildRun& r, const std::string& stage) {
+  double s = 0;
+  for (const StageUse& u : r.uses)
+    if (stage.empty() || u.stage == stage) s += u.cpu;
+  return s;
+}
+
+// The cost of the wells against the reservoir's size (hm::bench::fixed_cell_case): each lateral
+// meshed without wells and with the ten wells. Per stage, CPU seconds per reservoir cell (the run
+// without wells) and added per well ((with - without) / 10).
+void run_per_well(const std::vector<int>& laterals) {
+  constexpr int kWells = 10;
+  std::vector<std::string> stages;
+  std::printf("10 x 10 x 5 m cells, 20 layers, 0 and %d wells (the same wells at every size); CPU seconds\n", kWells);
+  for (int n : laterals) {
+    const ChildRun bare = run_in_child(hm::bench::fixed_cell_case(n, 0));
+    const ChildRun wells = run_in_child(hm::bench::fixed_cell_case(n, kWells));
+    if (!bare.ok || !wells.ok) {
+      std::printf("%-8d failed: %s%s\n", n, bare.error.c_str(), wells.error.c_str());
+      continue;
+    }
+    std::printf("lateral %d: %ld reservoir cells, %ld cells with the wells\n", n, bare.cells, wells.cells);
+    std::printf("  %-26s %12s %12s %14s %14s\n", "stage", "cpu_0_wells", "cpu_10_wells", "us/reservoir", "s added/well");
+    auto row = [&](const std::string& stage, const std::string& label) {
+      const double c0 = cpu_of(bare, stage), c1 = cpu_of(wells, stage);
+      std::printf("  %-26s %12.3f %12.3f %14.3f %14.4f\n", label.c_str(), c0, c1, 1e6 * c0 / bare.cells, (c1 - c0) / kWells);
+    };
+    for (const StageUse& u : wells.uses) row(u.stage, u.stage);
+    row("", "all (mesh + check + VTU)");
+    double wall0 = 0, wall1 = 0, peak0 = 0, peak1 = 0;
+    for (const StageUse& u : bare.uses) wall0 += u.wall, peak0 = std::max(peak0, u.peak_mb);
+    for (const StageUse& u : wells.uses) wall1 += u.wall, peak1 = std::max(peak1, u.peak_mb);
+    std::printf("  %-26s %12.3f %12.3f %14.3f %14.4f\n", "all, wall seconds", wall0, wall1, 1e6 * wall0 / bare.cells,
+                (wall1 - wall0) / kWells);
+    std::printf("  %-26s %12.0f %12.0f %14s %14.2f\n", "peak of a stage (MB)", peak0, peak1, "", (peak1 - peak0) / kWells);
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   hm::rerun_with_malloc_tunables(argv, hm::kMallocHugePages);  // as meshgen runs (and fvcheck its own)
   std::vector<int> laterals;
-  for (int i = 1; i < argc; ++i) laterals.push_back(std::atoi(argv[i]));
+  bool per_well = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--per-well") == 0) per_well = true;
+    else laterals.push_back(std::atoi(argv[i]));
+  }
+  if (per_well) {
+    if (laterals.empty()) laterals = {80, 112, 160, 224};
+    for (int n : laterals)
+      if (n < 80 || n % 2) return std::fprintf(stderr, "bench_scaling: --per-well needs even laterals >= 80 (got %d)\n", n), 2;
+    run_per_well(laterals);
+    return 0;
+  }
   if (laterals.empty()) laterals = {22, 70, 224};
   double load[3] = {0, 0, 0};
   getloadavg(load, 3);
