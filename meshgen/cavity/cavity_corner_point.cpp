@@ -133,6 +133,23 @@ CornerPointLocator::CornerPointLocator(const CornerPointModel& model, const Corn
   index_buckets();
 }
 
+int CornerPointLocator::bucket_index(int axis, double v) const {
+  return std::clamp(static_cast<int>(std::floor((v - origin_[axis]) / step_[axis])), 0, dims_[axis] - 1);
+}
+
+size_t CornerPointLocator::bucket_id(int x, int y, int z) const {
+  return (static_cast<size_t>(z) * dims_[1] + y) * dims_[0] + x;
+}
+
+template <class F>
+void CornerPointLocator::for_each_bucket_of(const Cell& c, F&& f) const {
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) lo[a] = bucket_index(a, c.lo[a]), hi[a] = bucket_index(a, c.hi[a]);
+  for (int z = lo[2]; z <= hi[2]; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int x = lo[0]; x <= hi[0]; ++x) f(bucket_id(x, y, z));
+}
+
 // About one bucket per cell, cubes as far as the extent allows (a flat model gets few layers of them).
 void CornerPointLocator::index_buckets() {
   constexpr int kMaxDim = 256;
@@ -149,30 +166,18 @@ void CornerPointLocator::index_buckets() {
     dims_[a] = std::isfinite(extent / side) ? std::clamp(static_cast<int>(std::ceil(extent / side)), 1, kMaxDim) : 1;
     step_[a] = extent > 0 ? extent / dims_[a] : 1.0;
   }
-  auto index = [&](int a, double v) { return std::clamp(static_cast<int>(std::floor((v - origin_[a]) / step_[a])), 0, dims_[a] - 1); };
   const size_t nb = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
-  std::vector<std::array<int, 6>> range(cells_.size());
   bucket_ptr_.assign(nb + 1, 0);
-  for (size_t k = 0; k < cells_.size(); ++k) {
-    for (int a = 0; a < 3; ++a) range[k][a] = index(a, cells_[k].lo[a]), range[k][3 + a] = index(a, cells_[k].hi[a]);
-    for (int z = range[k][2]; z <= range[k][5]; ++z)
-      for (int y = range[k][1]; y <= range[k][4]; ++y)
-        for (int x = range[k][0]; x <= range[k][3]; ++x) ++bucket_ptr_[(static_cast<size_t>(z) * dims_[1] + y) * dims_[0] + x + 1];
-  }
+  for (const Cell& c : cells_) for_each_bucket_of(c, [&](size_t b) { ++bucket_ptr_[b + 1]; });
   for (size_t b = 0; b < nb; ++b) bucket_ptr_[b + 1] += bucket_ptr_[b];
   bucket_cells_.resize(bucket_ptr_[nb]);
   std::vector<int32_t> fill(bucket_ptr_.begin(), bucket_ptr_.end() - 1);
   for (size_t k = 0; k < cells_.size(); ++k)  // ascending k: each bucket keeps the order of `among`
-    for (int z = range[k][2]; z <= range[k][5]; ++z)
-      for (int y = range[k][1]; y <= range[k][4]; ++y)
-        for (int x = range[k][0]; x <= range[k][3]; ++x)
-          bucket_cells_[fill[(static_cast<size_t>(z) * dims_[1] + y) * dims_[0] + x]++] = static_cast<int32_t>(k);
+    for_each_bucket_of(cells_[k], [&](size_t b) { bucket_cells_[fill[b]++] = static_cast<int32_t>(k); });
 }
 
-int CornerPointLocator::bucket_of(Vec3 x) const {
-  int b[3];
-  for (int a = 0; a < 3; ++a) b[a] = std::clamp(static_cast<int>(std::floor((x[a] - origin_[a]) / step_[a])), 0, dims_[a] - 1);
-  return (b[2] * dims_[1] + b[1]) * dims_[0] + b[0];
+size_t CornerPointLocator::bucket_of(Vec3 x) const {
+  return bucket_id(bucket_index(0, x[0]), bucket_index(1, x[1]), bucket_index(2, x[2]));
 }
 
 bool CornerPointLocator::holds(const Cell& c, Vec3 x) const {
@@ -187,7 +192,7 @@ int CornerPointLocator::cell_at(Vec3 x) const {
   // A cell holding x has x in its box, so it is in x's bucket (a point outside every box, or not
   // finite, is held by none).
   if (cells_.empty() || !(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z))) return -1;
-  const int b = bucket_of(x);
+  const size_t b = bucket_of(x);
   for (int32_t i = bucket_ptr_[b]; i < bucket_ptr_[b + 1]; ++i)
     if (holds(cells_[bucket_cells_[i]], x)) return cells_[bucket_cells_[i]].id;
   return -1;

@@ -34,7 +34,11 @@ class CornerPointLocator {
   };
   bool holds(const Cell& c, Vec3 x) const;
   void index_buckets();
-  int bucket_of(Vec3 x) const;
+  size_t bucket_of(Vec3 x) const;
+  int bucket_index(int axis, double v) const;  // clamped to the grid
+  size_t bucket_id(int x, int y, int z) const;
+  template <class F>
+  void for_each_bucket_of(const Cell& c, F&& f) const;  // f(bucket) for each bucket c's box meets
   std::vector<Cell> cells_;
   // Buckets: a grid of dims_ cells of size step_ from origin_; bucket b holds the indices into cells_
   // (ascending) of the cells whose box meets it: bucket_cells_[bucket_ptr_[b] .. bucket_ptr_[b + 1]).

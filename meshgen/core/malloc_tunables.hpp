@@ -2,7 +2,7 @@
 // arrays of tens of megabytes; on this kernel (transparent_hugepage/enabled = madvise) the kernel
 // faults and clears them 4 KiB at a time unless malloc asks for huge pages, which glibc does only
 // when GLIBC_TUNABLES says so when the process starts. They change the speed, never a result.
-// Measurements: docs/performance.md ("Huge pages for meshgen" and session 10).
+// Measurements: docs/performance.md (sessions 10 and 31).
 #pragma once
 #include <string>
 
