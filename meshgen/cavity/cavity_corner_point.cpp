@@ -46,14 +46,10 @@ struct ResTriangle {
 // without its centre (as cavity_triangles cuts the faces toward active cells).
 void add_surface_triangles(const CornerPointCellFaces& cells, int c, const std::vector<Vec3>& coords,
                            std::vector<ResTriangle>& out) {
-  for (size_t f = 0; f < cells.faces[c].size(); ++f) {
-    if (cells.neighbour[c][f] >= 0) continue;
-    const int32_t g = cells.group[c][f];
-    bool seen = false;
-    for (size_t e = 0; e < f && g >= 0 && !seen; ++e) seen = cells.group[c][e] == g;
-    if (seen) continue;
-    const std::vector<int32_t>& cycle = g >= 0 ? cells.groups[g] : cells.faces[c][f].nodes;  // outward for c
-    for (const auto& t : face_triangles(cycle, coords)) out.push_back({{t[2], t[1], t[0]}, -1, static_cast<int32_t>(c)});
+  for (int64_t f = cells.face_begin(c); f < cells.face_end(c); ++f) {
+    if (cells.neighbour[f] >= 0 || !cells.first_of_its_group(c, f)) continue;
+    for (const auto& t : face_triangles(cells.cycle(f), coords))  // the cycle is outward for c
+      out.push_back({{t[2], t[1], t[0]}, -1, static_cast<int32_t>(c)});
   }
 }
 
@@ -62,12 +58,12 @@ void add_surface_triangles(const CornerPointCellFaces& cells, int c, const std::
 std::vector<ResTriangle> reservoir_triangles(const CornerPointCellFaces& cells, const std::vector<char>& active,
                                              const std::vector<Vec3>& coords) {
   std::vector<ResTriangle> out;
-  for (size_t c = 0; c < cells.faces.size(); ++c) {
+  for (int64_t c = 0; c < cells.n_cells(); ++c) {
     if (!cells.meshed[c] || !active[c]) continue;
     for (CavityTriangle& t : cavity_triangles(cells, static_cast<int>(c), active, coords))
       out.push_back({std::move(t.nodes), static_cast<int32_t>(c), t.inside});
   }
-  for (size_t c = 0; c < cells.faces.size(); ++c)
+  for (int64_t c = 0; c < cells.n_cells(); ++c)
     if (cells.meshed[c] && !active[c]) add_surface_triangles(cells, static_cast<int>(c), coords, out);
   return out;
 }
@@ -126,8 +122,9 @@ CornerPointLocator::CornerPointLocator(const CornerPointModel& model, const Corn
     cell_box(model, c, cell.lo, cell.hi);
     cell.centre = Vec3{0, 0, 0};
     for (int q = 0; q < 8; ++q) cell.centre += model_cell_corner(model, c, q) / 8.0;
-    for (const CellFace& f : cells.faces[c])
-      for (const auto& t : face_triangles(f.nodes, coords)) cell.triangles.push_back({coords[t[0]], coords[t[1]], coords[t[2]]});
+    for (int64_t f = cells.face_begin(c); f < cells.face_end(c); ++f)
+      for (const auto& t : face_triangles(cells.face_nodes(f), coords))
+        cell.triangles.push_back({coords[t[0]], coords[t[1]], coords[t[2]]});
     cells_.push_back(std::move(cell));
   }
   index_buckets();
@@ -400,8 +397,9 @@ CavitySet build_corner_point_cavities(const CaseSpec& cs, const CornerPointModel
     while (!stack.empty()) {
       const int32_t c = stack.back();
       stack.pop_back();
-      for (int32_t nb : cells.neighbour[c])
-        if (nb >= 0 && cells.meshed[nb] && !active[nb] && comp[nb] < 0) comp[nb] = n_comp, stack.push_back(nb);
+      for (int64_t f = cells.face_begin(c); f < cells.face_end(c); ++f)
+        if (const int32_t nb = cells.neighbour[f]; nb >= 0 && cells.meshed[nb] && !active[nb] && comp[nb] < 0)
+          comp[nb] = n_comp, stack.push_back(nb);
     }
     ++n_comp;
   }

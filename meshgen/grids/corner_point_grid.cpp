@@ -68,22 +68,17 @@ class CornerPointMesher {
   // Every meshed cell's faces (outward), each with the model cell across it (-1: none).
   CornerPointCellFaces cell_faces(int32_t boundary_patch) {
     const int n = m_.nx * m_.ny * m_.nz;
-    CornerPointCellFaces out;
-    out.faces.assign(n, {});
-    out.neighbour.assign(n, {});
-    group_.assign(n, {});
+    staged_ = {};
     groups_.clear();
-    for (size_t p = 0; p < pairs_.size(); ++p) pair_faces(static_cast<int>(p), boundary_patch, out.faces, out.neighbour);
-    const bool flip = left_handed();
-    for (int c = 0; c < n; ++c) {
-      if (!meshed_[c]) continue;
-      top_bottom_faces(c, boundary_patch, out.faces[c], out.neighbour[c]);
-      if (flip)
-        for (CellFace& f : out.faces[c]) std::reverse(f.nodes.begin(), f.nodes.end());
-    }
-    if (flip)
+    for (size_t p = 0; p < pairs_.size(); ++p) pair_faces(static_cast<int>(p), boundary_patch);
+    for (int c = 0; c < n; ++c)
+      if (meshed_[c]) top_bottom_faces(c, boundary_patch);
+    CornerPointCellFaces out = by_cell(n);
+    if (left_handed()) {
+      for (size_t f = 0; f + 1 < out.node_start.size(); ++f)
+        std::reverse(out.nodes.begin() + out.node_start[f], out.nodes.begin() + out.node_start[f + 1]);
       for (auto& g : groups_) std::reverse(g.begin(), g.end());
-    out.group = std::move(group_);
+    }
     out.groups = std::move(groups_);
     out.meshed = meshed_;
     out.zero_volume_cells = zero_volume_;
@@ -93,14 +88,55 @@ class CornerPointMesher {
   }
 
  private:
+  // The faces in the order they are made (pillar pairs, then tops and bottoms), each with its cell.
+  struct Staged {
+    std::vector<int32_t> cell, patch, neighbour, group;
+    std::vector<int64_t> node_start{0};
+    std::vector<int32_t> nodes;
+  };
+  void stage(int32_t c, const int32_t* v, size_t count, int32_t patch, int32_t across, int32_t group) {
+    staged_.cell.push_back(c);
+    staged_.patch.push_back(patch);
+    staged_.neighbour.push_back(across);
+    staged_.group.push_back(group);
+    staged_.nodes.insert(staged_.nodes.end(), v, v + count);
+    staged_.node_start.push_back(static_cast<int64_t>(staged_.nodes.size()));
+  }
+  // The staged faces grouped by cell, each cell's in the order they were made (a stable counting sort).
+  CornerPointCellFaces by_cell(int n) {
+    CornerPointCellFaces out;
+    const size_t nf = staged_.cell.size();
+    out.cell_start.assign(static_cast<size_t>(n) + 1, 0);
+    for (int32_t c : staged_.cell) ++out.cell_start[c + 1];
+    for (int c = 0; c < n; ++c) out.cell_start[c + 1] += out.cell_start[c];
+    std::vector<int64_t> slot(nf), next(out.cell_start.begin(), out.cell_start.end() - 1);
+    for (size_t f = 0; f < nf; ++f) slot[f] = next[staged_.cell[f]]++;
+    out.patch.resize(nf), out.neighbour.resize(nf), out.group.resize(nf);
+    std::vector<int64_t> size(nf + 1, 0);
+    for (size_t f = 0; f < nf; ++f) {
+      out.patch[slot[f]] = staged_.patch[f];
+      out.neighbour[slot[f]] = staged_.neighbour[f];
+      out.group[slot[f]] = staged_.group[f];
+      size[slot[f] + 1] = staged_.node_start[f + 1] - staged_.node_start[f];
+    }
+    for (size_t f = 0; f < nf; ++f) size[f + 1] += size[f];
+    out.node_start = std::move(size);
+    out.nodes.resize(staged_.nodes.size());
+    for (size_t f = 0; f < nf; ++f)
+      std::copy(staged_.nodes.begin() + staged_.node_start[f], staged_.nodes.begin() + staged_.node_start[f + 1],
+                out.nodes.begin() + out.node_start[slot[f]]);
+    staged_ = {};
+    return out;
+  }
+
   const CornerPointModel& m_;
   MeshBuilder& b_;
+  Staged staged_;
   std::vector<char> meshed_;
   int64_t zero_volume_ = 0, fault_faces_ = 0, crossings_ = 0;
   std::vector<std::vector<double>> pillar_depth_;
   std::vector<std::vector<int32_t>> pillar_node_;
   std::vector<PillarPair> pairs_;
-  std::vector<std::vector<int32_t>> group_;   // per cell and face: its split group, -1 none
   std::vector<std::vector<int32_t>> groups_;  // the cycle each split group fans
   std::map<std::array<int32_t, 4>, int32_t> face_centre_;
   std::vector<Band> band_;  // per cell and side (4 c + side): its top and bottom line on that pillar pair  // centre node of a split top/bottom face, by its corners
@@ -385,8 +421,7 @@ class CornerPointMesher {
     return g;
   }
 
-  void pair_faces(int p, int32_t boundary_patch, std::vector<std::vector<CellFace>>& faces,
-                  std::vector<std::vector<int32_t>>& neighbour) {
+  void pair_faces(int p, int32_t boundary_patch) {
     const PillarPair& pp = pairs_[p];
     const bool is_i = p < n_ipairs();
     // Side A: the column on the -i (-j) side, whose +i (+j) face lies here; B: the other.
@@ -418,14 +453,11 @@ class CornerPointMesher {
                    const std::array<int32_t, 4>& corner, Vec3 centre, int32_t across) {
       if (c_is_a != is_i) std::reverse(poly.begin(), poly.end());
       if (split) {
-        split_face(poly, corner, centre, patch, faces[c]);
-        group_[c].resize(faces[c].size(), static_cast<int32_t>(groups_.size()));
-        groups_.push_back(poly);
+        split_face(c, poly, corner, centre, patch, across, static_cast<int32_t>(groups_.size()));
+        groups_.push_back(std::move(poly));
       } else {
-        faces[c].push_back(CellFace{std::move(poly), patch});
+        stage(c, poly.data(), poly.size(), patch, across, -1);
       }
-      group_[c].resize(faces[c].size(), -1);
-      neighbour[c].resize(faces[c].size(), across);
     };
     std::vector<Band> bands_b;
     for (int b : cb) bands_b.push_back(band(b, side_b));
@@ -469,7 +501,7 @@ class CornerPointMesher {
   // fan of the plain quad whatever the stations (the mesh's fan of a polygon turns about the mean of
   // all its nodes, which moves with them: on a thin twisted cell the top and bottom fans then crossed
   // and the volume came out negative).
-  void top_bottom_faces(int c, int32_t boundary_patch, std::vector<CellFace>& faces, std::vector<int32_t>& neighbour) {
+  void top_bottom_faces(int c, int32_t boundary_patch) {
     struct Edge {
       int side;
       bool forward;  // s from 0 to 1
@@ -505,9 +537,7 @@ class CornerPointMesher {
         if (same) patch = kInteriorFace, across = o;
       }
       if (face.size() == 4) {
-        faces.push_back(CellFace{std::move(face), patch});
-        neighbour.resize(faces.size(), across);
-        group_[c].resize(faces.size(), -1);
+        stage(c, face.data(), face.size(), patch, across, -1);
         continue;
       }
       static const int kQuad[2][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}};
@@ -518,22 +548,22 @@ class CornerPointMesher {
         corner[e] = pillar_node(pillar_of(c, q), corner_depth(m_, c, q));
         centre += corner_point(c, q);
       }
-      split_face(face, corner, centre / 4.0, patch, faces);
-      neighbour.resize(faces.size(), across);
-      group_[c].resize(faces.size(), static_cast<int32_t>(groups_.size()));
-      groups_.push_back(face);
+      split_face(c, face, corner, centre / 4.0, patch, across, static_cast<int32_t>(groups_.size()));
+      groups_.push_back(std::move(face));
     }
   }
 
   // A cell face (4 corners) whose cycle has more nodes than its corners, as the triangles from its
   // centre (one node per face, found by its corners) to each of its edges.
-  void split_face(const std::vector<int32_t>& cycle, std::array<int32_t, 4> corner, Vec3 centre, int32_t patch,
-                  std::vector<CellFace>& faces) {
+  void split_face(int32_t c, const std::vector<int32_t>& cycle, std::array<int32_t, 4> corner, Vec3 centre,
+                  int32_t patch, int32_t across, int32_t group) {
     std::sort(corner.begin(), corner.end());
     auto [it, added] = face_centre_.emplace(corner, -1);
     if (added) it->second = b_.add_node(centre);
-    for (size_t e = 0; e < cycle.size(); ++e)
-      faces.push_back(CellFace{{it->second, cycle[e], cycle[(e + 1) % cycle.size()]}, patch});
+    for (size_t e = 0; e < cycle.size(); ++e) {
+      const int32_t tri[3] = {it->second, cycle[e], cycle[(e + 1) % cycle.size()]};
+      stage(c, tri, 3, patch, across, group);
+    }
   }
 };
 
@@ -650,16 +680,13 @@ std::vector<std::array<int32_t, 3>> face_triangles(const std::vector<int32_t>& c
 std::vector<CavityTriangle> cavity_triangles(const CornerPointCellFaces& cells, int c, const std::vector<char>& active,
                                              const std::vector<Vec3>& coords) {
   std::vector<CavityTriangle> out;
-  for (size_t f = 0; f < cells.faces[c].size(); ++f) {
-    const int32_t nb = cells.neighbour[c][f], g = cells.group[c][f];
+  for (int64_t f = cells.face_begin(c); f < cells.face_end(c); ++f) {
+    const int32_t nb = cells.neighbour[f];
     if (nb < 0 || active[nb]) continue;
     // A fanned face (split_face) is triangulated from its cycle, once, without the fan's centre: a
     // centre node in the middle of a cavity wall lies in the spheres of the triangles beside it.
-    bool seen = false;
-    for (size_t e = 0; e < f && g >= 0 && !seen; ++e) seen = cells.group[c][e] == g;
-    if (seen) continue;
-    const std::vector<int32_t>& cycle = g >= 0 ? cells.groups[g] : cells.faces[c][f].nodes;
-    for (const auto& t : face_triangles(cycle, coords)) out.push_back({{t[0], t[1], t[2]}, nb});
+    if (!cells.first_of_its_group(c, f)) continue;
+    for (const auto& t : face_triangles(cells.cycle(f), coords)) out.push_back({{t[0], t[1], t[2]}, nb});
   }
   return out;
 }
@@ -670,15 +697,15 @@ namespace {
 // counted once (by the first), every other face once (one toward a cavity becomes a few triangles).
 BuilderCapacity corner_point_capacity(const CornerPointCellFaces& cells, const std::vector<char>& active) {
   BuilderCapacity c;
-  for (size_t m = 0; m < cells.faces.size(); ++m) {
+  for (int64_t m = 0; m < cells.n_cells(); ++m) {
     if (!cells.meshed[m] || !active[m]) continue;
     ++c.cells;
-    for (size_t f = 0; f < cells.faces[m].size(); ++f) {
-      const int32_t nb = cells.neighbour[m][f];
+    for (int64_t f = cells.face_begin(m); f < cells.face_end(m); ++f) {
+      const int32_t nb = cells.neighbour[f];
       const bool shared = nb >= 0 && cells.meshed[nb] && active[nb];
-      if (shared && nb < static_cast<int32_t>(m)) continue;  // the face is the first cell's
+      if (shared && nb < m) continue;  // the face is the first cell's
       ++c.faces;
-      c.face_nodes += cells.faces[m][f].nodes.size();
+      c.face_nodes += cells.nodes_end(f) - cells.nodes_begin(f);
     }
   }
   return c;
@@ -708,9 +735,14 @@ CornerPointCells add_corner_point_cells(const CornerPointModel& model, const Cor
       if (k == faces.size()) faces.emplace_back();
       return faces[k++];
     };
-    for (size_t f = 0; f < cells.faces[c].size(); ++f) {
-      const int32_t nb = cells.neighbour[c][f];
-      if (!(nb >= 0 && !active[nb])) next() = cells.faces[c][f];
+    for (int64_t f = cells.face_begin(c); f < cells.face_end(c); ++f) {
+      const int32_t nb = cells.neighbour[f];
+      if (nb >= 0 && !active[nb]) continue;
+      CellFace& face = next();
+      face.nodes.assign(cells.nodes_begin(f), cells.nodes_end(f));
+      face.patch = cells.patch[f];
+      face.known_face = -1;
+      face.by_id_only = false;
     }
     for (CavityTriangle& t : cavity_triangles(cells, c, active, coords))  // toward a cavity
       next() = CellFace{std::move(t.nodes), kInteriorFace};

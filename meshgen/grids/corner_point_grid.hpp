@@ -20,18 +20,38 @@ struct CornerPointCells {
   int64_t crossing_nodes = 0;    ///< nodes where an edge of one side of a pillar pair crosses one of the other
 };
 
-/// The faces of a model's cells before they are added (the nodes are): per model cell (natural
-/// order) its outward faces as add_corner_point_cells makes them, and per face the model cell
-/// across it (-1: none, a boundary face). Cells with present[c] == 0 take no part (gaps).
+/// The faces of a model's cells before they are added (the nodes are), in flat arrays: per model
+/// cell (natural order) its outward faces as add_corner_point_cells makes them, and per face the
+/// model cell across it (-1: none, a boundary face). Cells with present[c] == 0 take no part (gaps).
+/// Flat because a refined model has millions of cells: one heap vector per face cost 700 bytes per
+/// cell (docs/performance.md, "Session 32").
 struct CornerPointCellFaces {
-  std::vector<std::vector<CellFace>> faces;
-  std::vector<std::vector<int32_t>> neighbour;
-  /// Per face: the split group it belongs to (a face fanned about its centre node), -1 none; and per
-  /// group the cycle it fans (outward for its cell).
-  std::vector<std::vector<int32_t>> group;
+  std::vector<int64_t> cell_start;  ///< n_cells + 1: cell c's faces are f in [cell_start[c], cell_start[c + 1])
+  std::vector<int64_t> node_start;  ///< n_faces + 1: face f's nodes are nodes[node_start[f] .. node_start[f + 1])
+  std::vector<int32_t> nodes;       ///< builder node ids, each face outward for its cell
+  std::vector<int32_t> patch;       ///< n_faces: kInteriorFace or the boundary patch
+  std::vector<int32_t> neighbour;   ///< n_faces: the model cell across, -1 none
+  /// n_faces: the split group a face belongs to (a face fanned about its centre node), -1 none; and
+  /// per group the cycle it fans (outward for its cell).
+  std::vector<int32_t> group;
   std::vector<std::vector<int32_t>> groups;
   std::vector<char> meshed;  ///< per model cell: present, active and of non-zero thickness
   int64_t zero_volume_cells = 0, fault_faces = 0, crossing_nodes = 0;
+
+  int64_t n_cells() const { return static_cast<int64_t>(cell_start.size()) - 1; }
+  int64_t face_begin(int64_t c) const { return cell_start[c]; }
+  int64_t face_end(int64_t c) const { return cell_start[c + 1]; }
+  const int32_t* nodes_begin(int64_t f) const { return nodes.data() + node_start[f]; }
+  const int32_t* nodes_end(int64_t f) const { return nodes.data() + node_start[f + 1]; }
+  std::vector<int32_t> face_nodes(int64_t f) const { return {nodes_begin(f), nodes_end(f)}; }
+  /// False for a triangle of a fanned face after the fan's first: the fan's cycle is taken once.
+  bool first_of_its_group(int64_t c, int64_t f) const {
+    for (int64_t e = face_begin(c); e < f && group[f] >= 0; ++e)
+      if (group[e] == group[f]) return false;
+    return true;
+  }
+  /// Face f's cycle, or its group's when it is one triangle of a fanned face.
+  std::vector<int32_t> cycle(int64_t f) const { return group[f] >= 0 ? groups[group[f]] : face_nodes(f); }
 };
 
 /// Corner q (bit 0 +i, bit 1 +j, bit 2 +k) of model cell c as meshed: on its pillar at its ZCORN depth.

@@ -127,11 +127,12 @@ FaceMultipliers face_multipliers(const PolyMesh& mesh, const CornerPointModel& m
   }
   out.edit_nnc_pairs_on_faces = static_cast<int64_t>(edited.size());
   if (cells != nullptr)
-    for (size_t c = 0; c < cells->faces.size(); ++c) {
+    for (int64_t c = 0; c < cells->n_cells(); ++c) {
       if (!cells->meshed[c] || active[c]) continue;
-      for (int32_t b : cells->neighbour[c]) {
-        if (b <= static_cast<int32_t>(c) || !cells->meshed[b] || active[b]) continue;
-        const double m = connection_multiplier(model, static_cast<int64_t>(c), b);
+      for (int64_t f = cells->face_begin(c); f < cells->face_end(c); ++f) {
+        const int32_t b = cells->neighbour[f];
+        if (b <= c || !cells->meshed[b] || active[b]) continue;
+        const double m = connection_multiplier(model, c, b);
         if (m == 1.0) continue;
         ++out.inside_cavities;
         out.inside_min = std::min(out.inside_min, m);

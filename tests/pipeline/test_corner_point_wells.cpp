@@ -185,16 +185,13 @@ void expect_sound_mesh(const CaseSpec& cs, const HybridMesh& out) {
   };
   double bent_volume = 0;
   for (int32_t c : dead_cells)
-    for (size_t k = 0; k < model_faces.faces[c].size(); ++k) {
-      if (model_faces.neighbour[c][k] >= 0) continue;
-      const int32_t g = model_faces.group[c][k];
-      bool seen = false;
-      for (size_t e = 0; e < k && g >= 0; ++e) seen = seen || model_faces.group[c][e] == g;
-      if (seen) continue;
-      const std::vector<int32_t>& cycle = g >= 0 ? model_faces.groups[g] : model_faces.faces[c][k].nodes;
+    for (int64_t k = model_faces.face_begin(c); k < model_faces.face_end(c); ++k) {
+      if (model_faces.neighbour[k] >= 0 || !model_faces.first_of_its_group(c, k)) continue;
+      const int32_t g = model_faces.group[k];
+      const std::vector<int32_t> cycle = model_faces.cycle(k);
       const Vec3 o = builder_coords[cycle[0]];
-      for (size_t e = 0; e < model_faces.faces[c].size(); ++e)  // the face, or every face of its fan
-        if (e == k || (g >= 0 && model_faces.group[c][e] == g)) bent_volume += fan_volume(model_faces.faces[c][e].nodes, o);
+      for (int64_t e = model_faces.face_begin(c); e < model_faces.face_end(c); ++e)  // the face, or every face of its fan
+        if (e == k || (g >= 0 && model_faces.group[e] == g)) bent_volume += fan_volume(model_faces.face_nodes(e), o);
       for (const auto& t : face_triangles(cycle, builder_coords)) {
         bent_volume -= fan_volume({t[0], t[1], t[2]}, o);
         ++surface_found;
@@ -627,8 +624,8 @@ TEST(CornerPointWells, CavityAcrossAZeroThicknessLayerIsMadeAManifold) {
   while (!stack.empty()) {
     const int32_t c = stack.back();
     stack.pop_back();
-    for (int32_t nb : cells.neighbour[c])
-      if (nb >= 0 && !active[nb] && reached.insert(nb).second) stack.push_back(nb);
+    for (int64_t f = cells.face_begin(c); f < cells.face_end(c); ++f)
+      if (const int32_t nb = cells.neighbour[f]; nb >= 0 && !active[nb] && reached.insert(nb).second) stack.push_back(nb);
   }
   EXPECT_EQ(reached.size(), dead.size());
   std::printf("[ figures  ] two cells meeting at an edge across a zero-thickness layer: %d cells added, %zu deactivated\n",
