@@ -128,6 +128,19 @@ StageUse run_fvcheck_binary(const std::string& vtu, bool* ok) {
   return u;
 }
 
+// Where a run writes its VTU (removed after it).
+std::string scratch_vtu_path() {
+  return (std::filesystem::temp_directory_path() / ("hm_bench_" + std::to_string(getpid()) + ".vtu")).string();
+}
+
+// Seconds of the transition builds (Delaunay + sites + power diagram) and of the optimisation, summed
+// over the cavities: each cavity runs on one thread, so the sums are CPU seconds.
+void transition_seconds(const hm::HybridMesh& h, double* build_s, double* optimize_s) {
+  *build_s = *optimize_s = 0;
+  for (const hm::TransitionReport& r : h.transition_reports)
+    *build_s += r.seconds_delaunay + r.seconds_sites + r.seconds_power, *optimize_s += r.seconds_optimize;
+}
+
 void run_case(int lateral) {
   const hm::CaseSpec cs = hm::bench::scaling_case(lateral);
   StageMeter meter;
@@ -144,7 +157,7 @@ void run_case(int lateral) {
   }
   const double mesh_s = since(t0);
   Clock::time_point t1 = Clock::now();
-  const std::string vtu = (std::filesystem::temp_directory_path() / ("hm_bench_" + std::to_string(getpid()) + ".vtu")).string();
+  const std::string vtu = scratch_vtu_path();
   const hm::WriteStatus st = hm::write_vtu(vtu, h.mesh);
   const double vtu_s = since(t1);
   meter.mark("write_vtu");
@@ -160,8 +173,7 @@ void run_case(int lateral) {
   else std::filesystem::remove(vtu, ec);
   double transition_s = 0, optimize_s = 0, check_s = 0;
   int tcells = 0;
-  for (const hm::TransitionReport& r : h.transition_reports)
-    transition_s += r.seconds_delaunay + r.seconds_sites + r.seconds_power, optimize_s += r.seconds_optimize;
+  transition_seconds(h, &transition_s, &optimize_s);
   for (const auto& [stage, s] : h.timings_s)
     if (stage == "self_check") check_s = s;
   // The same sites again (the transition meshes are deterministic) for raw CGAL.
@@ -210,7 +222,7 @@ ChildRun run_in_child(const hm::CaseSpec& cs) {
     opts.on_stage = [&](const std::string& stage) { meter.mark(stage); };
     try {
       const hm::HybridMesh h = hm::build_hybrid_mesh(cs, opts);
-      const std::string vtu = (std::filesystem::temp_directory_path() / ("hm_bench_" + std::to_string(getpid()) + ".vtu")).string();
+      const std::string vtu = scratch_vtu_path();
       const hm::WriteStatus st = hm::write_vtu(vtu, h.mesh);
       meter.mark("write_vtu");
       std::error_code ec;
@@ -218,11 +230,8 @@ ChildRun run_in_child(const hm::CaseSpec& cs) {
       if (!st.ok) throw std::runtime_error("write_vtu: " + st.message);
       std::fprintf(out, "cells %d\n", h.mesh.n_cells());
       for (const StageUse& u : meter.uses) std::fprintf(out, "%s %.6f %.6f %.1f\n", u.stage.c_str(), u.wall, u.cpu, u.peak_mb);
-      // Inside the cavities' stage: each cavity's transition build and optimisation run on one
-      // thread, so their seconds summed over the cavities are CPU seconds.
       double build_s = 0, optimize_s = 0;
-      for (const hm::TransitionReport& r : h.transition_reports)
-        build_s += r.seconds_delaunay + r.seconds_sites + r.seconds_power, optimize_s += r.seconds_optimize;
+      transition_seconds(h, &build_s, &optimize_s);
       std::fprintf(out, "split %.6f %.6f\n", build_s, optimize_s);
     } catch (const std::exception& e) {
       std::fprintf(out, "failed %s\n", e.what());
@@ -260,7 +269,6 @@ double cpu_of(const ChildRun& r, const std::string& stage) {
 // without wells) and added per well ((with - without) / 10).
 void run_per_well(const std::vector<int>& laterals) {
   constexpr int kWells = 10;
-  std::vector<std::string> stages;
   std::printf("10 x 10 x 5 m cells, 20 layers, 0 and %d wells (the same wells at every size); CPU seconds\n", kWells);
   for (int n : laterals) {
     const ChildRun bare = run_in_child(hm::bench::fixed_cell_case(n, 0));

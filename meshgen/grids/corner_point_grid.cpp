@@ -112,15 +112,14 @@ class CornerPointMesher {
     std::vector<int64_t> slot(nf), next(out.cell_start.begin(), out.cell_start.end() - 1);
     for (size_t f = 0; f < nf; ++f) slot[f] = next[staged_.cell[f]]++;
     out.patch.resize(nf), out.neighbour.resize(nf), out.group.resize(nf);
-    std::vector<int64_t> size(nf + 1, 0);
+    out.node_start.assign(nf + 1, 0);  // face sizes, then their running sums
     for (size_t f = 0; f < nf; ++f) {
       out.patch[slot[f]] = staged_.patch[f];
       out.neighbour[slot[f]] = staged_.neighbour[f];
       out.group[slot[f]] = staged_.group[f];
-      size[slot[f] + 1] = staged_.node_start[f + 1] - staged_.node_start[f];
+      out.node_start[slot[f] + 1] = staged_.node_start[f + 1] - staged_.node_start[f];
     }
-    for (size_t f = 0; f < nf; ++f) size[f + 1] += size[f];
-    out.node_start = std::move(size);
+    for (size_t f = 0; f < nf; ++f) out.node_start[f + 1] += out.node_start[f];
     out.nodes.resize(staged_.nodes.size());
     for (size_t f = 0; f < nf; ++f)
       std::copy(staged_.nodes.begin() + staged_.node_start[f], staged_.nodes.begin() + staged_.node_start[f + 1],
