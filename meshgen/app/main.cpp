@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
     }
     // Mesh in the local frame (local_frame.hpp); the user's coordinates come back when writing.
     origin = hm::case_origin(cs);
-    result = hm::build_hybrid_mesh(hm::translated_case(cs, -origin), opts);
+    result = hm::build_hybrid_mesh_in_local_frame(cs, opts);
   } catch (const hm::InputError& e) {
     std::cerr << "meshgen: " << e.what() << "\n";
     return 2;

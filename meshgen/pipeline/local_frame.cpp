@@ -1,5 +1,7 @@
 #include "local_frame.hpp"
 
+#include <cmath>
+
 #include "meshgen/case/grdecl.hpp"
 
 namespace hm {
@@ -14,11 +16,48 @@ CaseSpec translated_case(const CaseSpec& cs, Vec3 shift) {
   for (double& v : out.reservoir.x) v += shift.x;
   for (double& v : out.reservoir.y) v += shift.y;
   for (double& v : out.reservoir.z) v += shift.z;
-  if (cs.reservoir.corner_point)
+  if (cs.reservoir.corner_point && !(shift == Vec3{}))
     out.reservoir.corner_point = std::make_shared<const CornerPointModel>(translated_model(*cs.reservoir.corner_point, shift));
   for (WellSpec& w : out.wells)
     for (Vec3& p : w.trajectory) p += shift;
   return out;
+}
+
+bool translation_round_trips(const CornerPointModel& m, Vec3 shift) {
+  // Equal and of the same sign: -0 comes back as +0.
+  auto back = [](double v, double s) {
+    const double w = (v + s) - s;
+    return w == v && std::signbit(w) == std::signbit(v);
+  };
+  for (size_t p = 0; p < m.coord.size(); p += 3)
+    if (!back(m.coord[p], shift.x) || !back(m.coord[p + 1], shift.y) || !back(m.coord[p + 2], shift.z)) return false;
+  for (double z : m.zcorn)
+    if (!back(z, shift.z)) return false;
+  for (const auto& cell : m.corners)
+    for (const Vec3& p : cell)
+      if (!back(p.x, shift.x) || !back(p.y, shift.y) || !back(p.z, shift.z)) return false;
+  return true;
+}
+
+HybridMesh build_hybrid_mesh_in_local_frame(CaseSpec& cs, const PipelineOptions& opts) {
+  const Vec3 origin = case_origin(cs);
+  const CaseSpec local = translated_case(cs, -origin);
+  std::shared_ptr<const CornerPointModel>& user_model = cs.reservoir.corner_point;
+  const bool hold_once = user_model && user_model != local.reservoir.corner_point && user_model.use_count() == 1 &&
+                         translation_round_trips(*user_model, -origin);
+  if (hold_once) user_model.reset();
+  auto give_back = [&] {
+    if (hold_once)
+      user_model = std::make_shared<const CornerPointModel>(translated_model(*local.reservoir.corner_point, origin));
+  };
+  try {
+    HybridMesh h = build_hybrid_mesh(local, opts);
+    give_back();
+    return h;
+  } catch (...) {
+    give_back();
+    throw;
+  }
 }
 
 void translate_mesh(PolyMesh& mesh, Vec3 shift) {

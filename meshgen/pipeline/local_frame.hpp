@@ -6,14 +6,28 @@
 #pragma once
 #include "meshgen/case/case.hpp"
 #include "meshgen/core/polymesh.hpp"
+#include "meshgen/pipeline/hybrid_mesh.hpp"
 
 namespace hm {
 
 /// The reservoir's min corner in plan, (x[0], y[0], 0): depth is not moved.
 Vec3 case_origin(const CaseSpec& cs);
 
-/// cs with every coordinate (reservoir axes, trajectory points) plus `shift`.
+/// cs with every coordinate (reservoir axes, trajectory points) plus `shift`. A zero shift shares
+/// the corner-point model with cs instead of copying it.
 CaseSpec translated_case(const CaseSpec& cs, Vec3 shift);
+
+/// Whether moving the model's coordinates by `shift` and back gives each of them bit for bit:
+/// (v + s) - s is v, the sign of a zero included, for every COORD, ZCORN and corner value. Field
+/// coordinates within a factor 2 of the shift do (Sterbenz's lemma), as UTM models' are.
+bool translation_round_trips(const CornerPointModel& m, Vec3 shift);
+
+/// What meshgen does: meshes cs in its local frame (build_hybrid_mesh on translated_case(cs,
+/// -case_origin(cs))); the mesh comes back in the local frame. A large corner-point model is held
+/// once, not twice, meanwhile: when cs holds the only reference to it and the translation round-trips
+/// (so the deck still gets the user's own numbers), cs's copy is released while meshing and made
+/// again from the local one afterwards. cs is as given on return, also when meshing throws.
+HybridMesh build_hybrid_mesh_in_local_frame(CaseSpec& cs, const PipelineOptions& opts = {});
 
 /// Moves every position of the mesh by `shift`: nodes, FV centres, end-cap centres. Everything
 /// else in a PolyMesh (topology, permeability, radii, lengths) does not depend on the frame.

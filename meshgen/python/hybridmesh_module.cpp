@@ -252,7 +252,7 @@ PYBIND11_MODULE(hybridmesh, mod) {
         // As meshgen: mesh in the local frame (meshgen/pipeline/local_frame.hpp), then give the mesh and its
         // geometry back in the case's coordinates.
         const hm::Vec3 origin = hm::case_origin(cs);
-        m->result = hm::build_hybrid_mesh(hm::translated_case(cs, -origin), opts);
+        m->result = hm::build_hybrid_mesh_in_local_frame(m->cs, opts);
         hm::translate_mesh(m->result.mesh, origin);
         for (hm::Vec3& p : m->result.geometry.face_centroid) p += origin;
         for (hm::Vec3& p : m->result.geometry.cell_centroid) p += origin;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -20,6 +21,7 @@
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/grids/corner_point_multipliers.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 
 using namespace hm;
 namespace fs = std::filesystem;
@@ -554,6 +556,41 @@ TEST(CornerPoint, TranslatedModelMeshesToTheSameCells) {
   EXPECT_EQ(out.mesh.face_nodes, r.out.mesh.face_nodes);
   for (int c = 0; c < out.mesh.n_cells(); ++c)
     ASSERT_NEAR(out.geometry.cell_volume[c] / r.out.geometry.cell_volume[c], 1.0, 1e-9) << c;
+}
+
+// meshgen meshes a field model in its local frame holding it once (build_hybrid_mesh_in_local_frame):
+// the user's copy is released and made again from the local one, so it must come back bit for bit,
+// and a shift that does not round-trip must keep the user's copy itself. Both meshes are the local
+// frame's.
+TEST(CornerPoint, MeshingInTheLocalFrameGivesTheUsersModelBackBitForBit) {
+  TempDir tmp;
+  const CpgRun r = mesh_of(tmp, SyntheticCpg{}.text());
+  auto same_bits = [](const std::vector<double>& a, const std::vector<double>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+  };
+  int released = 0, kept = 0;
+  for (const Vec3 shift : {Vec3{456000, 5926000, 0}, Vec3{0.1, 0.3, 0}}) {
+    CaseSpec field = translated_case(r.cs, shift);
+    const CornerPointModel given = *field.reservoir.corner_point;  // a deep copy to compare with
+    const CornerPointModel* const users = field.reservoir.corner_point.get();
+    const bool round_trips = translation_round_trips(given, -1.0 * case_origin(field));
+    (round_trips ? released : kept) += 1;
+    const HybridMesh h = build_hybrid_mesh_in_local_frame(field);
+    const CornerPointModel& back = *field.reservoir.corner_point;
+    if (!round_trips) {
+      EXPECT_EQ(&back, users) << "a model that does not round-trip was copied back";
+    }
+    EXPECT_TRUE(same_bits(back.coord, given.coord)) << shift.x;
+    EXPECT_TRUE(same_bits(back.zcorn, given.zcorn)) << shift.x;
+    ASSERT_EQ(back.corners.size(), given.corners.size());
+    EXPECT_EQ(std::memcmp(back.corners.data(), given.corners.data(), given.corners.size() * sizeof(given.corners[0])), 0);
+    EXPECT_TRUE(same_bits(back.permx, given.permx) && same_bits(back.poro, given.poro));
+    EXPECT_EQ(back.actnum, given.actnum);
+    ASSERT_EQ(h.mesh.n_cells(), r.out.mesh.n_cells()) << shift.x;
+    EXPECT_EQ(h.mesh.face_nodes, r.out.mesh.face_nodes) << shift.x;
+  }
+  EXPECT_EQ(released, 1) << "UTM offsets should round-trip: the release is not tested";
+  EXPECT_EQ(kept, 1) << "offsets of 0.1 m should not round-trip on every value: the fallback is not tested";
 }
 
 // Bad geometry and wells: input errors naming the key and the reason (exit 2).

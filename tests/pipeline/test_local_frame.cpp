@@ -17,10 +17,10 @@ using namespace hm;
 namespace {
 
 // What meshgen does: move the case to its local frame, mesh it there.
-HybridMesh mesh_like_meshgen(const CaseSpec& cs, bool optimize = true) {
+HybridMesh mesh_like_meshgen(CaseSpec cs, bool optimize = true) {
   PipelineOptions opts;
   opts.optimize = optimize;
-  return build_hybrid_mesh(translated_case(cs, -case_origin(cs)), opts);
+  return build_hybrid_mesh_in_local_frame(cs, opts);
 }
 
 double diagonal(const CaseSpec& cs) {
