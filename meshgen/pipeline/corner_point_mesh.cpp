@@ -16,6 +16,7 @@
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
 #include "meshgen/grids/corner_point_multipliers.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "meshgen/core/two_point.hpp"
 #include "perforations.hpp"
 #include "transition_assembly.hpp"
@@ -357,6 +358,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   if (out.build_report.ok) apply_model_multipliers(out, model, &faces, out.cavities.reservoir_active, coords);
   attach_deck_nncs(out, model);
   attach_minpv_connections(out, model);
+  round_to_written_frame(out.mesh, opts.written_origin);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   std::vector<int> all_wells(nw);
@@ -394,6 +396,7 @@ HybridMesh build_corner_point_mesh(const CaseSpec& cs, const PipelineOptions& op
   if (out.build_report.ok) apply_model_multipliers(out, model, nullptr, all_present(model), {});
   attach_deck_nncs(out, model);
   attach_minpv_connections(out, model);
+  round_to_written_frame(out.mesh, opts.written_origin);
   out.geometry = compute_geometry(out.mesh);
   stage.mark("assembly_geometry");
   if (cells.zero_volume_cells > 0)

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "meshgen/core/progress.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "perforations.hpp"
 #include "transition_assembly.hpp"
 
@@ -352,6 +353,7 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
       builder, out.transition_reports);
   out.mesh = builder.finish(&out.build_report);
   fill_cell_maps(out, maps);
+  round_to_written_frame(out.mesh, opts.written_origin);
   out.geometry = compute_geometry(out.mesh);
   assembly_progress.reset();
   timer.mark("assembly_geometry");

@@ -24,6 +24,11 @@ struct PipelineOptions {
   bool build_transition = true;  ///< false: stop after the cavities (the mesh then has open cavity faces)
   bool optimize = true;          ///< run the small-edge optimisation when the case asks for it
   int threads = 0;               ///< cavities built at once (meshgen -j); 0: every core
+  /// The origin the writers add back (build_hybrid_mesh_in_local_frame sets it; local_frame.hpp): before
+  /// the geometry and the self-check, every position of the mesh is rounded to what it is once moved
+  /// there and back (round_to_written_frame), so that the self-check judges the coordinates the files
+  /// get. Zero: nothing is rounded.
+  Vec3 written_origin;
   /// Called at the end of each stage of HybridMesh::timings_s with its name (benchmarks
   /// sample memory there); may be empty.
   std::function<void(const std::string& stage)> on_stage;

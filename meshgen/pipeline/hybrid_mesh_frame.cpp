@@ -4,6 +4,7 @@
 #include <string>
 
 #include "hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "meshgen/pipeline/permeability_frame.hpp"
 
 namespace hm {
@@ -26,11 +27,14 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
     out.frame = frame;
     return out;
   }
-  HybridMesh out = build_hybrid_mesh_euclidean(scaled_case(cs, frame), opts);
+  PipelineOptions scaled_opts = opts;
+  scaled_opts.written_origin = Vec3{};  // the scaled frame's positions are not the written ones
+  HybridMesh out = build_hybrid_mesh_euclidean(scaled_case(cs, frame), scaled_opts);
   const auto t0 = std::chrono::steady_clock::now();
   out.frame = frame;
   const FrameUnmapper unmap(frame, cs.reservoir);
   unscale_mesh(out.mesh, unmap);
+  round_to_written_frame(out.mesh, opts.written_origin);
   out.geometry = compute_geometry(out.mesh);
   out.grid = make_reservoir_grid(cs.reservoir);
   for (Vec3& p : out.cavity_node_coords) p = unmap(p);

@@ -50,14 +50,25 @@ HybridMesh build_hybrid_mesh_in_local_frame(CaseSpec& cs, const PipelineOptions&
     if (hold_once)
       user_model = std::make_shared<const CornerPointModel>(translated_model(*local.reservoir.corner_point, origin));
   };
+  PipelineOptions written = opts;
+  written.written_origin = origin;
   try {
-    HybridMesh h = build_hybrid_mesh(local, opts);
+    HybridMesh h = build_hybrid_mesh(local, written);
     give_back();
     return h;
   } catch (...) {
     give_back();
     throw;
   }
+}
+
+void round_to_written_frame(PolyMesh& mesh, Vec3 origin) {
+  if (origin == Vec3{}) return;
+  auto round = [&](Vec3& p) { p = (p + origin) - origin; };
+  for (Vec3& p : mesh.nodes) round(p);
+  for (Vec3& p : mesh.cell_fv_center) round(p);
+  for (RadialCellInfo& r : mesh.cell_radial)
+    if (r.band >= 0) round(r.cap_center);
 }
 
 void translate_mesh(PolyMesh& mesh, Vec3 shift) {

@@ -226,12 +226,18 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
     optimization = optimize_sites(set, cavity, node_coords, frames, options, outside, out);
   }
   // The optimiser's removals need a Q_S gain: sliver edges it left are removed here too.
-  if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, out);
+  int repairs = 0;
+  if (images.empty()) {
+    sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, out);
+    // optimize_sites ends with the same repair rounds.
+    if (!optimize) repairs = repair_failing_cells(set, cavity, node_coords, frames, options, outside, out);
+  }
   if (raw) out.unoptimized = std::move(raw);
   // Merge the stage reports.
   TransitionReport& r = out.report;
   r.optimization = optimization;
   r.sliver_removals = sliver_removals;
+  r.repairs = repairs;
   r.seconds_optimize = optimize ? seconds(t3, Clock::now()) : 0.0;
   r.seconds_delaunay = seconds(t0, t1);
   r.seconds_sites = seconds(t1, t2);

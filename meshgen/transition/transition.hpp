@@ -63,6 +63,7 @@ struct TransitionReport {
   double seconds_optimize = 0;  ///< wall time of the site optimiser (0 when not run)
   SiteOptimizeReport optimization;
   int sliver_removals = 0;      ///< without optimisation: site moves that removed a sliver edge (docs/transition.md)
+  int repairs = 0;              ///< without optimisation: site moves that mended cells failing a shape check
 };
 
 /// Transition cells of one cavity, ready for the builder.

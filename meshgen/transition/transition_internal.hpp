@@ -267,6 +267,14 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                         const std::vector<Vec3>& outside_centres, TransitionCells& out);
+/// Without optimisation, after remove_sliver_edges: rounds of repairs of the cells failing a shape
+/// check of the self-check, while some fail and untried moves remain: the removal of a failing cell's
+/// edge between two free vertices shorter than G2 h (nearly co-spherical sites), or a step of its site
+/// or of a face neighbour's; each kept only if fewer cells around fail and none newly fails. Returns
+/// the moves kept.
+int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+                         const std::vector<Vec3>& outside_centres, TransitionCells& out);
 /// Per cavity face: the FV centre of the well cell beyond a well polygon; NaN for every other face.
 std::vector<Vec3> well_polygon_centres(const Cavity& cavity, const std::vector<WellBlock>& blocks);
 

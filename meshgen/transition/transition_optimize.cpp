@@ -281,13 +281,18 @@ void add_cell_and_neighbours(const PolyMesh& sub, int c, std::vector<int>& cells
   cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
 }
 
+// What a SiteOptimizer's rounds propose: every kind of move (optimize_sites), removals of sliver
+// edges alone (remove_sliver_edges), or repairs of cells failing a shape check alone
+// (repair_failing_cells).
+enum class Pass { Optimize, Slivers, Repairs };
+
 class SiteOptimizer {
  public:
   SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                 const std::vector<PolygonFrame>& frames, const std::vector<double>& h_ref,
-                const TransitionOptions& opt, const std::vector<Vec3>& outside_centres, bool slivers_only = false)
+                const TransitionOptions& opt, const std::vector<Vec3>& outside_centres, Pass pass = Pass::Optimize)
       : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt),
-        outside_centres_(outside_centres), slivers_only_(slivers_only) {}
+        outside_centres_(outside_centres), pass_(pass) {}
 
   // One round on `out` (a valid diagram of set_): true if some move was kept.
   // skew_only: only steps against skewed faces and repairs. Sets skewed_left() to the count on
@@ -376,9 +381,9 @@ class SiteOptimizer {
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   int skewed_left_ = 0;
   int proposed_last_ = 0;
-  // Only removals of sliver edges (below kSliverEdge h), kept unless a cell newly fails a
-  // shape check: the pass run on a diagram that is not optimised (remove_sliver_edges).
-  bool slivers_only_ = false;
+  // Pass::Slivers: only removals of sliver edges (below kSliverEdge h), kept unless a cell newly
+  // fails a shape check: the pass run on a diagram that is not optimised (remove_sliver_edges).
+  Pass pass_ = Pass::Optimize;
   std::optional<Measured> next_;  // the measurement of the diagram the last round left in `out`
 };
 
@@ -501,10 +506,17 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
       h = std::max(h, h_ref_[edge_cell[j][2]]), ++j;
     const int32_t a = edge_cell[i][0], b = edge_cell[i][1];
     const bool free_end = global[a] >= out.base_node_id || global[b] >= out.base_node_id;
+    const bool both_free = global[a] >= out.base_node_id && global[b] >= out.base_node_id;
     const double len = norm(sub.nodes[a] - sub.nodes[b]);
-    const bool wanted = slivers_only_ ? global[a] >= out.base_node_id && global[b] >= out.base_node_id &&
-                                            len < kSliverEdge * h
-                                      : free_end && len < opt_.g_expand * h;
+    bool of_failing_cell = false;
+    for (size_t k = i; k < j; ++k) of_failing_cell = of_failing_cell || now.failing.cell[edge_cell[k][2]];
+    bool wanted = false;
+    switch (pass_) {
+      case Pass::Optimize: wanted = free_end && len < opt_.g_expand * h; break;
+      case Pass::Slivers: wanted = both_free && len < kSliverEdge * h; break;
+      // A failing cell's short edge between two free vertices (nearly co-spherical sites) is removed.
+      case Pass::Repairs: wanted = both_free && of_failing_cell && len < opt_.g_remove * h; break;
+    }
     if (wanted && h > 0) cand.push_back({len / h, len, h, a, b, i, j});
     i = j;
   }
@@ -527,7 +539,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   // Skewed faces first, worst first: one of their two sites moves a step (toward or away from
   // its polygon, or from the other site), kept if the cells around have fewer skewed faces.
   for (int f : skewed_faces) {
-    if (slivers_only_) break;
+    if (pass_ != Pass::Optimize) break;
     const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
     if (moved[s1] || moved[s2] || locked[s1] || locked[s2]) continue;
     Move best;
@@ -542,7 +554,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     if (best.site >= 0) admit(best);
   }
   for (const Candidate& e : cand) {
-    if (skew_only) break;
+    if (skew_only && pass_ != Pass::Repairs) break;
     std::vector<int> around;  // sites of the cells around the edge
     for (size_t k = e.first; k < e.last; ++k) around.push_back(out.cell_site[edge_cell[k][2]]);
     bool busy = false;
@@ -553,7 +565,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     for (int end = 0; end < 2; ++end) {
       const int32_t v = end ? e.a : e.b, u = end ? e.b : e.a;
       if (global[v] < out.base_node_id) continue;
-      const bool removal = (slivers_only_ || e.rel < opt_.g_remove) && global[u] >= out.base_node_id;
+      const bool removal = (pass_ == Pass::Slivers || e.rel < opt_.g_remove) && global[u] >= out.base_node_id;
       const Vec3 pv = sub.nodes[v], pu = sub.nodes[u];
       const Vec3 x = removal ? pu : pv + ((opt_.g_expand * e.h - e.len) / e.len) * (pv - pu);
       // Sites of v not around the edge: those of its cells and of its power sphere.
@@ -571,11 +583,12 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
         if (refused_.count(m.tag)) continue;
         // A sliver's sites may sit at a bound of their range (an end face's height cap): the
         // co-spherical position is then beyond it by rounding, the size of the edge itself.
-        const double range_slack = slivers_only_ ? kSliverEdge * e.h : 0.0;
+        const double range_slack = pass_ == Pass::Slivers ? kSliverEdge * e.h : 0.0;
         if (!trial_move(d, around.front(), x, opt_.max_shift * e.h, range_slack, &m) || locked[m.site]) continue;
         const double shift = norm(m.after.p - m.before.p);
         m.removal = removal;
-        if (slivers_only_) m.kind = MoveKind::SliverRemoval;
+        if (pass_ == Pass::Slivers) m.kind = MoveKind::SliverRemoval;
+        if (pass_ == Pass::Repairs) m.kind = MoveKind::Repair;
         if (shift < best_shift) best = m, best_shift = shift;
       }
     }
@@ -585,7 +598,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   // neighbour's (toward or away from the other, a polygon site along its range), kept only if fewer
   // cells around fail. Each round tries the first option not refused before, so later rounds try the
   // next ones. Last, as the moves above mend most failing cells of a raw diagram in passing.
-  for (int c = 0; c < nc && !slivers_only_; ++c) {
+  for (int c = 0; c < nc && pass_ != Pass::Slivers; ++c) {
     const int s = out.cell_site[c];
     if (!now.failing.cell[c] || locked[s]) continue;
     Move best;
@@ -723,11 +736,26 @@ int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Ve
   if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, true);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, Pass::Slivers);
   while (rep.rounds < kSliverRounds) {
     ++rep.rounds;
     // A round whose removals were all refused has tagged them: the next tries each sliver's next site.
     if (!optimizer.round(out, rep, false) && optimizer.proposed_last() == 0) break;
+  }
+  out.h_ref = h_ref;
+  return rep.kept;
+}
+
+int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+                         const std::vector<Vec3>& outside_centres, TransitionCells& out) {
+  SiteOptimizeReport rep;
+  const std::vector<double> h_ref = out.h_ref;
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, Pass::Repairs);
+  // The first round measures the diagram; it proposes nothing when no cell fails.
+  while (rep.rounds < kRepairRounds && optimizer.failing_now() != 0) {
+    ++rep.rounds;
+    if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
   }
   out.h_ref = h_ref;
   return rep.kept;

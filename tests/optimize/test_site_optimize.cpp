@@ -147,7 +147,7 @@ TEST(SiteOptimizer, SliverPassTriesTheNextSiteWhenARemovalIsRefused) {
   CaseSpec cs = bench::scaling_case(165);
   cs.wells = {cs.wells[8]};
   HybridMesh h;
-  ASSERT_NO_THROW(h = build_hybrid_mesh(translated_case(cs, -case_origin(cs)))) << "the self-check refused the mesh";
+  ASSERT_NO_THROW(h = build_hybrid_mesh_in_local_frame(cs)) << "the self-check refused the mesh";
   int slivers_removed = 0;
   for (const TransitionReport& r : h.transition_reports) slivers_removed += r.sliver_removals;
   EXPECT_GT(slivers_removed, 0);
@@ -201,9 +201,9 @@ TEST(SiteOptimizer, SameWellsInALargerReservoirGetTheSameCells) {
 // removal left a 4 mm x 2 cm triangle of skewness 21 (checkMesh's limit is 4; the optimiser had left
 // the mesh at 3.9). Removals that raise the count of faces above the limit around them are refused.
 TEST(SiteOptimizer, SliverPassLeavesNoFaceAboveCheckMeshSkewness) {
-  const CaseSpec cs = load_case(std::string(HM_SOURCE_DIR) + "/examples/accuracy_bent.yaml");
+  CaseSpec cs = load_case(std::string(HM_SOURCE_DIR) + "/examples/accuracy_bent.yaml");
   HybridMesh h;
-  ASSERT_NO_THROW(h = build_hybrid_mesh(translated_case(cs, -case_origin(cs))));
+  ASSERT_NO_THROW(h = build_hybrid_mesh_in_local_frame(cs));
   int slivers_removed = 0;
   for (const TransitionReport& r : h.transition_reports) slivers_removed += r.sliver_removals;
   EXPECT_GT(slivers_removed, 0);

@@ -75,7 +75,8 @@ inline CaseResult run_classified(const std::function<void(CaseResult&)>& job) {
 inline CaseResult mesh_and_check(const RealisticCase& rc) {
   return run_classified([&](CaseResult& res) {
     // As meshgen does: mesh in the local frame (a field-coordinate case is moved to its origin).
-    const HybridMesh h = build_hybrid_mesh(translated_case(rc.spec, -1.0 * case_origin(rc.spec)));
+    CaseSpec user = rc.spec;
+    const HybridMesh h = build_hybrid_mesh_in_local_frame(user);
     std::string bad;
     if (!h.build_report.ok) bad += "builder; ";
     for (const WellBlock& b : h.blocks)

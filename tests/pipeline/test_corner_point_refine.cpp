@@ -538,7 +538,8 @@ fs::path reek_deck() {
 // origin); a failure is the test's.
 HybridMesh mesh_in_local_frame(const CaseSpec& cs) {
   try {
-    return build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
+    CaseSpec user = cs;
+    return build_hybrid_mesh_in_local_frame(user);
   } catch (const std::exception& e) {
     ADD_FAILURE() << e.what();
     return {};

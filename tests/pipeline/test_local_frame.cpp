@@ -28,11 +28,14 @@ double diagonal(const CaseSpec& cs) {
   return norm(Vec3{r.x.back() - r.x.front(), r.y.back() - r.y.front(), r.z.back() - r.z.front()});
 }
 
-// Same topology; FV centres, centroids and volumes equal to relative 1e-9; every check finds the
-// same violations. Not to 1e-9: a few power vertices where nearly co-spherical sites meet are
-// ill-conditioned along the faces they lie in (three_wells: 4 nodes move by up to 0.022 m for a
-// 5e-10 m change of the input, which moves the area vectors of their small faces by 2.4e-6
-// relative and the worst planarity by 8e-6 degrees); docs/architecture.md, "Local frame".
+// Same topology; FV centres and centroids equal to 1e-9 of the reservoir's size; every check finds
+// the same violations. b's positions are those its files hold (round_to_written_frame: rounded to the
+// doubles of the user's frame, 9.3e-10 m at y = 6.78e6), so volumes agree to 1e-7 relative (0.1 m
+// wellbore cells), area vectors to 1e-4 and the checks' worst values to 0.01 degree (planarity: a
+// small face's plane tilts by 0.007 degree under that rounding) or 1e-4 (the relative measures). A
+// few power vertices where nearly co-spherical sites meet are ill-conditioned along the faces they
+// lie in (three_wells: 4 nodes move by up to 0.022 m for a 5e-10 m change of the input);
+// docs/architecture.md, "Local frame".
 void expect_same_mesh(const HybridMesh& a, const HybridMesh& b, double length) {
   const PolyMesh &ma = a.mesh, &mb = b.mesh;
   ASSERT_EQ(ma.n_cells(), mb.n_cells());
@@ -66,8 +69,8 @@ void expect_same_mesh(const HybridMesh& a, const HybridMesh& b, double length) {
               ma.n_cells(), centre_shift, centroid_shift, volume_rel, area_rel, moved_nodes, tol, node_shift);
   EXPECT_LE(centre_shift, tol);
   EXPECT_LE(centroid_shift, tol);
-  EXPECT_LE(volume_rel, 1e-9);
-  EXPECT_LE(area_rel, 1e-5);
+  EXPECT_LE(volume_rel, 1e-7);
+  EXPECT_LE(area_rel, 1e-4);
   const MeshGeometry &ga = a.geometry, &gb = b.geometry;
   const std::vector<CheckResult> ca = {check_convexity(ma, ga), check_orthogonality(ma, ga),
                                        check_auto_centering(ma, ga), check_planarity(ma, ga)};
@@ -75,8 +78,8 @@ void expect_same_mesh(const HybridMesh& a, const HybridMesh& b, double length) {
                                        check_auto_centering(mb, gb), check_planarity(mb, gb)};
   for (size_t i = 0; i < ca.size(); ++i) {
     EXPECT_EQ(ca[i].violations, cb[i].violations) << ca[i].name;
-    // Planarity's worst face (1.35e-5 vs 2.13e-5 degrees) holds one of the ill-conditioned nodes.
-    EXPECT_NEAR(ca[i].worst, cb[i].worst, 1e-4) << ca[i].name;
+    const bool degrees = ca[i].name == "orthogonality" || ca[i].name == "planarity";
+    EXPECT_NEAR(ca[i].worst, cb[i].worst, degrees ? 1e-2 : 1e-4) << ca[i].name;
     double worst = 0;
     for (size_t k = 0; k < ca[i].values.size(); ++k) worst = std::max(worst, std::abs(ca[i].values[k] - cb[i].values[k]));
     std::printf("[ frame     ] %s: worst %.10g vs %.10g, largest difference %.3g\n", ca[i].name.c_str(), ca[i].worst,
