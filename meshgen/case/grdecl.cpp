@@ -322,11 +322,28 @@ double corner_depth(const CornerPointModel& m, int c, int q) {
 }
 
 Vec3 pillar_point(const CornerPointModel& m, int p, double z) {
+  // OPM's EclipseGrid::getCellCorners, term for term and in its order, so that a corner equals getCornerPos bit for bit.
   const double* a = &m.coord[6 * size_t(p)];
-  const double dz = a[5] - a[2];
-  if (dz == 0) return {a[0], a[1], z};
-  const double t = (z - a[2]) / dz;
-  return {a[0] + t * (a[3] - a[0]), a[1] + t * (a[4] - a[1]), z};
+  const double xt = a[0], yt = a[1], zt = a[2], xb = a[3], yb = a[4], zb = a[5];
+  if (zt == zb) return {xt, yt, z};
+  return {xt + (xb - xt) / (zt - zb) * (zt - z), yt + (yb - yt) / (zt - zb) * (zt - z), z};
+}
+
+Vec3 corner(const CornerPointModel& m, size_t cell, int q) {
+  const size_t nx = size_t(m.nx), ny = size_t(m.ny);
+  const size_t i = cell % nx, j = cell / nx % ny, k = cell / (nx * ny);
+  const int I = static_cast<int>(i) + (q & 1), J = static_cast<int>(j) + ((q >> 1) & 1);
+  return pillar_point(m, I + (m.nx + 1) * J,
+                      m.zcorn[zcorn_index(m, static_cast<int>(i), static_cast<int>(j), static_cast<int>(k), q)]);
+}
+
+std::array<Vec3, 8> cell_corners(const CornerPointModel& m, size_t cell) {
+  const size_t nx = size_t(m.nx), ny = size_t(m.ny);
+  const int i = static_cast<int>(cell % nx), j = static_cast<int>(cell / nx % ny), k = static_cast<int>(cell / (nx * ny));
+  std::array<Vec3, 8> out;
+  for (int q = 0; q < 8; ++q)
+    out[q] = pillar_point(m, i + (q & 1) + (m.nx + 1) * (j + ((q >> 1) & 1)), m.zcorn[zcorn_index(m, i, j, k, q)]);
+  return out;
 }
 
 int64_t merge_rounded_depths(CornerPointModel& m) {

@@ -105,6 +105,7 @@ struct CornerPointModel {
   /// unit grid x and y directions (origin, unit_x, unit_y), for has_mapaxes.
   std::array<double, 2> map_origin{0, 0}, map_unit_x{1, 0}, map_unit_y{0, 1};
   int n_active() const;
+  size_t n_cells() const { return size_t(nx) * size_t(ny) * size_t(nz); }
 };
 
 /// Reads a deck or a GRDECL file (INCLUDEs followed, relative to its folder). Throws InputError
@@ -154,8 +155,15 @@ size_t zcorn_index(const CornerPointModel& m, int i, int j, int k, int q);
 /// Depth of corner q of cell c (natural index).
 double corner_depth(const CornerPointModel& m, int c, int q);
 /// The point of pillar p (i + (nx+1) j) at depth z (linear along the pillar; a pillar whose two
-/// COORD points have the same depth is vertical through its top point), as OPM places corners.
+/// COORD points have the same depth is vertical through its top point), as OPM places corners:
+/// OPM's getCellCorners arithmetic, so that a corner computed here equals getCornerPos bit for bit.
 Vec3 pillar_point(const CornerPointModel& m, int p, double z);
+/// Corner q (bit 0 = +i, bit 1 = +j, bit 2 = +k; OPM's and Eclipse's order) of cell `cell` (natural
+/// index): the point of its pillar at its ZCORN depth (pillar_point), in the grid's input frame (z
+/// depth, positive down). For a model as read, EclipseGrid::getCornerPos bit for bit.
+Vec3 corner(const CornerPointModel& m, size_t cell, int q);
+/// The 8 corners of a cell, indexed as `corner`'s q.
+std::array<Vec3, 8> cell_corners(const CornerPointModel& m, size_t cell);
 
 /// Depths on one pillar within this many units in the last place of each other are one depth written
 /// with a rounding: a fault whose throw is a whole number of layers, or passes through zero.
