@@ -449,7 +449,7 @@ void keep_minpv_cells_near_wells(CaseSpec& cs) {
   std::vector<int64_t> kept;
   for (const int64_t c : m.minpv_removed) {
     const size_t i = static_cast<size_t>(c);
-    if (m.opm_volume[i] > 0 && rock_problem(r, i).empty() && near_a_well(m.corners[i], cs.wells)) kept.push_back(c);
+    if (m.opm_volume[i] > 0 && rock_problem(r, i).empty() && near_a_well(cell_corners(m, i), cs.wells)) kept.push_back(c);
   }
   if (kept.empty()) return;
   auto model = std::make_shared<CornerPointModel>(m);

@@ -115,9 +115,11 @@ bool cell_within_reach(const std::array<Vec3, 8>& corners, const FaultStepReques
 // Per cell: whether it comes within reach of a well that asked.
 std::vector<char> cells_near(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells,
                              const std::vector<char>& asked) {
-  std::vector<char> near(m.corners.size(), 0);
-  for (size_t c = 0; c < m.corners.size(); ++c)
-    for (size_t w = 0; w < wells.size() && !near[c]; ++w) near[c] = asked[w] && cell_within_reach(m.corners[c], wells[w]);
+  std::vector<char> near(m.n_cells(), 0);
+  for (size_t c = 0; c < m.n_cells(); ++c) {
+    const std::array<Vec3, 8> corners = cell_corners(m, c);
+    for (size_t w = 0; w < wells.size() && !near[c]; ++w) near[c] = asked[w] && cell_within_reach(corners, wells[w]);
+  }
   return near;
 }
 
@@ -129,8 +131,8 @@ std::vector<size_t> wells_reaching_split_cells(const CornerPointModel& m, const 
   std::vector<size_t> out;
   for (size_t w = 0; w < wells.size(); ++w) {
     if (asked[w]) continue;
-    for (size_t c = 0; c < m.corners.size(); ++c)
-      if (near[c] && cell_within_reach(m.corners[c], wells[w])) {
+    for (size_t c = 0; c < m.n_cells(); ++c)
+      if (near[c] && cell_within_reach(cell_corners(m, c), wells[w])) {
         out.push_back(w);
         break;
       }
@@ -311,10 +313,6 @@ CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const Fa
             const double z = level == 0    ? top
                              : level == nk ? bottom
                                            : inner[k][size_t(p) * 4 + ((i - I + 1) | ((j - J + 1) << 1))][size_t(level - 1)];
-            // On the parent's top or bottom: its corner bit for bit.
-            r.corners[c][q] = z == top      ? m.corners[pcell][corner]
-                              : z == bottom ? m.corners[pcell][4 | corner]
-                                            : pillar_point(m, p, z);
             r.zcorn[zcorn_index(r, i, j, kc, q)] = z;
           }
           inherit_cell(r, c, m, pcell);

@@ -58,10 +58,11 @@ class Polyline {
 }  // namespace
 
 CornerPointInterior::CornerPointInterior(const CornerPointModel& m, Vec3 lo, Vec3 hi) {
-  for (size_t c = 0; c < m.corners.size(); ++c) {
+  for (size_t c = 0; c < m.n_cells(); ++c) {
     if (!m.actnum[c]) continue;
-    Cell cell{m.corners[c][0], m.corners[c][0], m.corners[c]};
-    for (const Vec3& p : m.corners[c])
+    const std::array<Vec3, 8> corners = cell_corners(m, c);
+    Cell cell{corners[0], corners[0], corners};
+    for (const Vec3& p : corners)
       for (int k = 0; k < 3; ++k) cell.lo[k] = std::min(cell.lo[k], p[k]), cell.hi[k] = std::max(cell.hi[k], p[k]);
     bool meets = true;
     for (int k = 0; k < 3; ++k) meets = meets && cell.lo[k] <= hi[k] && cell.hi[k] >= lo[k];
@@ -148,14 +149,14 @@ double surface_gap(const CornerPointModel& m, Vec3 at, const WellSpec& ws) {
   // kFaces in the order -i, +i, -j, +j, -k, +k: the logical neighbour across each.
   constexpr int kStep[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
   double longest = 0;
-  for (int c = 0; c < static_cast<int>(m.corners.size()); ++c) {
+  for (int c = 0; c < static_cast<int>(m.n_cells()); ++c) {
     if (!m.actnum[c]) continue;
     const int i = c % m.nx, j = c / m.nx % m.ny, k = c / (m.nx * m.ny);
     for (int f = 0; f < 6; ++f) {
       if (active(i + kStep[f][0], j + kStep[f][1], k + kStep[f][2])) continue;
       std::array<Vec3, 4> q;
       bool near = false;
-      for (int v = 0; v < 4; ++v) q[v] = m.corners[c][kFaces[f][v]], near = near || norm(q[v] - at) <= reach;
+      for (int v = 0; v < 4; ++v) q[v] = corner(m, size_t(c), kFaces[f][v]), near = near || norm(q[v] - at) <= reach;
       if (!near) continue;
       for (int v = 0; v < 4; ++v) longest = std::max(longest, norm(q[(v + 1) % 4] - q[v]));
       longest = std::max({longest, norm(q[2] - q[0]), norm(q[3] - q[1])});

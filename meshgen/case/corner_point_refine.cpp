@@ -338,9 +338,6 @@ CornerPointModel refined_model(const CornerPointModel& m, const ColumnSplits& sp
           double z = 0;
           for (int a = 0; a < 4; ++a) z += w[a] * m.zcorn[zcorn_index(m, i, j, k, side | a)];
           r.zcorn[zcorn_index(r, I, J, k, q)] = z;
-          const bool on_model_pillar = (s == 0 || s == 1) && (t == 0 || t == 1);
-          r.corners[c][q] = on_model_pillar ? m.corners[pc][side | (s == 1 ? 1 : 0) | (t == 1 ? 2 : 0)]
-                                            : pillar_point(r, I + (q & 1) + (r.nx + 1) * (J + ((q >> 1) & 1)), z);
         }
         // +x, -x, +y, -y act on the parent's faces; z on every child.
         const bool at[6] = {si[I].child == si[I].of - 1, si[I].child == 0, sj[J].child == sj[J].of - 1,

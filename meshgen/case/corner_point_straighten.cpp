@@ -72,7 +72,7 @@ Walk surface_depth(const CornerPointModel& m, int k, int side, double x, double 
     const size_t c = cell_id(m, I, J, k);
     std::array<Vec3, 4> q;
     std::array<double, 4> depth;
-    for (int a = 0; a < 4; ++a) q[a] = m.corners[c][side | a], depth[a] = q[a].z;
+    for (int a = 0; a < 4; ++a) q[a] = corner(m, c, side | a), depth[a] = q[a].z;
     double s = 0, t = 0;
     if (!inverse_bilinear(q, x, y, s, t)) return Walk::Lost;
     const int di = s < -kQuadEdge ? -1 : s > 1 + kQuadEdge ? 1 : 0;
@@ -286,17 +286,13 @@ void regrid_cells(const CornerPointModel& m, Regrid& g) {
       }
 }
 
-// The re-gridding written into `res`: COORD, ZCORN, corners on turned pillars (the others stay bit
-// for bit as the cells beside have them), and each cell's rock and parent from its source cell.
+// The re-gridding written into `res`: COORD of the turned pillars and ZCORN (the corners, computed from
+// them, move on the turned pillars only), and each cell's rock and parent from its source cell.
 void apply_regrid(const CornerPointModel& m, const Regrid& g, CornerPointModel& res) {
   for (const auto& [p, line] : g.coord) std::copy(line.begin(), line.end(), &res.coord[6 * size_t(p)]);
   for (const auto& [c, zc] : g.zcorn) {
     const int I = static_cast<int>(c % m.nx), J = static_cast<int>((c / m.nx) % m.ny), k = static_cast<int>(c / (size_t(m.nx) * m.ny));
-    for (int q = 0; q < 8; ++q) {
-      const int p = pillar_id(m, I + (q & 1), J + ((q >> 1) & 1));
-      res.zcorn[zcorn_index(m, I, J, k, q)] = zc[q];
-      if (g.coord.count(p)) res.corners[c][q] = pillar_point(res, p, zc[q]);
-    }
+    for (int q = 0; q < 8; ++q) res.zcorn[zcorn_index(m, I, J, k, q)] = zc[q];
   }
   for (const auto& [c, s] : g.source) {
     res.actnum[c] = m.actnum[s];
@@ -340,8 +336,8 @@ CornerPointModel straightened_model(const CornerPointModel& m, const std::vector
     if (!res) {
       res = m;
       if (res->parent_cell.empty()) {
-        res->parent_cell.resize(m.corners.size());
-        for (size_t c = 0; c < m.corners.size(); ++c) res->parent_cell[c] = static_cast<int32_t>(c);
+        res->parent_cell.resize(m.n_cells());
+        for (size_t c = 0; c < m.n_cells(); ++c) res->parent_cell[c] = static_cast<int32_t>(c);
         res->parent_nx = m.nx, res->parent_ny = m.ny;
       }
       res->opm_volume.clear();

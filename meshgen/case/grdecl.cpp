@@ -140,16 +140,9 @@ CornerPointModel read_corner_point_model(const std::string& path, const std::str
     m.ny = static_cast<int>(grid.getNY());
     m.nz = static_cast<int>(grid.getNZ());
     const size_t n = grid.getCartesianSize();
-    m.corners.resize(n);
     m.actnum.resize(n);
-    for (size_t c = 0; c < n; ++c) {
-      const size_t i = c % m.nx, j = (c / m.nx) % m.ny, k = c / (size_t(m.nx) * m.ny);
-      for (int q = 0; q < 8; ++q) {
-        const auto p = grid.getCornerPos(i, j, k, q);
-        m.corners[c][q] = {p[0], p[1], p[2]};
-      }
-      m.actnum[c] = grid.cellActive(c) ? 1 : 0;
-    }
+    for (size_t c = 0; c < n; ++c) m.actnum[c] = grid.cellActive(c) ? 1 : 0;
+    // The corners are computed from these (corner: getCornerPos's arithmetic), not stored.
     m.coord = grid.getCOORD();
     m.zcorn = grid.getZCORN();
     m.opm_volume.resize(n);
@@ -276,7 +269,7 @@ namespace {
 // Rock per cell as the mesh carries it: NTG folded into the porosity and the horizontal
 // permeabilities (OPM's pore volumes and TRANX/TRANY).
 void set_rock(const CornerPointModel& m, ReservoirSpec& r) {
-  const size_t n = m.corners.size();
+  const size_t n = m.n_cells();
   r.cell_permx.resize(n);
   r.cell_permy.resize(n);
   r.cell_poro.resize(n);
@@ -299,7 +292,6 @@ size_t zcorn_index(const CornerPointModel& m, int i, int j, int k, int q) {
 
 void resize_cell_arrays(CornerPointModel& r, const CornerPointModel& m) {
   const size_t n = size_t(r.nx) * r.ny * r.nz;
-  r.corners.assign(n, {});
   r.zcorn.assign(8 * n, 0.0);
   r.actnum.resize(n);
   r.parent_cell.resize(n);
@@ -375,7 +367,6 @@ int64_t merge_rounded_depths(CornerPointModel& m) {
           const Corner& c = at[e];
           m.zcorn[zcorn_index(m, static_cast<int>(c.cell % m.nx), static_cast<int>(c.cell / m.nx % m.ny),
                               static_cast<int>(c.cell / (size_t(m.nx) * m.ny)), c.q)] = at[b].z;
-          m.corners[c.cell][c.q] = pillar_point(m, I + J * (m.nx + 1), at[b].z);
           ++changed;
         }
         b = e;
@@ -434,9 +425,9 @@ ReservoirSpec corner_point_reservoir(std::shared_ptr<const CornerPointModel> mod
   check_corner_point_geometry(m, key);
   ReservoirSpec r;
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  for (size_t c = 0; c < m.corners.size(); ++c)
+  for (size_t c = 0; c < m.n_cells(); ++c)
     if (m.actnum[c])
-      for (const Vec3& p : m.corners[c]) {
+      for (const Vec3& p : cell_corners(m, c)) {
         lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
         hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
       }
@@ -464,8 +455,6 @@ CornerPointModel translated_model(const CornerPointModel& m, Vec3 shift) {
     out.coord[p + 2] += shift.z;
   }
   for (double& z : out.zcorn) z += shift.z;
-  for (auto& cell : out.corners)
-    for (Vec3& p : cell) p += shift;
   return out;
 }
 
@@ -474,19 +463,20 @@ ReservoirSpec rectilinear_reservoir(const CornerPointModel& m, const std::string
   const int nx = m.nx, ny = m.ny;
   auto idx = [&](int i, int j, int k) { return i + nx * (j + ny * k); };
   // Axes from the cells along the grid's three edges, then every corner must sit on them.
-  for (int i = 0; i < nx; ++i) r.x.push_back(m.corners[idx(i, 0, 0)][0].x);
-  r.x.push_back(m.corners[idx(nx - 1, 0, 0)][1].x);
-  for (int j = 0; j < ny; ++j) r.y.push_back(m.corners[idx(0, j, 0)][0].y);
-  r.y.push_back(m.corners[idx(0, ny - 1, 0)][2].y);
-  for (int k = 0; k < m.nz; ++k) r.z.push_back(m.corners[idx(0, 0, k)][0].z);
-  r.z.push_back(m.corners[idx(0, 0, m.nz - 1)][4].z);
-  const size_t n = m.corners.size();
+  for (int i = 0; i < nx; ++i) r.x.push_back(corner(m, idx(i, 0, 0), 0).x);
+  r.x.push_back(corner(m, idx(nx - 1, 0, 0), 1).x);
+  for (int j = 0; j < ny; ++j) r.y.push_back(corner(m, idx(0, j, 0), 0).y);
+  r.y.push_back(corner(m, idx(0, ny - 1, 0), 2).y);
+  for (int k = 0; k < m.nz; ++k) r.z.push_back(corner(m, idx(0, 0, k), 0).z);
+  r.z.push_back(corner(m, idx(0, 0, m.nz - 1), 4).z);
+  const size_t n = m.n_cells();
   for (size_t c = 0; c < n; ++c) {
     const int i = c % nx, j = (c / nx) % ny, k = c / (size_t(nx) * ny);
     if (!m.actnum[c])
       throw InputError(key + ": " + cell_name(c, nx, ny) + " is inactive; inactive cells are not meshed yet");
+    const std::array<Vec3, 8> corners = cell_corners(m, c);
     for (int q = 0; q < 8; ++q) {
-      const Vec3 p = m.corners[c][q];
+      const Vec3 p = corners[q];
       const Vec3 want{r.x[i + (q & 1)], r.y[j + ((q >> 1) & 1)], r.z[k + ((q >> 2) & 1)]};
       if (!(p == want))
         throw InputError(key + ": " + cell_name(c, nx, ny) +

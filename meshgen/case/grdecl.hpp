@@ -23,15 +23,13 @@ struct RegionMultipliers;
 /// (i fastest, then j, then k; size nx*ny*nz), rock in mD and fractions.
 struct CornerPointModel {
   int nx = 0, ny = 0, nz = 0;
-  /// 8 corners per cell in the grid's input frame (COORD/ZCORN; z depth, positive down);
-  /// corner bit 0 = +i, bit 1 = +j, bit 2 = +k (OPM's and Eclipse's order).
-  std::vector<std::array<Vec3, 8>> corners;
   std::vector<int> actnum;                     ///< 1 active, 0 inactive (EclipseGrid: ACTNUM, cells of no volume; not MINPV)
   std::vector<double> permx, permy, permz;     ///< mD
   std::vector<double> poro, ntg;               ///< NTG is 1 where the deck has none
   /// The deck's geometry as OPM holds it (EclipseGrid::getCOORD/getZCORN): 6 numbers per pillar
   /// (top x y z, bottom x y z; pillar (i, j) at i + (nx+1) j) and 8 depths per cell (Eclipse order,
-  /// `zcorn_index`). The mesh's model cells and the exported deck's COORD/ZCORN come from these.
+  /// `zcorn_index`). The mesh's model cells and the exported deck's COORD/ZCORN come from these, and
+  /// so do the cells' corners (`corner`, `cell_corners`: computed, not stored; getCornerPos's bit for bit).
   std::vector<double> coord, zcorn;
   std::vector<double> opm_volume;              ///< EclipseGrid::getCellVolume per cell (m3), for comparisons; empty for a refined model
   /// OPM's transmissibility multipliers per cell and face direction (TransMult::getMultiplier: MULTX,
@@ -125,7 +123,7 @@ ReservoirSpec rectilinear_reservoir(const CornerPointModel& model, const std::st
 double region_multiplier(const CornerPointModel& model, int64_t a, int64_t b);
 
 /// Sizes the per-cell arrays of `r` (r.nx x r.ny x r.nz cells), a model derived from `m` (refined,
-/// split): corners, ZCORN, ACTNUM, parent_cell, rock, and the pore-volume and transmissibility
+/// split): ZCORN, ACTNUM, parent_cell, rock, and the pore-volume and transmissibility
 /// multipliers that `m` has.
 void resize_cell_arrays(CornerPointModel& r, const CornerPointModel& m);
 

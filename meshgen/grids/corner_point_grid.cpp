@@ -585,9 +585,7 @@ double min_angle(Vec3 a, Vec3 b, Vec3 c) {
 
 }  // namespace
 
-Vec3 model_cell_corner(const CornerPointModel& model, int c, int q) {
-  return pillar_point(model, cell_corner_pillar(model, c, q), corner_depth(model, c, q));
-}
+Vec3 model_cell_corner(const CornerPointModel& model, int c, int q) { return corner(model, static_cast<size_t>(c), q); }
 
 CornerPointCellFaces corner_point_cell_faces(const CornerPointModel& model, const std::vector<char>& present,
                                              MeshBuilder& builder, int32_t boundary_patch) {

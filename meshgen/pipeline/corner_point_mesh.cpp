@@ -134,7 +134,7 @@ double minpv_transmissibility(const CornerPointModel& model, int64_t upper, int6
     for (int i = first; i < first + count; ++i) s = s + q[i];
     return s / count;
   };
-  const std::array<Vec3, 8>&u = model.corners[static_cast<size_t>(upper)], &l = model.corners[static_cast<size_t>(lower)];
+  const std::array<Vec3, 8> u = cell_corners(model, static_cast<size_t>(upper)), l = cell_corners(model, static_cast<size_t>(lower));
   // The vector area of the upper cell's bottom, corners 4, 5, 7, 6 in cyclic order.
   const Vec3 area = 0.5 * cross(u[7] - u[4], u[6] - u[5]);
   auto perm = [&](int64_t c) {
@@ -159,7 +159,7 @@ void attach_minpv_connections(HybridMesh& out, const CornerPointModel& model) {
     if (out.reservoir_cell_of[c] >= 0) mesh_cell[out.reservoir_cell_of[c]] = c;
   std::map<int64_t, std::vector<int64_t>> children;  // cell as read -> its cells in `model`
   for (const auto& [up, low] : model.minpv_connections) children[up];
-  for (int64_t c = 0; c < static_cast<int64_t>(model.corners.size()); ++c)
+  for (int64_t c = 0; c < static_cast<int64_t>(model.n_cells()); ++c)
     if (auto it = children.find(cell_as_read(model, c)); it != children.end()) it->second.push_back(c);
   const int64_t parent_nxy = model.parent_cell.empty() ? nxy : int64_t(model.parent_nx) * model.parent_ny;
   // Layers split at fault steps: the upper cell's lowest meshed child connects to the lower cell's

@@ -18,7 +18,8 @@ Vec3 case_origin(const CaseSpec& cs);
 CaseSpec translated_case(const CaseSpec& cs, Vec3 shift);
 
 /// Whether moving the model's coordinates by `shift` and back gives each of them bit for bit:
-/// (v + s) - s is v, the sign of a zero included, for every COORD, ZCORN and corner value. Field
+/// (v + s) - s is v, the sign of a zero included, for every COORD and ZCORN value (the corners are
+/// computed from them, so they come back bit for bit too). Field
 /// coordinates within a factor 2 of the shift do (Sterbenz's lemma), as UTM models' are.
 bool translation_round_trips(const CornerPointModel& m, Vec3 shift);
 

@@ -838,10 +838,11 @@ TEST(SegmentDistance, PolylineCutoffIsExactBelowAndBoundAbove) {
 TEST(CornerPointPath, PointsOnFacesAreDecidedAsJustAboveThem) {
   CornerPointModel m;
   m.nx = 1, m.ny = 1, m.nz = 2;
+  for (int J = 0; J < 2; ++J)
+    for (int I = 0; I < 2; ++I) m.coord.insert(m.coord.end(), {double(I), double(J), 0.0, double(I), double(J), 2.0});
+  m.zcorn.resize(16);
   for (int k = 0; k < 2; ++k) {
-    std::array<Vec3, 8> c;
-    for (int q = 0; q < 8; ++q) c[q] = Vec3{double(q & 1), double((q >> 1) & 1), double(k + ((q >> 2) & 1))};
-    m.corners.push_back(c);
+    for (int q = 0; q < 8; ++q) m.zcorn[zcorn_index(m, 0, 0, k, q)] = double(k + ((q >> 2) & 1));
     m.actnum.push_back(1);
   }
   const CornerPointInterior inside(m, Vec3{-1, -1, -1}, Vec3{2, 2, 3});

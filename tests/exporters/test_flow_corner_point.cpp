@@ -497,7 +497,7 @@ TEST(FlowCornerPoint, PinchedOutLayerWithWellsMatchesSolverDemo) {
     int flat_columns = 0;  // columns (of the model refined near the wells) where the layer has zero thickness
     for (int c = g.pinch_k * m.nx * m.ny; c < (g.pinch_k + 1) * m.nx * m.ny; ++c) {
       bool flat = true;
-      for (int q = 0; q < 4; ++q) flat = flat && m.corners[c][q].z == m.corners[c][q + 4].z;
+      for (int q = 0; q < 4; ++q) flat = flat && corner(m, c, q).z == corner(m, c, q + 4).z;
       flat_columns += flat;
     }
     EXPECT_GT(flat_columns, 0);

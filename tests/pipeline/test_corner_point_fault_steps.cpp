@@ -101,11 +101,12 @@ TEST(FaultSteps, WellsBesideSplitCellsGetTheirCellsSplitToo) {
   for (const auto& [s, given] : runs)
     for (const FaultStepRequest& w : given) {
       int split = 0, whole = 0;
-      for (size_t cell = 0; cell < m.corners.size(); ++cell) {
+      for (size_t cell = 0; cell < m.n_cells(); ++cell) {
+        const std::array<Vec3, 8> corners = cell_corners(m, cell);
         Vec3 centre{0, 0, 0};
-        for (const Vec3& q : m.corners[cell]) centre += q / 8.0;
+        for (const Vec3& q : corners) centre += q / 8.0;
         double radius = 0;
-        for (const Vec3& q : m.corners[cell]) radius = std::max(radius, norm(q - centre));
+        for (const Vec3& q : corners) radius = std::max(radius, norm(q - centre));
         if (segment_segment_distance(centre, centre, w.path[0], w.path[1]) > w.reach + radius) continue;
         (s->near[cell] ? split : whole)++;
       }
@@ -137,7 +138,7 @@ TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
   std::printf("[ figures  ] fault faces: %lld before, %lld after (between cells near the well and the others)\n",
               static_cast<long long>(faults_before), static_cast<long long>(faults_after));
   std::vector<double> sum(parent_volume.size(), 0.0);
-  for (size_t c = 0; c < r.corners.size(); ++c) sum[r.parent_cell[c]] += child_volume[c];
+  for (size_t c = 0; c < r.n_cells(); ++c) sum[r.parent_cell[c]] += child_volume[c];
   int near = 0, far = 0;
   for (size_t p = 0; p < parent_volume.size(); ++p) {
     EXPECT_NEAR(sum[p] / parent_volume[p], 1.0, 1e-12) << "model cell " << p;
@@ -146,7 +147,7 @@ TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
   EXPECT_GT(near, 0);
   EXPECT_GT(far, 0);
   // Away from the well a cell is whole in its first child, the other of zero thickness (not meshed).
-  for (size_t c = 0; c < r.corners.size(); ++c) {
+  for (size_t c = 0; c < r.n_cells(); ++c) {
     const size_t p = static_cast<size_t>(r.parent_cell[c]);
     if (split.near[p]) continue;
     const bool first = c / (size_t(r.nx) * r.ny) == size_t(2 * (p / (size_t(m.nx) * m.ny)));
@@ -181,15 +182,15 @@ TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
       EXPECT_GT(matched, 4);
     }
 
-  for (size_t c = 0; c < r.corners.size(); ++c) {
+  for (size_t c = 0; c < r.n_cells(); ++c) {
     const int p = r.parent_cell[c], k = static_cast<int>(c / (size_t(r.nx) * r.ny));
     const bool first = k == 0 || r.parent_layer[k - 1] != r.parent_layer[k];
     const bool last = k + 1 == r.nz || r.parent_layer[k + 1] != r.parent_layer[k];
     bool at_bottom = true;  // the child ends at its parent's bottom (the last one; the first too away from the well)
-    for (int q = 4; q < 8; ++q) at_bottom = at_bottom && r.corners[c][q] == m.corners[p][q];
+    for (int q = 4; q < 8; ++q) at_bottom = at_bottom && corner(r, c, q) == corner(m, p, q);
     for (int q = 0; q < 8; ++q)
       if ((q < 4 && first) || (q >= 4 && last)) {
-        EXPECT_EQ(r.corners[c][q], m.corners[p][q]) << c << " " << q;
+        EXPECT_EQ(corner(r, c, q), corner(m, p, q)) << c << " " << q;
       }
     EXPECT_EQ(r.permx[c], m.permx[p]);
     EXPECT_EQ(r.poro[c], m.poro[p]);

@@ -76,13 +76,13 @@ TEST(NearWellRefinement, ChildrenTileTheirParents) {
   ASSERT_EQ(r.nx, 12);
   ASSERT_EQ(r.ny, 8);
   ASSERT_EQ(r.nz, m.nz);
-  ASSERT_EQ(r.parent_cell.size(), r.corners.size());
-  EXPECT_EQ(splits.cells(m.nz), double(r.corners.size()));  // what the case checks before building
+  ASSERT_EQ(r.parent_cell.size(), r.n_cells());
+  EXPECT_EQ(splits.cells(m.nz), double(r.n_cells()));  // what the case checks before building
 
   const std::vector<double> parent_volume = cell_volumes(m), child_volume = cell_volumes(r);
   std::vector<double> sum(parent_volume.size(), 0.0);
   double total_parent = 0, total_child = 0;
-  for (size_t c = 0; c < r.corners.size(); ++c) sum[r.parent_cell[c]] += child_volume[c], total_child += child_volume[c];
+  for (size_t c = 0; c < r.n_cells(); ++c) sum[r.parent_cell[c]] += child_volume[c], total_child += child_volume[c];
   for (size_t p = 0; p < parent_volume.size(); ++p) {
     total_parent += parent_volume[p];
     EXPECT_NEAR(sum[p] / parent_volume[p], 1.0, 1e-12) << "model cell " << p;
@@ -90,15 +90,16 @@ TEST(NearWellRefinement, ChildrenTileTheirParents) {
   EXPECT_NEAR(total_child / total_parent, 1.0, 1e-12);
 
   int on_model_pillars = 0;
-  for (size_t c = 0; c < r.corners.size(); ++c) {
+  for (size_t c = 0; c < r.n_cells(); ++c) {
     const int p = r.parent_cell[c];
     EXPECT_EQ(r.permx[c], m.permx[p]);
     EXPECT_EQ(r.poro[c], m.poro[p]);
     EXPECT_EQ(r.actnum[c], m.actnum[p]);
+    const std::array<Vec3, 8> child = cell_corners(r, c), parent = cell_corners(m, p);
     for (int q = 0; q < 8; ++q)
       for (int pq = 0; pq < 8; ++pq)
-        if ((q & 4) == (pq & 4) && norm(r.corners[c][q] - m.corners[p][pq]) < 1e-9) {
-          EXPECT_EQ(r.corners[c][q], m.corners[p][pq]);  // bit for bit, not only close
+        if ((q & 4) == (pq & 4) && norm(child[q] - parent[pq]) < 1e-9) {
+          EXPECT_EQ(child[q], parent[pq]);  // bit for bit, not only close
           ++on_model_pillars;
         }
     if (p != marked) {
@@ -172,7 +173,7 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsRegionMultipliers) {
   const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}, {}, {}});
   std::map<double, int> seen;
   const int64_t step[3] = {1, r.nx, static_cast<int64_t>(r.nx) * r.ny};
-  for (int64_t a = 0; a < static_cast<int64_t>(r.corners.size()); ++a) {
+  for (int64_t a = 0; a < static_cast<int64_t>(r.n_cells()); ++a) {
     const int64_t i = a % r.nx, j = (a / r.nx) % r.ny, k = a / step[2];
     for (int d = 0; d < 3; ++d) {
       if ((d == 0 && i + 1 == r.nx) || (d == 1 && j + 1 == r.ny) || (d == 2 && k + 1 == r.nz)) continue;
@@ -205,9 +206,9 @@ TEST(NearWellRefinement, ChildrenKeepTheModelsPoreVolumeMultipliers) {
     const CornerPointModel r = refined_model(m, ColumnSplits{{1, 2, 3, 3, 2, 1}, {2, 1, 2}, {}, {}});
     ASSERT_EQ(r.pore_volume_mult.empty(), !multpv);
     if (!multpv) continue;
-    ASSERT_EQ(r.pore_volume_mult.size(), r.corners.size());
+    ASSERT_EQ(r.pore_volume_mult.size(), r.n_cells());
     int aquifer = 0;
-    for (size_t a = 0; a < r.corners.size(); ++a) {
+    for (size_t a = 0; a < r.n_cells(); ++a) {
       EXPECT_EQ(r.pore_volume_mult[a], m.pore_volume_mult[r.parent_cell[a]]) << a;
       aquifer += r.pore_volume_mult[a] > 999;
     }
@@ -555,7 +556,7 @@ struct ReekSteepWell {
     auto face_centre = [&](int k, bool lower) {
       const int c = i + m.nx * (j + m.ny * k);
       Vec3 p{0, 0, 0};
-      for (int q = 0; q < 4; ++q) p += 0.25 * m.corners[c][q + (lower ? 4 : 0)];
+      for (int q = 0; q < 4; ++q) p += 0.25 * corner(m, c, q + (lower ? 4 : 0));
       return Vec3{m.map_origin[0] + p.x * m.map_unit_x[0] + p.y * m.map_unit_y[0],
                   m.map_origin[1] + p.x * m.map_unit_x[1] + p.y * m.map_unit_y[1], p.z};
     };

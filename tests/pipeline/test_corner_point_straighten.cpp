@@ -115,7 +115,7 @@ TEST(UprightPillars, LayersKeptPillarsUprightRockFromTheCellHoldingTheCentre) {
     for (int J = 0; J < r.ny; ++J)
       for (int I = 0; I < r.nx; ++I)
         for (int q = 0; q < 8; ++q) {
-          const Vec3 x = r.corners[I + size_t(r.nx) * (J + size_t(r.ny) * k)][q];
+          const Vec3 x = corner(r, I + size_t(r.nx) * (J + size_t(r.ny) * k), q);
           worst = std::max(worst, std::abs(x.z - layer_surface(g, k + (q >> 2), x.x, x.y)));
           EXPECT_EQ(x.z, r.zcorn[zcorn_index(r, I, J, k, q)]);
         }
@@ -133,13 +133,14 @@ TEST(UprightPillars, LayersKeptPillarsUprightRockFromTheCellHoldingTheCentre) {
   // Rock and parent: the model cell each turned cell's centre lies in, found from the model's own
   // geometry (not through the code's walk).
   int checked = 0;
-  for (size_t c = 0; c < r.corners.size(); ++c) {
-    if (r.corners[c] == m.corners[c]) {
+  for (size_t c = 0; c < r.n_cells(); ++c) {
+    const std::array<Vec3, 8> corners = cell_corners(r, c);
+    if (corners == cell_corners(m, c)) {
       EXPECT_EQ(r.parent_cell[c], m.parent_cell[c]);
       continue;
     }
     Vec3 centre{0, 0, 0};
-    for (const Vec3& x : r.corners[c]) centre += x / 8.0;
+    for (const Vec3& x : corners) centre += x / 8.0;
     const int64_t p = model_cell_at(g, centre);
     if (p < 0) continue;
     ++checked;

@@ -210,9 +210,9 @@ TEST(Grdecl, ReekReadsWithItsDimensionsActiveCellsAndMapAxes) {
   // Depths 1577-1950 m, PERMZ multiplied by 0.3 in the deck (MULTIPLY): kz/kx well below 1.
   double zmin = 1e30, zmax = -1e30, kv_kh = 0;
   int n = 0;
-  for (size_t c = 0; c < m.corners.size(); ++c) {
+  for (size_t c = 0; c < m.n_cells(); ++c) {
     if (!m.actnum[c]) continue;
-    for (const Vec3& p : m.corners[c]) zmin = std::min(zmin, p.z), zmax = std::max(zmax, p.z);
+    for (const Vec3& p : cell_corners(m, c)) zmin = std::min(zmin, p.z), zmax = std::max(zmax, p.z);
     if (m.permx[c] > 0) kv_kh += m.permz[c] / m.permx[c], ++n;
   }
   EXPECT_GT(zmin, 1500);
@@ -582,8 +582,8 @@ TEST(CornerPoint, MeshingInTheLocalFrameGivesTheUsersModelBackBitForBit) {
     }
     EXPECT_TRUE(same_bits(back.coord, given.coord)) << shift.x;
     EXPECT_TRUE(same_bits(back.zcorn, given.zcorn)) << shift.x;
-    ASSERT_EQ(back.corners.size(), given.corners.size());
-    EXPECT_EQ(std::memcmp(back.corners.data(), given.corners.data(), given.corners.size() * sizeof(given.corners[0])), 0);
+    // and so the corners, computed from them
+    EXPECT_TRUE(back.nx == given.nx && back.ny == given.ny && back.nz == given.nz) << shift.x;
     EXPECT_TRUE(same_bits(back.permx, given.permx) && same_bits(back.poro, given.poro));
     EXPECT_EQ(back.actnum, given.actnum);
     ASSERT_EQ(h.mesh.n_cells(), r.out.mesh.n_cells()) << shift.x;
