@@ -330,11 +330,8 @@ Vec3 corner(const CornerPointModel& m, size_t cell, int q) {
 }
 
 std::array<Vec3, 8> cell_corners(const CornerPointModel& m, size_t cell) {
-  const size_t nx = size_t(m.nx), ny = size_t(m.ny);
-  const int i = static_cast<int>(cell % nx), j = static_cast<int>(cell / nx % ny), k = static_cast<int>(cell / (nx * ny));
   std::array<Vec3, 8> out;
-  for (int q = 0; q < 8; ++q)
-    out[q] = pillar_point(m, i + (q & 1) + (m.nx + 1) * (j + ((q >> 1) & 1)), m.zcorn[zcorn_index(m, i, j, k, q)]);
+  for (int q = 0; q < 8; ++q) out[q] = corner(m, cell, q);
   return out;
 }
 
