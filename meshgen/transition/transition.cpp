@@ -229,7 +229,7 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   int repairs = 0;
   if (images.empty()) {
     sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, out);
-    // optimize_sites ends with the same repair rounds.
+    // optimize_sites ends with repair rounds of its own (steps, no removals).
     if (!optimize) repairs = repair_failing_cells(set, cavity, node_coords, frames, options, outside, out);
   }
   if (raw) out.unoptimized = std::move(raw);
