@@ -138,6 +138,7 @@ struct BendPlan {
   double radius = 0;    // rho
   double tangent = 0;   // t
   int wedges = 0;       // k
+  double lean = 0;      // largest lean of its joint and outer faces (bend_lean), radians
 };
 
 // rho >= 1.3 R: the wedges' inner sides stay open and the transition's free sites fit on the
@@ -349,6 +350,114 @@ std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& l
     }
   }
   return st;
+}
+
+// ---- Wedge counts for orthogonality at bends.
+// Faces between two wedges are mirror planes (orthogonal); two faces of a bend are not
+// (docs/anisotropy.md, "Bend wedges"): the cross-section where a straight cell meets the first
+// (last) wedge, whose wedge centre lies nearer the arc's axis than the straight cell's, and a
+// wedge's outer ring face, whose transition site lies on the normal through the face's
+// circumcentre, off the wedge centre's normal line. Both leans fall as the wedge angle squared.
+
+// FV centre of the radial cell (ring, sector) between stations a and b (as make_well_block
+// places it: the midpoint of the point at r_center on the mid-angle line of both cross-sections).
+Vec3 radial_centre(const Station& a, const Station& b, double r_center, double phi_mid) {
+  const double c = std::cos(phi_mid), s = std::sin(phi_mid);
+  return 0.5 * (a.p + r_center * (c * a.u + s * a.v) + b.p + r_center * (c * b.u + s * b.v));
+}
+
+double angle_between(Vec3 a, Vec3 b) { return std::atan2(norm(cross(a, b)), std::abs(dot(a, b))); }
+
+// Circumcentre of the triangle p0 p1 p2 (of a planar co-circular polygon through them).
+Vec3 circumcentre(Vec3 p0, Vec3 p1, Vec3 p2) {
+  const Vec3 a = p1 - p0, b = p2 - p0, n = cross(a, b);
+  return p0 + cross(dot(a, a) * b - dot(b, b) * a, n) / (2.0 * dot(n, n));
+}
+
+// The largest lean (radians) at the bend whose stations carry bend_point == point: across the
+// cross-sections joining the wedges to the straight cells, and between a wedge's outer ring
+// cell and a transition site on its outer face's circumcentre normal, taken in the face's plane
+// (site height 0: the bound for any height the transition gives it).
+double bend_lean(const std::vector<Station>& st, int point, const std::vector<double>& radii, int sectors) {
+  int first = -1, last = -1;
+  for (int l = 0; l < static_cast<int>(st.size()); ++l)
+    if (st[l].bend_point == point) {
+      if (first < 0) first = l;
+      last = l;
+    }
+  const int rings = static_cast<int>(radii.size()) - 1;
+  const double sector_angle = 2.0 * kPi / sectors;
+  double lean = 0;
+  for (int i = 0; i < rings; ++i) {
+    const double r_center = std::sqrt(radii[i] * radii[i + 1]);
+    for (int s = 0; s < sectors; ++s) {
+      const double phi = (s + 0.5) * sector_angle;
+      for (int joint : {first, last}) {
+        const int before = joint - 1, after = joint + 1;
+        if (before < 0 || after >= static_cast<int>(st.size())) continue;
+        const Vec3 d = radial_centre(st[joint], st[after], r_center, phi) - radial_centre(st[before], st[joint], r_center, phi);
+        lean = std::max(lean, angle_between(d, st[joint].d));
+      }
+      if (i + 1 < rings) continue;
+      const double r = radii[rings], p0 = s * sector_angle, p1 = p0 + sector_angle;
+      for (int l = first; l < last; ++l) {
+        const Station &a = st[l], &b = st[l + 1];
+        auto at = [&](const Station& x, double q) { return x.p + r * (std::cos(q) * x.u + std::sin(q) * x.v); };
+        const Vec3 n0 = at(a, p0), n1 = at(a, p1), n2 = at(b, p1);
+        const Vec3 normal = normalized(cross(n1 - n0, n2 - n0));
+        const Vec3 to_centre = radial_centre(a, b, r_center, phi) - circumcentre(n0, n1, n2);
+        lean = std::max(lean, angle_between(to_centre, normal));
+      }
+    }
+  }
+  return lean;
+}
+
+// Leans above this raise the bend's wedge count (issue 15: 1 degree on every radial and
+// transition face). The outer faces' lean is bounded at site height 0; the transition's sites
+// sit higher, so fvcheck measures less. A tighter bound gives more, narrower wedges, which the
+// transition holds less well (docs/anisotropy.md, "Wedges by their lean").
+constexpr double kMaxBendLean = 1.0 * kPi / 180.0;
+// More wedges than this per bend are not made: the lean stays above kMaxBendLean (a short
+// straight cell beside a sharp bend) and the note says so.
+constexpr int kMaxBendWedges = 24;
+
+// The stations of make_stations with each bend's wedge count raised (plans updated) until
+// its lean is at most kMaxBendLean or it has kMaxBendWedges wedges.
+std::vector<Station> stations_with_orthogonal_bends(const WellSpec& ws, const std::vector<Leg>& legs,
+                                                    std::vector<BendPlan>& plans, std::array<double, 2> end_min,
+                                                    const std::vector<double>& radii, int sectors) {
+  for (;;) {
+    std::vector<Station> st = make_stations(ws, legs, plans, end_min);
+    bool raised = false;
+    for (BendPlan& p : plans) {
+      p.lean = bend_lean(st, p.point, radii, sectors);
+      if (p.lean > kMaxBendLean && p.wedges < kMaxBendWedges) {
+        ++p.wedges;
+        raised = true;
+      }
+    }
+    if (!raised) return st;
+  }
+}
+
+// The block's axis: its bends (wedge counts raised for orthogonality) and its stations, as
+// make_well_block builds them with `sectors` sectors.
+struct BlockAxis {
+  std::vector<BendPlan> plans;
+  std::vector<Station> stations;
+};
+
+BlockAxis block_axis(const CaseSpec& cs, int w, const WellSpec& ws, const std::vector<Leg>& legs,
+                     const std::vector<double>& radii, int sectors) {
+  const MeshedTrajectory mt = meshed_trajectory(cs.reservoir, cs.wells[w], well_key(w), false);
+  std::array<double, 2> end_min{0.0, 0.0};
+  for (int e = 0; e < 2; ++e)
+    if (ws.end_caps == EndCaps::Flat && mt.ends[e] != WellEndKind::Boundary) end_min[e] = flat_end_min_segment(radii, sectors);
+  BlockAxis axis;
+  axis.plans = plan_bends(ws, w, legs);
+  axis.stations = stations_with_orthogonal_bends(ws, legs, axis.plans, end_min, radii, sectors);
+  return axis;
 }
 
 // Signed volume of a closed cell given as its 6 outward faces (fan around each face's node
@@ -580,11 +689,9 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
   }
 
   const std::vector<Leg> legs = make_legs(ws, w);
-  const std::vector<BendPlan> plans = plan_bends(ws, w, legs);
-  std::array<double, 2> end_min{0.0, 0.0};
-  for (int e = 0; e < 2; ++e)
-    if (ws.end_caps == EndCaps::Flat && !block.boundary_end[e]) end_min[e] = flat_end_min_segment(block.radii, sectors);
-  const std::vector<Station> stations = make_stations(ws, legs, plans, end_min);
+  const BlockAxis axis = block_axis(cs, w, ws, legs, block.radii, sectors);
+  const std::vector<BendPlan>& plans = axis.plans;
+  const std::vector<Station>& stations = axis.stations;
   const int n_layers = static_cast<int>(stations.size());
   block.layers = n_layers;
   for (const Station& st : stations) {
@@ -601,7 +708,11 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
                           std::to_string(p.point) + " meshed as " + std::to_string(p.wedges) +
                           " mirror wedge(s) on an arc of radius " + num(p.radius) + " m: the wellbore axis leaves the"
                           " trajectory " + num(p.tangent) + " m before the point and passes " +
-                          num(polyline_distance({ws.trajectory[p.point]}, block.layer_center)) + " m from it");
+                          num(polyline_distance({ws.trajectory[p.point]}, block.layer_center)) + " m from it" +
+                          (p.lean > kMaxBendLean ? "; its faces lean up to " + num(p.lean * 180 / kPi) +
+                                                       " degrees off orthogonal (" + std::to_string(kMaxBendWedges) +
+                                                       " wedges at most; a longer leg beside it gives less)"
+                                                 : ""));
 
   // Nodes: local id = (layer * (rings + 1) + ring) * sectors + sector.
   const int rings = ws.rings;
@@ -871,7 +982,7 @@ std::vector<int32_t> add_well_block(const WellBlock& block, MeshBuilder& builder
   return ids;
 }
 
-double well_block_prism_length(const CaseSpec& cs, int w) {
+double well_block_prism_length(const CaseSpec& cs, int w, int sectors) {
   const WellSpec ws = block_well_spec(cs, w);
   const std::vector<Leg> legs = make_legs(ws, w);
   double length = 0;
@@ -880,7 +991,7 @@ double well_block_prism_length(const CaseSpec& cs, int w) {
   // cross-section projected on the mirror plane (area A cos(a/2)), of height 2 |h| with h
   // affine over it and equal to delta cos(a/2) at the centre: volume A x 2 delta cos^2(a/2).
   // The k wedges of a bend replace the 2 t of straight legs around the bend point.
-  for (const BendPlan& p : plan_bends(ws, w, legs)) {
+  for (const BendPlan& p : block_axis(cs, w, ws, legs, ring_radii(ws), sectors).plans) {
     const double a = p.angle / p.wedges, delta = p.radius * std::tan(0.5 * a), c = std::cos(0.5 * a);
     length += p.wedges * 2.0 * delta * c * c - 2.0 * p.tangent;
   }
@@ -913,13 +1024,13 @@ double exact_well_block_volume(const CaseSpec& cs, int w, int sectors) {
                           ? 2.0 * (hemisphere_cap_volume(ws.drainage_radius, sectors) -
                                    hemisphere_cap_volume(ws.radius, sectors))
                           : 0.0;
-  return annulus * well_block_prism_length(cs, w) + caps;
+  return annulus * well_block_prism_length(cs, w, sectors) + caps;
 }
 
 double exact_wellbore_hole_volume(const CaseSpec& cs, int w, int sectors) {
   const WellSpec ws = block_well_spec(cs, w);
   const double caps = ws.end_caps == EndCaps::Hemisphere ? 2.0 * hemisphere_cap_volume(ws.radius, sectors) : 0.0;
-  return regular_polygon_area(sectors, ws.radius) * well_block_prism_length(cs, w) + caps;
+  return regular_polygon_area(sectors, ws.radius) * well_block_prism_length(cs, w, sectors) + caps;
 }
 
 }  // namespace hm

@@ -89,8 +89,9 @@ void add_well_block_cells(const WellBlock& block, const std::vector<int32_t>& id
 
 /// L* such that the block's volume is (outer - inner polygon area) x L* and the wellbore
 /// hole's is (inner polygon area) x L*: the trajectory length, less 2 t per bend, plus
-/// 2 delta cos^2(a / 2) per wedge (closed form of the mirror wedges, well_block.cpp).
-double well_block_prism_length(const CaseSpec& cs, int w);
+/// 2 delta cos^2(a / 2) per wedge (closed form of the mirror wedges, well_block.cpp). The wedge
+/// counts depend on the sectors (bends' orthogonality, well_block.cpp).
+double well_block_prism_length(const CaseSpec& cs, int w, int sectors);
 
 /// Volume of a hemispherical cap's polyhedral half-ball of the given radius (the region inside
 /// its shell faces at that radius and the end cross-section), from the cap's node positions.

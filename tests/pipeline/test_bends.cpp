@@ -207,12 +207,14 @@ TEST(Bends, ValidationRefusesBendsAboveTheLimit) {
 // degrees, to the limit kMaxBendDegrees in HM_BEND_STEP steps, default 2.5; to measure beyond the
 // limit, raise kMaxBendDegrees, which validation applies, and rebuild), R / dx (0.6, 1.4), inclination of the first leg (0, 50, 90),
 // fillet (1.5 R, 1.3 R); caps and flat ends alternate, the bend plane turns by 37 degrees per case,
-// optimisation on for every fourth case. Prints one line per case and a table per bend angle.
+// optimisation on for every fourth case. Prints one line per case (its index first) and a table per bend angle.
 TEST(Bends, SweepTable) {
   const char* v = std::getenv("HM_LONG_TESTS");
   if (!(v && std::string(v) == "1")) GTEST_SKIP() << "long test: set HM_LONG_TESTS=1";
   const double step = std::getenv("HM_BEND_STEP") ? std::atof(std::getenv("HM_BEND_STEP")) : 2.5;
   const double from = std::getenv("HM_BEND_FROM") ? std::atof(std::getenv("HM_BEND_FROM")) : 30;
+  // HM_BEND_DUMP=DIR: every case's file as DIR/bend_<index>.yaml (the index printed per case), for meshgen.
+  const char* dump_dir = std::getenv("HM_BEND_DUMP");
   struct Row {
     int cases = 0, meshed = 0;
     std::map<Outcome, int> count;
@@ -230,11 +232,16 @@ TEST(Bends, SweepTable) {
           b.optimize = index % 4 == 1;
           ++index;
           const RealisticCase rc = make_bend_case(b);
+          if (dump_dir) {
+            std::ofstream yaml(std::string(dump_dir) + "/bend_" + std::to_string(index - 1) + ".yaml");
+            yaml << rc.yaml;
+            EXPECT_TRUE(yaml.good()) << "HM_BEND_DUMP: cannot write into " << dump_dir;
+          }
           const CaseResult res = mesh_and_check_isolated(rc, 600);
           Row& row = rows[beta];
           ++row.cases;
           ++row.count[res.outcome];
-          std::printf("[ bends     ] %s: %s %.2f s %s\n", rc.label.c_str(), outcome_name(res.outcome), res.seconds,
+          std::printf("[ bends     ] %d %s: %s %.2f s %s\n", index - 1, rc.label.c_str(), outcome_name(res.outcome), res.seconds,
                       res.reason.substr(0, 160).c_str());
           std::fflush(stdout);
         }

@@ -182,7 +182,7 @@ TEST(BoundaryWells, BlockCoversOnlyTheMeshedPart) {
   const WellBlock b = make_gabriel_well_block(cs, 0);
   EXPECT_EQ(b.layer_center.front().z, 1000.0);
   EXPECT_EQ(b.layer_center.back().z, 1060.0);
-  EXPECT_NEAR(well_block_prism_length(cs, 0), 60.0, 1e-12);
+  EXPECT_NEAR(well_block_prism_length(cs, 0, b.sectors), 60.0, 1e-12);
   // Oblique: the block ends where its end section keeps kRetractGap R from the top.
   const CaseSpec dev = example("deviated_through_top");
   const WellBlock d = make_gabriel_well_block(dev, 0);

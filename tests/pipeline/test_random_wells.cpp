@@ -41,7 +41,7 @@ double box_minus_hole(const CaseSpec& cs, const HybridMesh& h) {
   const double caps =
       cs.wells[0].end_caps == EndCaps::Hemisphere ? 2 * hemisphere_cap_volume(r_w, sectors) : 0.0;
   return 200.0 * 200.0 * 100.0 -
-         0.5 * sectors * r_w * r_w * std::sin(2 * M_PI / sectors) * well_block_prism_length(cs, 0) - caps;
+         0.5 * sectors * r_w * r_w * std::sin(2 * M_PI / sectors) * well_block_prism_length(cs, 0, sectors) - caps;
 }
 // Every other case with hemispherical end caps, strictly (they must mesh: no fallback to flat ends).
 void alternate_end_caps(WellSpec& w, int t) {

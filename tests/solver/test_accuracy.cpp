@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include <string>
 
 #include "fvcheck/lib/transmissibility.hpp"
+#include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/permeability_frame.hpp"
 #include "solver_demo/lib/accuracy.hpp"
@@ -70,18 +72,20 @@ TEST(AccuracySetup, ExactRateAndSourceFollowTheCase) {
   const CaseSpec cs = accuracy_case("bent");
   const AccuracySetup s = make_accuracy_setup(cs);
   // The source follows the meshed axis: the trajectory with its bend cut along the chords of
-  // the block's fillet (docs/architecture.md): radius rho = 1.5 R, k wedges (at most 30 degrees,
-  // none longer than a segment on the outside of the bend, at radius rho + R), tangents
-  // t = rho tan(beta/2) replaced by k chords 2 rho sin(beta / 2k).
+  // the block's fillet (docs/architecture.md): radius rho = 1.5 R, k wedges (the block's),
+  // tangents t = rho tan(beta/2) replaced by k chords 2 rho sin(beta / 2k).
   const WellSpec& w = cs.wells[0];
   const std::vector<Vec3>& t = w.trajectory;
   const Vec3 d1 = normalized(t[1] - t[0]), d2 = normalized(t[2] - t[1]);
   const double beta = std::atan2(norm(cross(d1, d2)), dot(d1, d2)), rho = 1.5 * w.drainage_radius;
-  const int k = std::max(static_cast<int>(std::ceil(beta / (M_PI / 6))),
-                         static_cast<int>(std::ceil((rho + w.drainage_radius) * beta / w.segment_length)));
+  const WellBlock block = make_gabriel_well_block(cs, 0);
+  const int k = static_cast<int>(std::count_if(block.layer_bend.begin(), block.layer_bend.end(),
+                                               [](int b) { return b >= 0; })) - 1;
   const double length = norm(t[1] - t[0]) + norm(t[2] - t[1]) - 2 * rho * std::tan(beta / 2) +
                         k * 2 * rho * std::sin(beta / (2 * k));
-  EXPECT_EQ(k, 4);  // the 40-degree bend of accuracy_bent: 20 m x 0.70 rad / 4 m = 3.5 -> 4
+  // The 40-degree bend of accuracy_bent: 7 wedges keep its faces within 1 degree of orthogonal
+  // (well_block.cpp, bend_lean; 4 before, from a segment's length on the outside of the bend).
+  EXPECT_EQ(k, 7);
   EXPECT_NEAR(s.field.source_length(), length - 2 * w.radius, 1e-9);
   EXPECT_NEAR(s.drawdown, 50.0, 1e-12);
   EXPECT_NEAR(s.near_radius, 24.0, 1e-12);
