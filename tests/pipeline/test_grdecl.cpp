@@ -337,6 +337,25 @@ int64_t interior_faces_between_columns(const HybridMesh& out, int i0, int i1) {
 // volume, every face matched (the self-check's conformity, closure and volume checks pass: they
 // would throw), the fault faces split where the two sides' edges cross, and the total volume
 // equal to OPM's active volume.
+// metric: permeability is refused on a true corner-point model (its cells are meshed in the model's
+// frame, never the frame of K) and accepted on a model of axis-aligned boxes, which is meshed as its axes.
+TEST(CornerPoint, PermeabilityMetricIsRefusedNamingTheKey) {
+  TempDir tmp;
+  write(tmp.path / "CPG.GRDECL", SyntheticCpg{}.text());
+  write(tmp.path / "BOX.GRDECL", grdecl_of_box(kX, kY, kZ, false));
+  try {
+    load_case(write(tmp.path / "cpg.yaml", "name: cpg\nmetric: permeability\nreservoir: {grdecl: CPG.GRDECL}\n"));
+    ADD_FAILURE() << "a corner-point model with metric: permeability was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("metric: permeability is not implemented for a corner-point model", 0), 0u)
+        << e.what();
+  }
+  const CaseSpec box = load_case(write(tmp.path / "box.yaml", "name: box\nmetric: permeability\nreservoir: {grdecl: "
+                                                              "BOX.GRDECL}\n" + std::string(kGrdeclWell)));
+  EXPECT_FALSE(box.reservoir.corner_point);
+  EXPECT_EQ(box.metric, MeshMetric::Permeability);
+}
+
 TEST(CornerPoint, FaultedPinchedModelMeshesAsItsCells) {
   TempDir tmp;
   const SyntheticCpg g;
