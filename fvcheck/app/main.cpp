@@ -17,6 +17,7 @@
 #include "fvcheck/lib/report_json.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/core/malloc_tunables.hpp"
+#include "meshgen/core/mesh_positions.hpp"
 #include "meshgen/core/parallel.hpp"
 #include "meshgen/core/progress.hpp"
 
@@ -122,6 +123,9 @@ int main(int argc, char** argv) {
   // The mesh holds every array it uses (restore_mesh_cell_arrays): the file's copies go now, not
   // after the checks (a third of the memory of a large file).
   in.cell_arrays = {};
+
+  // Checked in a local frame, as meshgen checks it (plan_origin): shape figures do not depend on it.
+  hm::translate_mesh(in.mesh, -1.0 * hm::plan_origin(in.mesh));
 
   hm::MeshGeometry geo;  // the checks' geometry pass, reused for the transmissibilities
   hm::FvReport report = hm::run_fvcheck(in.mesh, opt, h_ref, &in.build, &geo);

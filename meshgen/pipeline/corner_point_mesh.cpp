@@ -250,6 +250,7 @@ HybridMesh build_corner_point_wells(const CaseSpec& input, const PipelineOptions
   topts.optimize = opts.optimize && cs.transition.optimize;
   topts.g_remove = cs.transition.gamma[1];
   topts.g_expand = cs.transition.gamma[2];
+  topts.written_origin = opts.written_origin;
   constexpr int kMaxEnlargements = 5;
   std::vector<int32_t> extra;
   std::string asked_by;  // the latest refusal that enlarged a cavity

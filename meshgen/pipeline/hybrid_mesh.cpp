@@ -270,6 +270,7 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
     topts.optimize = opts.optimize && cs.transition.optimize;
     topts.g_remove = cs.transition.gamma[1];
     topts.g_expand = cs.transition.gamma[2];
+    topts.written_origin = opts.written_origin;
     std::vector<CachedTransition> keys(nk);
     std::vector<std::optional<TransitionOutcome>> outcomes(nk);
     std::vector<int> to_build;

@@ -59,20 +59,4 @@ HybridMesh build_hybrid_mesh_in_local_frame(CaseSpec& cs, const PipelineOptions&
   }
 }
 
-void round_to_written_frame(PolyMesh& mesh, Vec3 origin) {
-  if (origin == Vec3{}) return;
-  auto as_written = [&](Vec3& p) { p = (p + origin) - origin; };
-  for (Vec3& p : mesh.nodes) as_written(p);
-  for (Vec3& p : mesh.cell_fv_center) as_written(p);
-  for (RadialCellInfo& r : mesh.cell_radial)
-    if (r.band >= 0) as_written(r.cap_center);
-}
-
-void translate_mesh(PolyMesh& mesh, Vec3 shift) {
-  for (Vec3& p : mesh.nodes) p += shift;
-  for (Vec3& p : mesh.cell_fv_center) p += shift;
-  for (RadialCellInfo& r : mesh.cell_radial)
-    if (r.band >= 0) r.cap_center += shift;
-}
-
 }  // namespace hm

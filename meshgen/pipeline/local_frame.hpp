@@ -5,6 +5,7 @@
 // the origin is added back only when a file is written.
 #pragma once
 #include "meshgen/case/case.hpp"
+#include "meshgen/core/mesh_positions.hpp"  // round_to_written_frame, translate_mesh
 #include "meshgen/core/polymesh.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 
@@ -29,15 +30,5 @@ bool translation_round_trips(const CornerPointModel& m, Vec3 shift);
 /// (so the deck still gets the user's own numbers), cs's copy is released while meshing and made
 /// again from the local one afterwards. cs is as given on return, also when meshing throws.
 HybridMesh build_hybrid_mesh_in_local_frame(CaseSpec& cs, const PipelineOptions& opts = {});
-
-/// Rounds every position that translate_mesh moves to (p + origin) - origin: the position the
-/// written file's coordinates give back in the local frame. Field models' small faces do not all
-/// survive that rounding (a sliver face's plane tilts), so the self-check must see it. The files'
-/// coordinates are unchanged by it where p + origin - origin is exact (Sterbenz), as at UTM values.
-void round_to_written_frame(PolyMesh& mesh, Vec3 origin);
-
-/// Moves every position of the mesh by `shift`: nodes, FV centres, end-cap centres. Everything
-/// else in a PolyMesh (topology, permeability, radii, lengths) does not depend on the frame.
-void translate_mesh(PolyMesh& mesh, Vec3 shift);
 
 }  // namespace hm

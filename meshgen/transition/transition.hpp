@@ -22,6 +22,10 @@ struct TransitionOptions {
   double g_expand = 0.40;   ///< gamma G3: other edges with a free end below G3 h are expanded to it
   double max_shift = 0.5;   ///< a site moves at most this fraction of the edge's h per step
   int max_rounds = 8;       ///< rounds of simultaneous independent moves (each: one or two rebuilds)
+  /// The offset the mesh's files hold it at (PipelineOptions::written_origin, 0: the frame it is
+  /// built in): the repairs of cells that fail a shape check judge the cells at the positions those
+  /// files give back (round_to_written_frame), so that what they repair stays repaired as written.
+  Vec3 written_origin;
 };
 
 struct SiteOptimizeReport {

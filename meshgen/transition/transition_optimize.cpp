@@ -23,6 +23,7 @@
 #include "fvcheck/lib/checks.hpp"
 #include "meshgen/core/fv_quality.hpp"
 #include "meshgen/core/geometry.hpp"
+#include "meshgen/core/mesh_positions.hpp"
 #include "transition_internal.hpp"
 
 namespace hm::transition_detail {
@@ -292,7 +293,13 @@ class SiteOptimizer {
                 const std::vector<PolygonFrame>& frames, const std::vector<double>& h_ref,
                 const TransitionOptions& opt, const std::vector<Vec3>& outside_centres, Pass pass = Pass::Optimize)
       : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt),
-        outside_centres_(outside_centres), pass_(pass) {}
+        outside_centres_(outside_centres), pass_(pass) {
+    // Repairs judge the cells as written (TransitionOptions::written_origin): the well cells'
+    // centres beyond their faces too.
+    if (pass_ == Pass::Repairs)
+      for (Vec3& c : outside_centres_)
+        if (std::isfinite(c.x)) c = as_written(c, opt_.written_origin);
+  }
 
   // One round on `out` (a valid diagram of set_): true if some move was kept.
   // skew_only: only steps against skewed faces and repairs. Sets skewed_left() to the count on
@@ -320,6 +327,7 @@ class SiteOptimizer {
   Measured measure(const TransitionCells& t) const {
     Measured m;
     m.sub = transition_submesh(t, coords_, &m.global);
+    if (pass_ == Pass::Repairs) round_to_written_frame(m.sub, opt_.written_origin);
     m.qs = cell_shape_quality(m.sub, h_ref_);
     m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
     m.failing = shape_failures(m.sub, m.global, t, cavity_, outside_centres_);
@@ -375,7 +383,7 @@ class SiteOptimizer {
   const std::vector<PolygonFrame>& frames_;
   const std::vector<double>& h_ref_;
   const TransitionOptions& opt_;
-  const std::vector<Vec3>& outside_centres_;
+  std::vector<Vec3> outside_centres_;  // a copy: the repairs round them (as written)
   std::set<std::array<int, 9>> refused_;
   SiteSlab slab_;  // the sites by x, for centred(): reset at each round's start
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds

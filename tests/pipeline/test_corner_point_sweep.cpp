@@ -249,15 +249,12 @@ CaseSpec load_sweep_case(const CornerPointSweepCase& c) {
 
 // Meshes the case (in the local frame, as meshgen does) and checks what the module promises.
 // optimize = false: as `meshgen --no-optimize`; the reason then ends with the repairs kept.
-// written = false: the self-check judges the local frame's positions, not those the files get
-// (round_to_written_frame), to test the transition's own stages apart.
-CaseResult mesh_corner_point_case(const CornerPointSweepCase& c, bool optimize = true, bool written = true) {
+CaseResult mesh_corner_point_case(const CornerPointSweepCase& c, bool optimize = true) {
   return run_classified([&](CaseResult& res) {
     CaseSpec cs = load_sweep_case(c);
     if (!optimize) cs.transition.optimize = false;
     CaseSpec user = cs;
-    const HybridMesh h = written ? build_hybrid_mesh_in_local_frame(user)  // throws if the self-check fails
-                                 : build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)));
+    const HybridMesh h = build_hybrid_mesh_in_local_frame(user);  // throws if the self-check fails
     CaseSpec bare = cs;
     bare.wells.clear();
     double expected = total_volume(build_hybrid_mesh(bare).geometry);
@@ -412,14 +409,14 @@ TEST(CornerPointSweep, CiHorizontalSurveyWellMeshesWhereverTheModelSits) {
 // one merged cavity of 148,814 transition cells, whose raw diagram has two cells failing convexity
 // beside an 8e-5 m edge between free vertices (nearly co-spherical sites, above the sliver pass's
 // 1e-5 h). Without optimisation the self-check refused the mesh; the repair pass
-// (repair_failing_cells: a failing cell's short edge removed) mends them in the local frame, where
-// the transition is built (docs/transition.md, "Repairs without optimisation"). In the coordinates
-// the files get, one cell still fails (meshgen exits 1): not asserted here. About 7.2 GB and 4-6
-// minutes in Release: HM_LONG_TESTS=1.
+// (repair_failing_cells: a failing cell's short edge removed) mends them, judging the cells at the
+// coordinates the files get (TransitionOptions::written_origin; docs/transition.md, "Repairs
+// without optimisation"): meshed as meshgen does, the self-check passes as written. About 6.5 GB
+// and 3-5 minutes in Release: HM_LONG_TESTS=1.
 TEST(CornerPointSweep, HorizontalSeed6TwoWellsRawDiagramIsRepaired) {
   if (!long_tests()) GTEST_SKIP() << "HM_LONG_TESTS=1 runs it (7 GB)";
   const CornerPointSweepCase c = make_horizontal_case(6, 2);
-  const CaseResult r = run_isolated([&] { return mesh_corner_point_case(c, false, false); }, 1800);
+  const CaseResult r = run_isolated([&] { return mesh_corner_point_case(c, false); }, 1800);
   std::printf("[ seed 6  ] %s: %s (%.1f s)\n", outcome_name(r.outcome), r.reason.c_str(), r.seconds);
   ASSERT_EQ(r.outcome, Outcome::Meshed) << r.reason;
   const size_t at = r.reason.find("; repairs ");
