@@ -359,8 +359,11 @@ std::vector<Station> make_stations(const WellSpec& ws, const std::vector<Leg>& l
 // wedge's outer ring face, whose transition site lies on the normal through the face's
 // circumcentre, off the wedge centre's normal line. Both leans fall as the wedge angle squared.
 
-// FV centre of the radial cell (ring, sector) between stations a and b (as make_well_block
-// places it: the midpoint of the point at r_center on the mid-angle line of both cross-sections).
+// The radius of ring i's FV centres: the geometric mean of its radii (the log form's).
+double ring_centre_radius(const std::vector<double>& radii, int i) { return std::sqrt(radii[i] * radii[i + 1]); }
+
+// FV centre of the radial cell (ring, sector) between stations a and b: the midpoint of the point
+// at r_center on the mid-angle radial line of both cross-sections.
 Vec3 radial_centre(const Station& a, const Station& b, double r_center, double phi_mid) {
   const double c = std::cos(phi_mid), s = std::sin(phi_mid);
   return 0.5 * (a.p + r_center * (c * a.u + s * a.v) + b.p + r_center * (c * b.u + s * b.v));
@@ -389,7 +392,7 @@ double bend_lean(const std::vector<Station>& st, int point, const std::vector<do
   const double sector_angle = 2.0 * kPi / sectors;
   double lean = 0;
   for (int i = 0; i < rings; ++i) {
-    const double r_center = std::sqrt(radii[i] * radii[i + 1]);
+    const double r_center = ring_centre_radius(radii, i);
     for (int s = 0; s < sectors; ++s) {
       const double phi = (s + 0.5) * sector_angle;
       for (int joint : {first, last}) {
@@ -416,7 +419,7 @@ double bend_lean(const std::vector<Station>& st, int point, const std::vector<do
 // Leans above this raise the bend's wedge count (issue 15: 1 degree on every radial and
 // transition face). The outer faces' lean is bounded at site height 0; the transition's sites
 // sit higher, so fvcheck measures less. A tighter bound gives more, narrower wedges, which the
-// transition holds less well (docs/anisotropy.md, "Wedges by their lean").
+// transition holds less well (docs/anisotropy.md, "Session 34: wedges by their lean").
 constexpr double kMaxBendLean = 1.0 * kPi / 180.0;
 // More wedges than this per bend are not made: the lean stays above kMaxBendLean (a short
 // straight cell beside a sharp bend) and the note says so.
@@ -737,7 +740,7 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
     rad.segment = segment;
     rad.r_in = block.radii[ring];
     rad.r_out = block.radii[ring + 1];
-    rad.r_center = std::sqrt(rad.r_in * rad.r_out);
+    rad.r_center = ring_centre_radius(block.radii, ring);
     rad.angle = sector_angle;
     return at;
   };
@@ -772,14 +775,8 @@ WellBlock make_well_block(const CaseSpec& cs, int w, int sectors) {
         CellAttributes at = radial_cell(i, s, l);
         const RadialCellInfo& rad = at.radial;
         at.radial.length = length;
-        const double phi_mid = (s + 0.5) * sector_angle;
-        // Midpoint of the point at radius r_center on the mid-angle radial line of both
-        // cross-sections: the axis midpoint on straight parts (ring and angular faces exactly
-        // orthogonal), on the mirror plane in a wedge (the point's image).
-        const double cm = std::cos(phi_mid), sm = std::sin(phi_mid);
-        const Vec3 x0 = s0.p + rad.r_center * (cm * s0.u + sm * s0.v);
-        const Vec3 x1 = s1.p + rad.r_center * (cm * s1.u + sm * s1.v);
-        at.fv_center = 0.5 * (x0 + x1);
+        // Ring and angular faces exactly orthogonal on straight parts; on the mirror plane in a wedge.
+        at.fv_center = radial_centre(s0, s1, rad.r_center, (s + 0.5) * sector_angle);
         block.cell_faces.push_back(std::move(faces));
         block.cell_attrs.push_back(at);
       }

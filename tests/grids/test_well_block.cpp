@@ -598,6 +598,21 @@ TEST(WellBlock, BendFacesLeanAtMostOneDegree) {
       }
 }
 
+// Where even kMaxBendWedges wedges leave a bend's faces leaning more than 1 degree (a short straight
+// cell between two sharp bends), the block is still made and the bend's note says how far off it is.
+TEST(WellBlock, BendThatCannotBeMadeOrthogonalSaysSo) {
+  WellParams p;
+  p.trajectory = {{0, 0, 0}, {0, 0, 40}, {21, 0, 40}, {21, 0, 0}};  // two 90-degree bends, a 21 m leg between
+  p.end_caps = EndCaps::Flat;
+  const WellBlock b = make_well_block(make_case(p), 0, 12);
+  ASSERT_EQ(b.notes.size(), 2u);
+  for (const std::string& note : b.notes) {
+    std::printf("[ bend note ] %s\n", note.c_str());
+    EXPECT_NE(note.find("meshed as 24 mirror wedge(s)"), std::string::npos) << note;
+    EXPECT_NE(note.find("; its faces lean up to "), std::string::npos) << note;
+  }
+}
+
 // ---------------------------------------------------------------- segments near bends
 
 TEST(WellBlock, BendNotesStateTheWedgesAndTheAxisOffset) {
