@@ -18,8 +18,10 @@
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/core/cli.hpp"
+#include "meshgen/core/mesh_positions.hpp"
 #include "meshgen/core/text_file.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
+#include "meshgen/pipeline/local_frame.hpp"
 #include "solver_demo/lib/accuracy.hpp"
 #include "solver_demo/lib/case_problem.hpp"
 #include "solver_demo/lib/tpfa.hpp"
@@ -84,17 +86,26 @@ std::string load_mesh_file(const hm::CaseSpec& cs, const std::string& path, hm::
 }
 
 int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mesh_file) {
+  // Solved in a local frame, as meshgen meshes and computes the deck's numbers (docs/architecture.md,
+  // "Local frame"); pressure.vtu gets the user's coordinates back.
   hm::HybridMesh mesh;
+  hm::Vec3 origin;
   hm::FlowSolution sol;
   if (!mesh_file.empty()) {
     if (const std::string why = load_mesh_file(cs, mesh_file, &mesh.mesh); !why.empty()) {
       std::cerr << "solver_demo: " << why << "\n";
       return 2;
     }
+    origin = hm::plan_origin(mesh.mesh);
+    hm::translate_mesh(mesh.mesh, -1.0 * origin);
     mesh.geometry = hm::compute_geometry(mesh.mesh);
   }
   if (const int rc = guarded([&] {
-        if (mesh_file.empty()) mesh = hm::build_hybrid_mesh(cs);
+        if (mesh_file.empty()) {
+          hm::CaseSpec user = cs;
+          mesh = hm::build_hybrid_mesh_in_local_frame(user);
+          origin = hm::case_origin(cs);
+        }
         const hm::FlowProblem pb = hm::deck_flow_problem(cs, mesh.mesh, mesh.geometry);
         // The transmissibilities of the exported deck (docs/export-eclipse.md, "A corner-point model"),
         // without the connections flow leaves out of it: the deck's equation.
@@ -136,6 +147,7 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mes
     std::cerr << "solver_demo: " << error << "\n";
     return 2;
   }
+  hm::translate_mesh(mesh.mesh, origin);
   const hm::WriteStatus st = hm::write_vtu((out / "pressure.vtu").string(), mesh.mesh,
                                            {hm::VtuCellArray::real("pressure", 1, sol.pressure)});
   if (!st.ok) {
