@@ -85,7 +85,8 @@ std::string load_mesh_file(const hm::CaseSpec& cs, const std::string& path, hm::
   return {};
 }
 
-int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mesh_file) {
+// cs is as given on return (build_hybrid_mesh_in_local_frame holds a large model once meanwhile).
+int run_flow(hm::CaseSpec& cs, const fs::path& out, const std::string& mesh_file) {
   // Solved in a local frame, as meshgen meshes and computes the deck's numbers (docs/architecture.md,
   // "Local frame"); pressure.vtu gets the user's coordinates back.
   hm::HybridMesh mesh;
@@ -102,8 +103,7 @@ int run_flow(const hm::CaseSpec& cs, const fs::path& out, const std::string& mes
   }
   if (const int rc = guarded([&] {
         if (mesh_file.empty()) {
-          hm::CaseSpec user = cs;
-          mesh = hm::build_hybrid_mesh_in_local_frame(user);
+          mesh = hm::build_hybrid_mesh_in_local_frame(cs);
           origin = hm::case_origin(cs);
         }
         const hm::FlowProblem pb = hm::deck_flow_problem(cs, mesh.mesh, mesh.geometry);
