@@ -216,22 +216,20 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   const Clock::time_point t3 = Clock::now();
   SiteOptimizeReport optimization;
   int sliver_removals = 0;
-  // The site optimiser rebuilds the diagram without the boundary planes' mirror sites: a cavity
-  // that touches the outer boundary is left as built (docs/optimization.md).
-  const bool optimize = options.optimize && images.empty();
+  // A cavity that touches the outer boundary is optimised with its sites' images (every rebuild
+  // adds them, as build_power_cells does).
+  const bool optimize = options.optimize;
   std::shared_ptr<const TransitionCells> raw;
-  const std::vector<Vec3> outside = images.empty() ? well_polygon_centres(cavity, blocks) : std::vector<Vec3>{};
+  const std::vector<Vec3> outside = well_polygon_centres(cavity, blocks);
   if (optimize) {
     raw = std::make_shared<const TransitionCells>(out);
-    optimization = optimize_sites(set, cavity, node_coords, frames, options, outside, out);
+    optimization = optimize_sites(set, cavity, node_coords, frames, options, outside, images, out);
   }
   // The optimiser's removals need a Q_S gain: sliver edges it left are removed here too.
   int repairs = 0;
-  if (images.empty()) {
-    sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, out);
-    // optimize_sites ends with repair rounds of its own (steps, no removals).
-    if (!optimize) repairs = repair_failing_cells(set, cavity, node_coords, frames, options, outside, out);
-  }
+  sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, images, out);
+  // optimize_sites ends with repair rounds of its own (steps, no removals).
+  if (!optimize) repairs = repair_failing_cells(set, cavity, node_coords, frames, options, outside, images, out);
   if (raw) out.unoptimized = std::move(raw);
   // Merge the stage reports.
   TransitionReport& r = out.report;

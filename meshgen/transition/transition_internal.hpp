@@ -221,8 +221,11 @@ class PowerDiagram {
   ~PowerDiagram();
   PowerDiagram(const PowerDiagram&) = delete;
   PowerDiagram& operator=(const PowerDiagram&) = delete;
+  /// With outer-boundary planes (`images`), every live site's image joins the triangulation, as in
+  /// build_power_cells.
   std::vector<int> cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
-                         const std::vector<PolygonFrame>& frames, TransitionCells& out);
+                         const std::vector<PolygonFrame>& frames, TransitionCells& out,
+                         const BoundaryImages& images = {});
   int moved_last() const { return moved_; }  ///< sites moved incrementally by the last call
   /// Keeps a copy of the triangulation as it is: a later call starts from the copy when it is
   /// nearer the sites (fewer sites to move), as when a round's refused moves are undone.
@@ -258,15 +261,18 @@ bool move_is_kept(const MoveEffect& e, MoveKind kind);
 /// valid diagram of `set` on entry and on exit. Q_S's h is the entry diagram's h_ref.
 /// `outside_centres`: per cavity face, the FV centre of the cell beyond it (NaN where not known), so
 /// that a move may not turn a polygon face below fvcheck's orthogonality bound
-/// (well_polygon_centres).
+/// (well_polygon_centres). `images`: the cavity's outer-boundary planes (add_boundary_images); every
+/// rebuild adds the sites' images, and a move that takes a site across a plane is refused.
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& options,
-                                  const std::vector<Vec3>& outside_centres, TransitionCells& out);
+                                  const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                                  TransitionCells& out);
 /// Without optimisation: only the removal of sliver edges (kSliverEdge, transition_optimize.cpp),
 /// each kept unless a cell newly fails a shape check of the self-check. Returns the moves kept.
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                        const std::vector<Vec3>& outside_centres, TransitionCells& out);
+                        const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                        TransitionCells& out);
 /// Without optimisation, after remove_sliver_edges: rounds of repairs of the cells failing a shape
 /// check of the self-check, while some fail and untried moves remain: the removal of a failing cell's
 /// edge between two free vertices shorter than G2 h (nearly co-spherical sites), or a step of its site
@@ -274,7 +280,8 @@ int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Ve
 /// the moves kept.
 int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                          const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                         const std::vector<Vec3>& outside_centres, TransitionCells& out);
+                         const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                         TransitionCells& out);
 /// Per cavity face: the FV centre of the well cell beyond a well polygon; NaN for every other face.
 std::vector<Vec3> well_polygon_centres(const Cavity& cavity, const std::vector<WellBlock>& blocks);
 

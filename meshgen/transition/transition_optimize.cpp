@@ -173,15 +173,33 @@ struct ShapeFailures {
   int64_t count = 0;  ///< failing cells
 };
 
-// A boundary face of the submesh is a cavity polygon; where the FV centre beyond it is known
-// (outside_centres, a well cell's), its Q_O is checked too, as fvcheck measures it on the
-// written mesh: from the transition cell's site to that centre.
+// Whether every node of the submesh's face f lies in one of the outer-boundary planes (the
+// extraction puts the free vertices of those faces in the plane exactly).
+bool in_outer_plane(const PolyMesh& sub, int f, const std::vector<MirrorPlane>& planes) {
+  for (const MirrorPlane& m : planes) {
+    bool all = true;
+    for (const int32_t* v = sub.face_begin(f); v != sub.face_end(f) && all; ++v) all = sub.nodes[*v][m.axis] == m.value;
+    if (all) return true;
+  }
+  return false;
+}
+
+// A boundary face of the submesh is a cavity polygon or lies in an outer-boundary plane. Where
+// the FV centre beyond a polygon is known (outside_centres, a well cell's), its Q_O is checked
+// too, as fvcheck measures it on the written mesh: from the transition cell's site to that
+// centre; a face in an outer-boundary plane is checked as fvcheck checks a boundary face (to its
+// boundary flux point).
 ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& global, const TransitionCells& t,
-                             const Cavity& cavity, const std::vector<Vec3>& outside_centres) {
+                             const Cavity& cavity, const std::vector<Vec3>& outside_centres,
+                             const std::vector<MirrorPlane>& planes) {
   ShapeFailures out;
   out.cell.assign(sub.n_cells(), 0);
   const MeshGeometry geo = compute_geometry(sub);
   const CheckOptions opt;
+  for (int f = 0; f < sub.n_faces() && !planes.empty(); ++f)
+    if (sub.face_neighbour[f] < 0 && in_outer_plane(sub, f, planes) &&
+        face_orthogonality_of(sub, geo, f, boundary_flux_point(sub, geo, f)) < opt.min_orthogonality_deg)
+      out.cell[sub.face_owner[f]] = 1;
   if (!outside_centres.empty()) {
     const std::vector<int32_t> polygon = submesh_face_polygons(
         sub, global, t, cavity, [&](int32_t q) { return std::isfinite(outside_centres[q].x); });
@@ -291,9 +309,12 @@ class SiteOptimizer {
  public:
   SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                 const std::vector<PolygonFrame>& frames, const std::vector<double>& h_ref,
-                const TransitionOptions& opt, const std::vector<Vec3>& outside_centres, Pass pass = Pass::Optimize)
+                const TransitionOptions& opt, const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                Pass pass = Pass::Optimize)
       : set_(set), cavity_(cavity), coords_(coords), frames_(frames), h_ref_(h_ref), opt_(opt),
-        outside_centres_(outside_centres), pass_(pass) {
+        outside_centres_(outside_centres), images_(images), pass_(pass) {
+    for (const MirrorPlane& m : images_.planes)
+      for (const Site& s : set_.sites) side_.push_back(plane_side(s.p, m));
     // Repairs judge the cells as written (TransitionOptions::written_origin): the well cells'
     // centres beyond their faces too.
     if (pass_ == Pass::Repairs)
@@ -330,7 +351,7 @@ class SiteOptimizer {
     if (pass_ == Pass::Repairs) round_to_written_frame(m.sub, opt_.written_origin);
     m.qs = cell_shape_quality(m.sub, h_ref_);
     m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
-    m.failing = shape_failures(m.sub, m.global, t, cavity_, outside_centres_);
+    m.failing = shape_failures(m.sub, m.global, t, cavity_, outside_centres_, images_.planes);
     return m;
   }
   // The cells of `after` (a diagram of the same sites, so the same cell per site) that fail a
@@ -384,6 +405,17 @@ class SiteOptimizer {
   const std::vector<double>& h_ref_;
   const TransitionOptions& opt_;
   std::vector<Vec3> outside_centres_;  // a copy: the repairs round them (as written)
+  const BoundaryImages& images_;
+  std::vector<int> side_;  // [plane * sites + site]: the side of each outer-boundary plane a site starts on
+  static int plane_side(Vec3 p, const MirrorPlane& m) { return p[m.axis] < m.value ? -1 : p[m.axis] > m.value ? 1 : 0; }
+  // Every site on the side of each outer-boundary plane it started on: its image stays beyond it.
+  bool sites_keep_their_sides() const {
+    const size_t n = set_.sites.size();
+    for (size_t k = 0; k < images_.planes.size(); ++k)
+      for (size_t s = 0; s < n && k * n + s < side_.size(); ++s)
+        if (set_.sites[s].alive && plane_side(set_.sites[s].p, images_.planes[k]) != side_[k * n + s]) return false;
+    return true;
+  }
   std::set<std::array<int, 9>> refused_;
   SiteSlab slab_;  // the sites by x, for centred(): reset at each round's start
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
@@ -398,7 +430,8 @@ class SiteOptimizer {
 bool SiteOptimizer::rebuild(TransitionCells& fresh, int32_t base) {
   fresh = TransitionCells{};
   fresh.base_node_id = base;
-  if (!diagram_.cells(set_, cavity_, coords_, frames_, fresh).empty()) return false;
+  if (!sites_keep_their_sides()) return false;
+  if (!diagram_.cells(set_, cavity_, coords_, frames_, fresh, images_).empty()) return false;
   const TransitionReport& r = fresh.report;
   if (r.unmatched_external_faces > 0 || r.missing_polygons > 0) return false;
   for (const auto& cell : fresh.cells)
@@ -740,11 +773,12 @@ bool has_sliver_edge(const TransitionCells& t) {
 
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                        const std::vector<Vec3>& outside_centres, TransitionCells& out) {
+                        const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                        TransitionCells& out) {
   if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, Pass::Slivers);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, Pass::Slivers);
   while (rep.rounds < kSliverRounds) {
     ++rep.rounds;
     // A round whose removals were all refused has tagged them: the next tries each sliver's next site.
@@ -756,10 +790,11 @@ int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Ve
 
 int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                          const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                         const std::vector<Vec3>& outside_centres, TransitionCells& out) {
+                         const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                         TransitionCells& out) {
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, Pass::Repairs);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, Pass::Repairs);
   // The first round measures the diagram; it proposes nothing when no cell fails.
   while (rep.rounds < kRepairRounds && optimizer.failing_now() != 0) {
     ++rep.rounds;
@@ -771,10 +806,11 @@ int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<V
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                                  const std::vector<Vec3>& outside_centres, TransitionCells& out) {
+                                  const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                                  TransitionCells& out) {
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;  // the raw diagram's: the same reference before and after
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images);
   while (rep.rounds < opt.max_rounds) {
     ++rep.rounds;
     if (!optimizer.round(out, rep, false)) break;

@@ -784,8 +784,11 @@ void PowerDiagram::save() {
   c.p = d.p, c.w2 = d.w2, c.alive = d.alive, c.ready = true;
 }
 
-std::vector<int> PowerDiagram::cells(const SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
-                                     const std::vector<PolygonFrame>& frames, TransitionCells& out) {
+std::vector<int> PowerDiagram::cells(const SiteSet& real_set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                                     const std::vector<PolygonFrame>& frames, TransitionCells& out,
+                                     const BoundaryImages& images) {
+  const SiteSet imaged = images.empty() ? SiteSet{} : with_images(real_set, images);
+  const SiteSet& set = images.empty() ? real_set : imaged;
   const int ns = static_cast<int>(set.sites.size());
   auto live = [&](int s) { return set.sites[s].alive && set.sites[s].kind != SiteKind::Guard; };
   // The sites to move in a triangulation (ns + 1 where it must start from scratch).
@@ -831,7 +834,7 @@ std::vector<int> PowerDiagram::cells(const SiteSet& set, const Cavity& cavity, c
   }
   // Hidden sites after a fresh triangulation: the next call starts from scratch again.
   d.ready = static_cast<int>(d.rt.number_of_vertices()) == expected;
-  return extract_power_cells(d.rt, set, ns, cavity, coords, frames, out, {});
+  return extract_power_cells(d.rt, set, static_cast<int>(real_set.sites.size()), cavity, coords, frames, out, images);
 }
 
 // Buckets of side kBucket x eps: two points within eps share a bucket, or each lies within eps of

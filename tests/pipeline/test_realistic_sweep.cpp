@@ -271,6 +271,22 @@ TEST(RealisticSweep, FlatEndsWithLargeRingRatioMeshAndPassFvcheck) {
   }
 }
 
+// A well inclined 55 degrees through the top and bottom at kv/kh 0.01 (full-sweep seed 1064 with
+// HM_SWEEP_KVKH=0.01; R 8 m in 11.7 m cells 4.2 m thick, flat ends, no optimisation): the transition
+// cell under the top where the well enters had its outer-boundary face at 43.9 degrees from its
+// site's segment to the face's flux point, and the self-check refused the mesh (exit 1; docs/robustness.md,
+// session 17). Its cavity touches the boundary planes, which the repair pass now handles (the sites'
+// images in every rebuild) and judges (faces in a plane as fvcheck judges a boundary face); 3 repairs
+// mend it. It must mesh and pass every check (about 2 s in Release).
+TEST(RealisticSweep, BoundaryFaceFailingOrthogonalityIsRepaired) {
+  const uint32_t seed = 1064;
+  RealisticOptions o = sweep_options(seed);
+  o.kv_kh = 0.01;
+  ASSERT_TRUE(o.cross_top_bottom && !o.optimize);  // the generator still draws the through-the-boundary case
+  const RealisticCase rc = make_realistic_case(seed, o);
+  expect_meshes(rc, o);
+}
+
 // The optimiser kept site moves whose rebuilt cells were not convex (full-sweep seed 1009: 2 cells,
 // 1021: 1 cell, both straight from the raw diagram's convex cells); its acceptance now refuses a
 // move that makes a cell fail a shape check of the self-check (transition_optimize.cpp,
