@@ -227,7 +227,10 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   }
   // The optimiser's removals need a Q_S gain: sliver edges it left are removed here too.
   int repairs = 0;
-  sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, images, out);
+  // Not where the cavity reaches a boundary plane: there the removals' five co-spherical sites
+  // meet their images, and a removed edge can survive as a micro-edge that the permeability frame's
+  // way back turns out of plane (docs/optimization.md, "Cavities that reach the outer boundary").
+  if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, images, out);
   // optimize_sites ends with repair rounds of its own (steps, no removals).
   if (!optimize) repairs = repair_failing_cells(set, cavity, node_coords, frames, options, outside, images, out);
   if (raw) out.unoptimized = std::move(raw);
