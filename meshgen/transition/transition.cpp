@@ -216,21 +216,21 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   const Clock::time_point t3 = Clock::now();
   SiteOptimizeReport optimization;
   int sliver_removals = 0;
-  // A cavity that touches the outer boundary is optimised with its sites' images (every rebuild
-  // adds them, as build_power_cells does).
-  const bool optimize = options.optimize;
+  // A cavity that reaches a boundary plane is not optimised: in a strongly scaled permeability
+  // frame the optimiser's removals there left micro-edges that the way back turned out of plane
+  // (docs/optimization.md, "Cavities that reach the outer boundary"). Its failing cells are repaired,
+  // with its sites' images in every rebuild.
+  const bool optimize = options.optimize && images.empty();
   std::shared_ptr<const TransitionCells> raw;
   const std::vector<Vec3> outside = well_polygon_centres(cavity, blocks);
   if (optimize) {
     raw = std::make_shared<const TransitionCells>(out);
-    optimization = optimize_sites(set, cavity, node_coords, frames, options, outside, images, out);
+    optimization = optimize_sites(set, cavity, node_coords, frames, options, outside, out);
   }
   // The optimiser's removals need a Q_S gain: sliver edges it left are removed here too.
   int repairs = 0;
-  // Not where the cavity reaches a boundary plane: there the removals' five co-spherical sites
-  // meet their images, and a removed edge can survive as a micro-edge that the permeability frame's
-  // way back turns out of plane (docs/optimization.md, "Cavities that reach the outer boundary").
-  if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, images, out);
+  // Not where the cavity reaches a boundary plane either (the same micro-edges).
+  if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, out);
   // optimize_sites ends with repair rounds of its own (steps, no removals).
   if (!optimize) repairs = repair_failing_cells(set, cavity, node_coords, frames, options, outside, images, out);
   if (raw) out.unoptimized = std::move(raw);

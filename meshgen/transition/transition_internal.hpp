@@ -261,23 +261,23 @@ bool move_is_kept(const MoveEffect& e, MoveKind kind);
 /// valid diagram of `set` on entry and on exit. Q_S's h is the entry diagram's h_ref.
 /// `outside_centres`: per cavity face, the FV centre of the cell beyond it (NaN where not known), so
 /// that a move may not turn a polygon face below fvcheck's orthogonality bound
-/// (well_polygon_centres). `images`: the cavity's outer-boundary planes (add_boundary_images); every
-/// rebuild adds the sites' images, and a move that takes a site across a plane is refused.
+/// (well_polygon_centres). Cavities without outer-boundary planes only.
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& options,
-                                  const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
-                                  TransitionCells& out);
+                                  const std::vector<Vec3>& outside_centres, TransitionCells& out);
 /// Without optimisation: only the removal of sliver edges (kSliverEdge, transition_optimize.cpp),
 /// each kept unless a cell newly fails a shape check of the self-check. Returns the moves kept.
+/// Cavities without outer-boundary planes only.
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                        const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
-                        TransitionCells& out);
+                        const std::vector<Vec3>& outside_centres, TransitionCells& out);
 /// Without optimisation, after remove_sliver_edges: rounds of repairs of the cells failing a shape
 /// check of the self-check, while some fail and untried moves remain: the removal of a failing cell's
 /// edge between two free vertices shorter than G2 h (nearly co-spherical sites), or a step of its site
 /// or of a face neighbour's; each kept only if fewer cells around fail and none newly fails. Returns
-/// the moves kept.
+/// the moves kept. `images`: the cavity's outer-boundary planes (add_boundary_images): every rebuild
+/// adds the sites' images, a move that takes a site across a plane is refused, and a face in a plane
+/// is judged as fvcheck judges a boundary face.
 int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                          const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                          const std::vector<Vec3>& outside_centres, const BoundaryImages& images,

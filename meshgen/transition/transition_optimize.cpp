@@ -305,6 +305,8 @@ void add_cell_and_neighbours(const PolyMesh& sub, int c, std::vector<int>& cells
 // (repair_failing_cells).
 enum class Pass { Optimize, Slivers, Repairs };
 
+const BoundaryImages kNoImages{};  // the optimiser and the sliver pass: cavities without boundary planes
+
 class SiteOptimizer {
  public:
   SiteOptimizer(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -773,12 +775,11 @@ bool has_sliver_edge(const TransitionCells& t) {
 
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                        const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
-                        TransitionCells& out) {
+                        const std::vector<Vec3>& outside_centres, TransitionCells& out) {
   if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, Pass::Slivers);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, kNoImages, Pass::Slivers);
   while (rep.rounds < kSliverRounds) {
     ++rep.rounds;
     // A round whose removals were all refused has tagged them: the next tries each sliver's next site.
@@ -806,11 +807,10 @@ int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<V
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                                   const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
-                                  const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
-                                  TransitionCells& out) {
+                                  const std::vector<Vec3>& outside_centres, TransitionCells& out) {
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;  // the raw diagram's: the same reference before and after
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images);
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, kNoImages);
   while (rep.rounds < opt.max_rounds) {
     ++rep.rounds;
     if (!optimizer.round(out, rep, false)) break;

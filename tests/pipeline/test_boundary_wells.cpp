@@ -75,19 +75,6 @@ void check_case(const std::string& name, Expect want) {
   for (const Cavity& cav : h.cavities.cavities)
     for (const MirrorPlane& m : cav.mirrors) planes.insert({m.axis, m.value});
   for (const auto& p : want.planes) EXPECT_TRUE(planes.count(p)) << "axis " << p.first << " = " << p.second;
-  // The cases ask for optimisation: the cavities that reach a plane get it too, with their sites'
-  // images (session 35; before, such a cavity was left as built), and it keeps some moves.
-  ASSERT_EQ(h.transition_reports.size(), h.cavities.cavities.size());
-  int kept = 0;
-  for (size_t k = 0; k < h.transition_reports.size(); ++k) {
-    if (h.cavities.cavities[k].mirrors.empty()) continue;
-    const SiteOptimizeReport& o = h.transition_reports[k].optimization;
-    std::printf("[ figures  ] %s: cavity %zu (%zu planes): %d rounds, %d of %d moves kept\n", name.c_str(), k,
-                h.cavities.cavities[k].mirrors.size(), o.rounds, o.kept, o.proposed);
-    EXPECT_GT(o.rounds, 0) << "cavity " << k;
-    kept += o.kept;
-  }
-  EXPECT_GT(kept, 0);
 
   // Outer-boundary faces lie in the box planes and tile them (less the holes' sections); no
   // interior face and no wellbore face lies in a plane.
