@@ -414,7 +414,7 @@ class SiteOptimizer {
   bool sites_keep_their_sides() const {
     const size_t n = set_.sites.size();
     for (size_t k = 0; k < images_.planes.size(); ++k)
-      for (size_t s = 0; s < n && k * n + s < side_.size(); ++s)
+      for (size_t s = 0; s < n; ++s)
         if (set_.sites[s].alive && plane_side(set_.sites[s].p, images_.planes[k]) != side_[k * n + s]) return false;
     return true;
   }
