@@ -399,6 +399,29 @@ void clip_paths_to_model(CaseSpec& cs, const std::vector<WellSpec>& as_given, Su
   }
 }
 
+// Each corner-point well's block with outer faces small enough for the model's surface near its path
+// (fit_outer_faces); a well whose faces cannot be made so is left as it is, for the cavity's Gabriel
+// test to refuse, naming the cell.
+void fit_blocks_to_the_surface(CaseSpec& cs) {
+  if (!cs.reservoir.corner_point) return;
+  for (size_t i = 0; i < cs.wells.size(); ++i) {
+    WellSpec& w = cs.wells[i];
+    const double clearance = surface_clearance(*cs.reservoir.corner_point, w);
+    const OuterFaceFit fit = fit_outer_faces(w, clearance);
+    if (!fit.fits || (fit.sectors == w.sectors && fit.segment_length == w.segment_length)) continue;
+    std::string change;
+    if (fit.sectors != w.sectors) change = "sectors " + std::to_string(w.sectors) + " -> " + std::to_string(fit.sectors);
+    if (fit.segment_length != w.segment_length)
+      change += (change.empty() ? "" : ", ") + std::string("segment_length ") + fmt6(w.segment_length) + " -> " +
+                fmt6(fit.segment_length) + " m";
+    cs.notes.push_back(index_path("wells", i) + " (" + w.name + "): " + change + ": its block passes " +
+                       fmt6(clearance) + " m from the corner-point model's surface, so its outer faces are made "
+                       "smaller than that (their diametral spheres must not hold the surface's nodes, paper 5.1)");
+    w.sectors = fit.sectors;
+    w.segment_length = fit.segment_length;
+  }
+}
+
 // The case's reservoir becomes `model` (its axes and per-cell rock as corner_point_reservoir gives them).
 void use_model(ReservoirSpec& r, std::shared_ptr<const CornerPointModel> model) {
   const ReservoirSpec grid = corner_point_reservoir(std::move(model), "reservoir.grdecl");
@@ -856,6 +879,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   split_fault_steps_near_wells(cs);
   refine_near_wells(cs);
   clip_paths_to_model(cs, as_given, SurfaceGapRule::SurfaceFaces, true);
+  fit_blocks_to_the_surface(cs);
   check_wells(cs);
   split_layers_near_wells(cs);
   return cs;

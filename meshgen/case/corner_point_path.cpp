@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "meshgen/core/geometry.hpp"
+#include "segment_distance.hpp"
 
 namespace hm {
 
@@ -164,6 +165,87 @@ double surface_gap(const CornerPointModel& m, Vec3 at, const WellSpec& ws) {
   }
   longest = std::max(longest, norm(outer_far - inner_near));
   return std::clamp(kSurfaceGapMargin * 0.5 * longest, kSurfaceGapMin * R, kSurfaceGap * R);
+}
+
+double surface_clearance(const CornerPointModel& m, const WellSpec& ws) {
+  const double R = ws.drainage_radius, reach = 2 * R;
+  const std::vector<Vec3>& path = ws.trajectory;
+  Vec3 lo = path.front(), hi = lo;
+  for (const Vec3& p : path)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k] - reach), hi[k] = std::max(hi[k], p[k] + reach);
+  auto index = [&](int i, int j, int k) { return i + m.nx * (j + m.ny * k); };
+  auto inside = [&](int i, int j, int k) { return i >= 0 && j >= 0 && k >= 0 && i < m.nx && j < m.ny && k < m.nz; };
+  auto thick = [&](int c) {
+    for (int q = 0; q < 4; ++q)
+      if (corner_depth(m, c, q) != corner_depth(m, c, q + 4)) return true;
+    return false;
+  };
+  auto meshed = [&](int i, int j, int k) { return inside(i, j, k) && m.actnum[index(i, j, k)] && thick(index(i, j, k)); };
+  // Across a top or bottom face, layers of zero thickness are stepped over: the cell beyond touches it.
+  auto meshed_across = [&](int i, int j, int k, int f) {
+    static constexpr int kStep[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+    i += kStep[f][0], j += kStep[f][1], k += kStep[f][2];
+    if (f >= 4)
+      while (inside(i, j, k) && m.actnum[index(i, j, k)] && !thick(index(i, j, k))) k += kStep[f][2];
+    return meshed(i, j, k);
+  };
+  // Nodes beyond the end planes face the block's ends, whose faces clip_path_to_model sizes.
+  const size_t n = path.size();
+  auto beyond_ends = [&](Vec3 q) {
+    return dot(q - path[0], path[1] - path[0]) < 0 || dot(q - path[n - 1], path[n - 1] - path[n - 2]) > 0;
+  };
+  // A column whose pillars (straight, from its top cell's top to its bottom cell's bottom) pass
+  // beside the path's box in plan holds no node near it.
+  std::vector<Vec3> plan_path;
+  for (const Vec3& p : path) plan_path.push_back({p.x, p.y, 0});
+  auto column_near = [&](int i, int j) {
+    const std::array<Vec3, 8> top = cell_corners(m, size_t(index(i, j, 0)));
+    const std::array<Vec3, 8> bottom = cell_corners(m, size_t(index(i, j, m.nz - 1)));
+    Vec3 a{top[0].x, top[0].y, 0}, b = a;
+    for (int q = 0; q < 8; ++q)
+      for (const Vec3& p : {top[q], bottom[q]})
+        a = {std::min(a.x, p.x), std::min(a.y, p.y), 0}, b = {std::max(b.x, p.x), std::max(b.y, p.y), 0};
+    return polyline_distance({0.5 * (a + b)}, plan_path, reach + 0.5 * norm(b - a)) <= reach + 0.5 * norm(b - a);
+  };
+  std::vector<char> column(size_t(m.nx) * m.ny);
+  for (int j = 0; j < m.ny; ++j)
+    for (int i = 0; i < m.nx; ++i) column[i + size_t(m.nx) * j] = column_near(i, j);
+  double nearest = INFINITY;
+  for (int c = 0; c < static_cast<int>(m.n_cells()); ++c) {
+    if (!m.actnum[c] || !column[c % (m.nx * m.ny)]) continue;
+    const std::array<Vec3, 8> corners = cell_corners(m, size_t(c));
+    bool near = true;
+    for (int k = 0; k < 3 && near; ++k) {
+      double a = corners[0][k], b = a;
+      for (const Vec3& p : corners) a = std::min(a, p[k]), b = std::max(b, p[k]);
+      near = b >= lo[k] && a <= hi[k];
+    }
+    if (!near || !thick(c)) continue;
+    const int i = c % m.nx, j = c / m.nx % m.ny, k = c / (m.nx * m.ny);
+    for (int f = 0; f < 6; ++f) {
+      if (meshed_across(i, j, k, f)) continue;
+      for (int v = 0; v < 4; ++v) {
+        const Vec3 q = corners[kFaces[f][v]];
+        if (!beyond_ends(q)) nearest = std::min(nearest, polyline_distance({q}, path, reach) - R);
+      }
+    }
+  }
+  return nearest;
+}
+
+OuterFaceFit fit_outer_faces(const WellSpec& ws, double clearance) {
+  const double allowed = clearance / kSurfaceGapMargin, R = ws.drainage_radius;
+  auto chord = [R](int n) { return 2 * R * std::sin(kPi / n); };
+  OuterFaceFit fit{ws.sectors, ws.segment_length, true};
+  // A face's circumcentre lies R cos(pi / sectors) from the axis: its sphere reaches no node farther.
+  const double sphere = 0.5 * std::hypot(chord(fit.sectors), fit.segment_length);
+  if (R * std::cos(kPi / fit.sectors) + sphere <= R + clearance) return fit;
+  while (chord(fit.sectors) > std::sqrt(2.0) * allowed && fit.sectors < 4 * ws.sectors)
+    fit.sectors += fit.sectors % 2 == 0 ? 2 : 1;
+  const double length2 = 4 * allowed * allowed - chord(fit.sectors) * chord(fit.sectors);
+  fit.fits = length2 > 0;
+  if (fit.fits) fit.segment_length = std::min(ws.segment_length, std::sqrt(length2));
+  return fit;
 }
 
 ClippedPath clip_path_to_model(const CornerPointModel& m, const WellSpec& ws, const std::string& key,

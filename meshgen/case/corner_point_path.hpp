@@ -63,6 +63,28 @@ class CornerPointInterior {
 /// the grid or inactive.
 double surface_gap(const CornerPointModel& m, Vec3 at, const WellSpec& ws);
 
+/// The least distance (m) from the block's outer surface (drainage_radius around the meshed path
+/// ws.trajectory, grid frame) to a node of the model's surface within 2 drainage radii of the path:
+/// the corners of the faces of meshed cells (active, thicker than zero somewhere) whose neighbour
+/// across is outside the grid, inactive or, for a top or bottom face, past layers of zero thickness
+/// the edge of the model. The diametral spheres of the block's outer faces must clear those nodes
+/// (paper 5.1), since no cell behind them can be deactivated. +infinity when there are none.
+double surface_clearance(const CornerPointModel& m, const WellSpec& ws);
+
+/// Sectors and segment length of a block whose outer faces (a chord of 2 R sin(pi / sectors) by a
+/// segment) keep their diametral spheres off the surface's nodes `clearance` m beyond the block
+/// (surface_clearance). ws's own values when their spheres cannot reach that far (a circumcentre
+/// R cos(pi / sectors) from the axis plus the sphere's radius <= R + clearance); else the spheres made
+/// kSurfaceGapMargin times smaller than the clearance: the sectors raised first (at most to 4 x
+/// ws.sectors) until the chord is at most sqrt(2) of the radius allowed, then the segment shortened;
+/// `fits` is false when even that is not enough.
+struct OuterFaceFit {
+  int sectors = 0;
+  double segment_length = 0;
+  bool fits = false;
+};
+OuterFaceFit fit_outer_faces(const WellSpec& ws, double clearance);
+
 /// How clip_path_to_model sizes the gap: kSurfaceGap x R; kSurfaceGapMin x R (before the model is
 /// refined near the wells: the refinement follows the path so clipped, the longest a block can get);
 /// or surface_gap at each crossing (in the model the wells are meshed in).

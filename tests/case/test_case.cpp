@@ -858,3 +858,90 @@ TEST(CornerPointPath, PointsOnFacesAreDecidedAsJustAboveThem) {
   EXPECT_TRUE(upper.contains({0.5, 0.5, 1}));
   EXPECT_FALSE(upper.contains({0.5, 0.5, 1.5}));
 }
+
+namespace {
+
+// A model of 10 x 10 columns of 2 x 2 m on vertical pillars, its layers' depths `depths` (nz + 1
+// values, equal ones making layers of zero thickness), every cell active.
+CornerPointModel stacked_model(const std::vector<double>& depths) {
+  CornerPointModel m;
+  m.nx = m.ny = 10, m.nz = static_cast<int>(depths.size()) - 1;
+  for (int J = 0; J <= m.ny; ++J)
+    for (int I = 0; I <= m.nx; ++I)
+      m.coord.insert(m.coord.end(), {2.0 * I, 2.0 * J, depths.front(), 2.0 * I, 2.0 * J, depths.back()});
+  m.zcorn.resize(size_t(8) * m.nx * m.ny * m.nz);
+  for (int k = 0; k < m.nz; ++k)
+    for (int j = 0; j < m.ny; ++j)
+      for (int i = 0; i < m.nx; ++i)
+        for (int q = 0; q < 8; ++q) m.zcorn[zcorn_index(m, i, j, k, q)] = depths[k + ((q >> 2) & 1)];
+  m.actnum.assign(size_t(m.nx) * m.ny * m.nz, 1);
+  return m;
+}
+
+}  // namespace
+
+// surface_clearance: the nearest node of the model's surface beside the path, less the drainage
+// radius. A horizontal path 1.9 m under the top (0.4 m under an inner layer of zero thickness, which
+// is no surface, and 2.6 m over the bottom, reached past a bottom layer of zero thickness): 1.9 - R.
+// A cell made inactive beside the path brings its neighbours' faces 0.4 m from the axis; one
+// beyond the path's end does not count (the block's end faces are sized where the path is clipped).
+TEST(CornerPointPath, SurfaceClearanceIsTheNearestSurfaceNodeBesideThePath) {
+  CornerPointModel m = stacked_model({0, 1.5, 1.5, 3, 4.5, 4.5});
+  WellSpec ws;
+  ws.drainage_radius = 1;
+  ws.trajectory = {{4, 10, 1.9}, {17.5, 10, 1.9}};
+  EXPECT_NEAR(surface_clearance(m, ws), 0.9, 1e-14);
+  const int beyond_end = 9 + m.nx * (5 + m.ny * 2);  // x 18-20, y 10-12, z 1.5-3
+  m.actnum[beyond_end] = 0;
+  EXPECT_NEAR(surface_clearance(m, ws), 0.9, 1e-14);
+  const int beside = 5 + m.nx * (5 + m.ny * 2);  // x 10-12, y 10-12, z 1.5-3
+  m.actnum[beside] = 0;
+  EXPECT_NEAR(surface_clearance(m, ws), -0.6, 1e-14);
+  ws.trajectory = {{4, 10, 7}, {17.5, 10, 7}};  // 2.5 m under the bottom: no surface node within 2 R beside it
+  EXPECT_EQ(surface_clearance(m, ws), INFINITY);
+}
+
+// fit_outer_faces: the user's values when the outer faces' diametral spheres (half the diagonal of a
+// chord by a segment, about a circumcentre R cos(pi / sectors) from the axis) cannot reach the
+// surface's nodes; else spheres kSurfaceGapMargin times inside the clearance whenever it says they fit,
+// sectors raised before the segment is shortened, to at most 4 x; no fit only when even 4 x the
+// sectors leave a chord as wide as the sphere allowed.
+TEST(CornerPointPath, OuterFacesAreFittedInsideTheSurfaceClearance) {
+  int fitted = 0, raised = 0, refused = 0;
+  for (double R : {3.0, 6.0, 15.0})
+    for (int sectors : {8, 12, 13})
+      for (double segment : {1.0, 4.0, 10.0})
+        for (double clearance : {0.05, 0.5, 1.5, 2.5, 4.0, 8.0}) {
+          WellSpec ws;
+          ws.drainage_radius = R, ws.sectors = sectors, ws.segment_length = segment;
+          const OuterFaceFit fit = fit_outer_faces(ws, clearance);
+          const double allowed = clearance / kSurfaceGapMargin;
+          auto chord = [R](int n) { return 2 * R * std::sin(M_PI / n); };
+          const double sphere = 0.5 * std::hypot(chord(sectors), segment);
+          if (R * std::cos(M_PI / sectors) + sphere <= R + clearance) {
+            EXPECT_TRUE(fit.fits);
+            EXPECT_EQ(fit.sectors, sectors);
+            EXPECT_EQ(fit.segment_length, segment);
+            continue;
+          }
+          EXPECT_GE(fit.sectors, sectors);
+          EXPECT_LE(fit.sectors, 4 * sectors);
+          if (!fit.fits) {
+            ++refused;
+            EXPECT_GE(chord(fit.sectors), 2 * allowed) << R << " " << sectors << " " << clearance;
+            continue;
+          }
+          ++fitted, raised += fit.sectors > sectors;
+          EXPECT_LE(0.5 * std::hypot(chord(fit.sectors), fit.segment_length), allowed * (1 + 1e-12));
+          EXPECT_LE(fit.segment_length, segment);
+          if (fit.sectors < 4 * sectors) {
+            EXPECT_LE(chord(fit.sectors), std::sqrt(2.0) * allowed * (1 + 1e-12));
+          }
+          if (fit.sectors > sectors) {
+            EXPECT_GT(chord(fit.sectors - (fit.sectors % 2 == 0 ? 2 : 1)), std::sqrt(2.0) * allowed);
+          }
+        }
+  EXPECT_GT(fitted, 0);
+  EXPECT_GT(raised, 0);
+  EXPECT_GT(refused, 0);
+}

@@ -869,6 +869,44 @@ TEST(CornerPointSurface, WellEndingNearTheBottomIsMovedBackAsACrossingEnd) {
   expect_sound_mesh(cs, out);
 }
 
+// A horizontal well 2 m over the model's bottom beside its block (R = 5 m, 6 rings: its ends keep the
+// gap their end faces need, 1.9 m, "Wells through the model's surface"): the default outer faces
+// (12 sectors, 4 m segments: diametral spheres of 2.4 m) would hold the bottom's nodes, which cannot
+// move away, and the cavity was refused (exit 2, "cannot be made Gabriel"). The case now gives the
+// block more sectors and shorter segments (fit_outer_faces, with a note), and the mesh is sound.
+TEST(CornerPointSurface, HorizontalWellNearTheBottomGetsSmallerOuterFaces) {
+  TiltedModel g;
+  g.nx = g.ny = 20, g.nz = 14, g.dx = g.dy = 2, g.dz = 1.5;
+  const double x = 20, R = 5, above = R + 2;
+  auto bottom = [&](double y) { return g.depth(0, 10, 0, g.nz) + (0.01 + 1e-4 * x) * y; };  // x = 20 is pillar line 10
+  TempDir tmp("cpbottom");
+  const std::string wells = "wells:\n  - {name: P1, trajectory: [[" + num(x) + ", 8, " + num(bottom(8) - above) + "], [" +
+                            num(x) + ", 32, " + num(bottom(32) - above) + "]], radius: 0.1, drainage_radius: " + num(R) +
+                            ", rings: 6, sectors: 12, segment_length: 4, end_caps: flat, bhp: 150}\n";
+  const CaseSpec cs = case_of(tmp, g, wells);
+  const double clearance = surface_clearance(*cs.reservoir.corner_point, cs.wells[0]);
+  EXPECT_NEAR(clearance, 2.0, 1e-3);  // 2 m vertically, the bottom sloping 0.7 degree along the well
+  EXPECT_GT(cs.wells[0].sectors, 12);
+  EXPECT_LT(cs.wells[0].segment_length, 4.0);
+  bool noted = false;
+  for (const std::string& n : cs.notes) noted = noted || n.find("its outer faces are made smaller") != std::string::npos;
+  EXPECT_TRUE(noted);
+  std::printf("[ figures  ] horizontal well %g m over the bottom: %d sectors, segments %.3f m\n", clearance,
+              cs.wells[0].sectors, cs.wells[0].segment_length);
+  HybridMesh out;
+  ASSERT_NO_THROW(out = build_hybrid_mesh(cs));
+  expect_sound_mesh(cs, out);
+  // The block as the user gave it: refused at the cavity, as every such case was before.
+  CaseSpec as_given = cs;
+  as_given.wells[0].sectors = 12, as_given.wells[0].segment_length = 4;
+  try {
+    build_hybrid_mesh(as_given);
+    ADD_FAILURE() << "the user's block was meshed: the case does not test the fit";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot be made Gabriel"), std::string::npos) << e.what();
+  }
+}
+
 // CornerPointLocator tries only the cells of the query's bucket: the same answers as trying every
 // cell in order (each cell alone in a locator of its own), on a faulted model with inclined, bent
 // pillars and a pinch-out, at random points and at every cell's corner mean.
