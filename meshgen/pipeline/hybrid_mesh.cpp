@@ -271,6 +271,8 @@ HybridMesh build_hybrid_mesh_euclidean(const CaseSpec& input, const PipelineOpti
     topts.g_remove = cs.transition.gamma[1];
     topts.g_expand = cs.transition.gamma[2];
     topts.written_origin = opts.written_origin;
+    topts.frame = opts.frame;
+    topts.frame_written_origin = opts.frame_written_origin;
     std::vector<CachedTransition> keys(nk);
     std::vector<std::optional<TransitionOutcome>> outcomes(nk);
     std::vector<int> to_build;

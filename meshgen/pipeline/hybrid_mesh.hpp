@@ -29,6 +29,10 @@ struct PipelineOptions {
   /// there and back (round_to_written_frame), so that the self-check judges the coordinates the files
   /// get. Zero: nothing is rounded.
   Vec3 written_origin;
+  /// The permeability frame the case is meshed in (build_hybrid_mesh sets it; identity: none) and the
+  /// origin its physical positions are written about (TransitionOptions::frame).
+  PermeabilityFrame frame;
+  Vec3 frame_written_origin;
   /// Called at the end of each stage of HybridMesh::timings_s with its name (benchmarks
   /// sample memory there); may be empty.
   std::function<void(const std::string& stage)> on_stage;

@@ -29,6 +29,8 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
   }
   PipelineOptions scaled_opts = opts;
   scaled_opts.written_origin = Vec3{};  // the scaled frame's positions are not the written ones
+  scaled_opts.frame = frame;
+  scaled_opts.frame_written_origin = opts.written_origin;
   HybridMesh out = build_hybrid_mesh_euclidean(scaled_case(cs, frame), scaled_opts);
   const auto t0 = std::chrono::steady_clock::now();
   out.frame = frame;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "meshgen/cavity/cavity.hpp"
+#include "meshgen/case/permeability_metric.hpp"
 #include "meshgen/core/mesh_builder.hpp"
 
 namespace hm {
@@ -26,6 +27,12 @@ struct TransitionOptions {
   /// built in): the repairs of cells that fail a shape check judge the cells at the positions those
   /// files give back (round_to_written_frame), so that what they repair stays repaired as written.
   Vec3 written_origin;
+  /// The permeability frame the cavity is built in (identity: none) and the origin its physical,
+  /// written positions are rounded to (PipelineOptions::frame): the repairs also judge convexity, the
+  /// FV centres and planarity there, since the frame's map keeps neither angles nor the checks'
+  /// relative tolerances (a face 1 degree off planar in a frame of kv/kh = 0.01 can be 18 as written).
+  PermeabilityFrame frame;
+  Vec3 frame_written_origin;
 };
 
 struct SiteOptimizeReport {

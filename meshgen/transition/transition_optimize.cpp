@@ -222,6 +222,27 @@ ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& gl
   return out;
 }
 
+// The cells of a submesh built in permeability frame f (not the identity) that fail convexity, the
+// FV centre inside or planarity once moved back to physical positions (to_physical) and rounded as
+// written about `origin`, where fvcheck judges them; orthogonality, which the K metric keeps, is
+// judged in the frame (shape_failures).
+std::vector<char> written_frame_failures(PolyMesh sub, const PermeabilityFrame& f, Vec3 origin) {
+  for (Vec3& p : sub.nodes) p = as_written(to_physical(f, p), origin);
+  for (Vec3& p : sub.cell_fv_center) p = as_written(to_physical(f, p), origin);
+  const MeshGeometry geo = compute_geometry(sub);
+  const CheckOptions opt;
+  std::vector<char> cell(sub.n_cells(), 0);
+  for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)})
+    for (int c = 0; c < sub.n_cells(); ++c) cell[c] |= r.failing[c];
+  const CheckResult planarity = check_planarity(sub, geo, opt);
+  for (int f = 0; f < sub.n_faces(); ++f)
+    if (planarity.failing[f]) {
+      cell[sub.face_owner[f]] = 1;
+      if (sub.face_neighbour[f] >= 0) cell[sub.face_neighbour[f]] = 1;
+    }
+  return cell;
+}
+
 // Node -> cells (CSR, cells ascending) and edge -> cells ((a, b, cell) with a < b, sorted) over a
 // submesh's node ids: built per node in cell order, so only each node's short list is sorted.
 struct Incidence {
@@ -354,6 +375,11 @@ class SiteOptimizer {
     m.qs = cell_shape_quality(m.sub, h_ref_);
     m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
     m.failing = shape_failures(m.sub, m.global, t, cavity_, outside_centres_, images_.planes);
+    if (pass_ == Pass::Repairs && !opt_.frame.identity()) {
+      const std::vector<char> written = written_frame_failures(m.sub, opt_.frame, opt_.frame_written_origin);
+      for (size_t c = 0; c < written.size(); ++c) m.failing.cell[c] |= written[c];
+      m.failing.count = std::count(m.failing.cell.begin(), m.failing.cell.end(), 1);
+    }
     return m;
   }
   // The cells of `after` (a diagram of the same sites, so the same cell per site) that fail a
