@@ -558,6 +558,25 @@ void refine_near_wells(CaseSpec& cs) {
 
 // A corner-point model whose faults step by a fraction of a layer near a well: its layers split there
 // (meshgen/case/corner_point_fault_steps.hpp) so that the two sides meet face to face in the cavities.
+// Fault steps too thin to split, moved onto the other side's layer boundary near the wells
+// (snap_thin_fault_steps). In the model the wells are meshed in: the refinement's pillars between a
+// pillar near a well and one beyond would otherwise keep a part of the step.
+void snap_fault_steps_near_wells(CaseSpec& cs) {
+  ReservoirSpec& r = cs.reservoir;
+  if (!r.corner_point || cs.wells.empty()) return;
+  std::vector<FaultStepRequest> requests;
+  for (const WellSpec& w : cs.wells)
+    requests.push_back({w.trajectory, kFaultStepReach * (cs.transition.dilation + 2) * w.drainage_radius});
+  CornerPointModel snapped = *r.corner_point;
+  const SnappedSteps snaps = snap_thin_fault_steps(snapped, requests);
+  if (snaps.corners == 0) return;
+  cs.notes.push_back("reservoir: " + std::to_string(snaps.corners) + " cell corners on faults near the wells moved by "
+                     "at most " + fmt6(snaps.largest) + " m (under " + fmt6(100 * kMinStepFraction) +
+                     " % of their cells' thickness) onto the other side's layer boundary, so that the faults' two "
+                     "sides meet face to face there (docs/corner-point.md, \"Fault steps\")");
+  use_model(r, std::make_shared<const CornerPointModel>(std::move(snapped)));
+}
+
 void split_fault_steps_near_wells(CaseSpec& cs) {
   ReservoirSpec& r = cs.reservoir;
   if (!r.corner_point || cs.wells.empty()) return;
@@ -878,6 +897,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   check_wells(cs);
   split_fault_steps_near_wells(cs);
   refine_near_wells(cs);
+  snap_fault_steps_near_wells(cs);
   clip_paths_to_model(cs, as_given, SurfaceGapRule::SurfaceFaces, true);
   fit_blocks_to_the_surface(cs);
   check_wells(cs);

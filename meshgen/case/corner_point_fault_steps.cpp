@@ -49,11 +49,12 @@ std::vector<double> column_boundaries(const PillarColumns& pc, int I, int J, int
 }
 
 // Whether a boundary of column slot a lies strictly inside an active cell of slot b at pillar (I, J)
-// (kMinStepFraction of that cell's thickness from its ends).
-bool cuts_a_cell_of(const PillarColumns& pc, int I, int J, const std::vector<double>& boundaries_a, int b) {
+// (`fraction` of that cell's thickness from its ends).
+bool cuts_a_cell_of(const PillarColumns& pc, int I, int J, const std::vector<double>& boundaries_a, int b,
+                    double fraction) {
   for (int k = 0; k < pc.m.nz; ++k) {
     if (!pc.active(I, J, b, k)) continue;
-    const double top = pc.top(I, J, b, k), bottom = pc.bottom(I, J, b, k), margin = kMinStepFraction * (bottom - top);
+    const double top = pc.top(I, J, b, k), bottom = pc.bottom(I, J, b, k), margin = fraction * (bottom - top);
     const auto it = std::upper_bound(boundaries_a.begin(), boundaries_a.end(), top + margin);
     if (it != boundaries_a.end() && *it < bottom - margin) return true;
   }
@@ -61,15 +62,16 @@ bool cuts_a_cell_of(const PillarColumns& pc, int I, int J, const std::vector<dou
 }
 
 // The column slots at a pillar whose layers are offset against each other both ways (a fault's two
-// sides): offset[a][b]. A column with a boundary inside another's cell but not the other way round (a
-// layer pinching out or ending, cells MINPV removed and their neighbours extended over them) is no
-// fault step.
+// sides): offset[a][b], a boundary of each beyond `fraction` of a cell's thickness inside a cell of the
+// other. A column with a boundary inside another's cell but not the other way round (a layer pinching
+// out or ending, cells MINPV removed and their neighbours extended over them) is no fault step.
 std::array<std::array<bool, 4>, 4> offset_columns(const PillarColumns& pc, int I, int J,
-                                                  const std::array<std::vector<double>, 4>& boundaries) {
+                                                  const std::array<std::vector<double>, 4>& boundaries,
+                                                  double fraction = kMinStepFraction) {
   std::array<std::array<bool, 4>, 4> cut{}, out{};
   for (int a = 0; a < 4; ++a)
     for (int b = 0; b < 4; ++b)
-      cut[a][b] = a != b && pc.present(I, J, a) && pc.present(I, J, b) && cuts_a_cell_of(pc, I, J, boundaries[a], b);
+      cut[a][b] = a != b && pc.present(I, J, a) && pc.present(I, J, b) && cuts_a_cell_of(pc, I, J, boundaries[a], b, fraction);
   for (int a = 0; a < 4; ++a)
     for (int b = 0; b < 4; ++b) out[a][b] = cut[a][b] && cut[b][a];
   return out;
@@ -156,6 +158,68 @@ std::vector<double> padded(std::vector<double> exact, double top, double bottom,
 }
 
 }  // namespace
+
+namespace {
+
+// The boundaries of column slot a's active cells of non-zero thickness on pillar (I, J), each with the
+// thinner of the cells it separates, sorted by depth.
+std::vector<std::pair<double, double>> boundaries_with_thickness(const PillarColumns& pc, int I, int J, int a) {
+  std::vector<std::pair<double, double>> out;
+  for (int k = 0; k < pc.m.nz; ++k) {
+    if (!pc.active(I, J, a, k)) continue;
+    const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
+    if (!(bottom > top)) continue;
+    out.push_back({top, bottom - top}), out.push_back({bottom, bottom - top});
+  }
+  std::sort(out.begin(), out.end());
+  std::vector<std::pair<double, double>> merged;
+  for (const auto& b : out)
+    if (!merged.empty() && merged.back().first == b.first) merged.back().second = std::min(merged.back().second, b.second);
+    else merged.push_back(b);
+  return merged;
+}
+
+}  // namespace
+
+SnappedSteps snap_thin_fault_steps(CornerPointModel& m, const std::vector<FaultStepRequest>& wells) {
+  SnappedSteps out;
+  const PillarColumns pc{m};
+  for (int J = 0; J <= m.ny; ++J)
+    for (int I = 0; I <= m.nx; ++I) {
+      std::array<std::vector<double>, 4> boundaries;
+      for (int a = 0; a < 4; ++a) boundaries[a] = pc.present(I, J, a) ? column_boundaries(pc, I, J, a) : std::vector<double>{};
+      const auto offset = offset_columns(pc, I, J, boundaries, 0.0);  // thin steps too
+      const int p = I + (m.nx + 1) * J;
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          if (!offset[a][b]) continue;
+          const auto fixed = boundaries_with_thickness(pc, I, J, a);
+          for (const auto& [e, thick_b] : boundaries_with_thickness(pc, I, J, b))
+            for (const auto& [d, thick_a] : fixed) {
+              const double step = std::fabs(d - e);
+              if (step == 0 || step >= kMinStepFraction * std::min(thick_a, thick_b)) continue;
+              const Vec3 corner = pillar_point(m, p, e);
+              if (std::none_of(wells.begin(), wells.end(),
+                               [&](const FaultStepRequest& w) { return path_distance(corner, w) <= w.reach; }))
+                continue;
+              // Every column offset against slot a reads e at this pillar: all of them move to d.
+              for (int s = 0; s < 4; ++s) {
+                if (!offset[a][s] || !pc.present(I, J, s)) continue;
+                const int ci = PillarColumns::column_i(I, s), cj = PillarColumns::column_j(J, s);
+                for (int k = 0; k < m.nz; ++k)
+                  for (int q : {PillarColumns::corner(s), 4 | PillarColumns::corner(s)}) {
+                    double& z = m.zcorn[zcorn_index(m, ci, cj, k, q)];
+                    if (z == e) z = d, ++out.corners;
+                  }
+              }
+              out.largest = std::max(out.largest, step);
+              break;
+            }
+        }
+    }
+  if (out.corners > 0) m.opm_volume.clear();
+  return out;
+}
 
 FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells) {
   FaultStepSplit out;

@@ -55,6 +55,22 @@ struct FaultStepSplit {
   bool splits() const;
 };
 
+/// What snap_thin_fault_steps moved.
+struct SnappedSteps {
+  int64_t corners = 0;  ///< cell corners moved (ZCORN values)
+  double largest = 0;   ///< the largest move (m)
+};
+
+/// Steps too thin to split (kMinStepFraction): on a fault pillar within reach of a well, a layer
+/// boundary of one side that lies less than kMinStepFraction of the thinner of the cells it separates
+/// (on either side) from a boundary of the other side is moved onto it: every ZCORN value of the
+/// columns offset against the lower column slot equal to it, so that the sides meet face to face
+/// there. Such a step is within the tolerance of the model's depths, and left as it is it puts a
+/// cavity vertex a few centimetres from the corner of a wall face, inside that face's diametral
+/// sphere (not Delaunay admissible; docs/corner-point.md, "Fault steps"). Cells keep their ids; rock,
+/// ACTNUM and multipliers are untouched; m.opm_volume is cleared when anything moves.
+SnappedSteps snap_thin_fault_steps(CornerPointModel& m, const std::vector<FaultStepRequest>& wells);
+
 /// Children per layer: a layer is split where, within reach of a well, the corner of one of its
 /// cells on a fault pillar (a pillar whose columns' depths differ) has a boundary of a cell across
 /// the fault strictly inside it (beyond kMinStepFraction of its thickness from either end); into as

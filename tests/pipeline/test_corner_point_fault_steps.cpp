@@ -207,3 +207,63 @@ TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
     EXPECT_EQ(r.trans_mult[5][c], first ? 0.0625 : 1.0);
   }
 }
+
+// A throw of 0.96 layer leaves steps of 4 % of a layer (0.08 m) between the two sides' boundaries:
+// too thin to split (kMinStepFraction), and a cavity vertex that near a wall face's corner lies in its
+// diametral sphere (the horizontal sweep's seed 25: not Delaunay admissible). snap_thin_fault_steps
+// moves one side's boundary onto the other's on the fault pillars within reach of a well: there every
+// depth of one side within the range of both is a depth of the other or at least 5 % of a layer from
+// all of them; pillars beyond reach keep their depths; no cell loses its thickness. A throw of 0.4
+// layer has no thin step and nothing moves.
+TEST(FaultSteps, ThinStepsNearAWellAreSnappedOntoTheOtherSide) {
+  TempDir tmp("cpsteps_snap");
+  hmtest::LayeredModel g = faulted_model();
+  g.throw_m = 0.96 * g.dz;
+  const CornerPointModel before = read_model(tmp, g);
+  CornerPointModel m = before;
+  const std::vector<FaultStepRequest> well{{{{125, 75, 1000}, {125, 75, 1012}}, 20}};
+  const SnappedSteps snaps = snap_thin_fault_steps(m, well);
+  std::printf("[ figures  ] 0.96-layer throw: %lld corners moved, at most %.4f m\n", static_cast<long long>(snaps.corners),
+              snaps.largest);
+  EXPECT_GT(snaps.corners, 0);
+  EXPECT_NEAR(snaps.largest, 0.04 * g.dz, 1e-3);
+  check_corner_point_geometry(m, "snapped");
+  // Depths on fault pillar (4, J) of the columns on one side (i = 3) and the other (i = 4).
+  auto side_depths = [](const CornerPointModel& model, int J, int i) {
+    std::set<double> out;
+    for (int j : {J - 1, J}) {
+      if (j < 0 || j >= model.ny) continue;
+      const int q = (4 > i ? 1 : 0) | (J > j ? 2 : 0);
+      for (int k = 0; k < model.nz; ++k)
+        out.insert(model.zcorn[zcorn_index(model, i, j, k, q)]), out.insert(model.zcorn[zcorn_index(model, i, j, k, 4 | q)]);
+    }
+    return out;
+  };
+  int near_pillars = 0, far_pillars = 0;
+  for (int J = 0; J <= m.ny; ++J) {
+    const Vec3 top = pillar_point(m, 4 + (m.nx + 1) * J, 1006);
+    const bool near = segment_segment_distance(top, top, well[0].path[0], well[0].path[1]) <= well[0].reach - 2 * g.dz;
+    const bool far = segment_segment_distance(top, top, well[0].path[0], well[0].path[1]) > well[0].reach + 2 * g.dz;
+    if (far) {
+      ++far_pillars;
+      for (int i : {3, 4}) EXPECT_EQ(side_depths(m, J, i), side_depths(before, J, i)) << "pillar (4, " << J << ")";
+    }
+    if (!near) continue;
+    ++near_pillars;
+    const std::set<double> left = side_depths(m, J, 3), right = side_depths(m, J, 4);
+    const double lo = std::max(*left.begin(), *right.begin()), hi = std::min(*left.rbegin(), *right.rbegin());
+    int matched = 0;
+    for (double z : left) {
+      if (z < lo || z > hi) continue;
+      double nearest = INFINITY;
+      for (double w : right) nearest = std::min(nearest, std::fabs(w - z));
+      EXPECT_TRUE(nearest == 0 || nearest >= kMinStepFraction * g.dz) << "pillar (4, " << J << ") depth " << z;
+      matched += nearest == 0;
+    }
+    EXPECT_GT(matched, 2) << "pillar (4, " << J << ")";
+  }
+  EXPECT_GT(near_pillars, 0);
+  EXPECT_GT(far_pillars, 0);
+  CornerPointModel fractional = read_model(tmp, faulted_model());
+  EXPECT_EQ(snap_thin_fault_steps(fractional, well).corners, 0);
+}

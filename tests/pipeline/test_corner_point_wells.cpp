@@ -519,6 +519,22 @@ TEST(CornerPointSurface, WellTooNearTheTopForItsFacesIsRefusedWithTheReason) {
   }
 }
 
+// A vertical well 3 m beside a fault of 0.96 layer's throw (2.88 m in 3 m layers, 6 m columns), its
+// cavity across the fault: the steps of 4 % of a layer that are left are too thin to split; they are
+// moved onto the other side's boundaries near the well (snap_thin_fault_steps, with a note) and the
+// case meshes soundly.
+TEST(CornerPointWells, WellAcrossANearlyWholeLayerThrowMeshesSoundly) {
+  TempDir tmp("cpwells");
+  TiltedModel g = small_columns();
+  g.fault_i = 8, g.throw_m = 0.96 * g.dz;
+  const CaseSpec cs = case_of(tmp, g, vertical_well(45, 45, 1023, 1035));
+  EXPECT_TRUE(std::any_of(cs.notes.begin(), cs.notes.end(), [](const std::string& n) {
+    return n.find("onto the other side's layer boundary") != std::string::npos;
+  }));
+  const HybridMesh out = build_hybrid_mesh(cs);
+  expect_sound_mesh(cs, out);
+}
+
 // Constrained triangles: a face's triangles cover it (area) with its own nodes and orientation.
 TEST(CornerPointWells, FaceTrianglesCoverTheFaceWithItsNodes) {
   const std::vector<Vec3> coords{{0, 0, 0}, {10, 0, 0}, {20, 0, 0.5}, {20, 5, 0}, {10, 5, 0.2}, {0, 5, 0}, {5, 0, 0}};
