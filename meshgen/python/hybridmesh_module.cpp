@@ -156,13 +156,18 @@ PYBIND11_MODULE(hybridmesh, mod) {
           d["radius"] = w.radius;
           d["drainage_radius"] = w.drainage_radius;
           d["bhp"] = w.bhp;
+          d["rings"] = w.rings;
+          d["sectors"] = w.sectors;
+          d["segment_length"] = w.segment_length;
           std::vector<std::vector<double>> traj;
           for (const hm::Vec3& p : w.trajectory) traj.push_back({p.x, p.y, p.z});
           d["trajectory"] = traj;
           wells.append(d);
         }
         return wells;
-      });
+      })
+      .def_property_readonly("notes", [](const hm::CaseSpec& c) { return c.notes; },
+                             "what reading the case changed (paths clipped, layers split, faces fitted ...)");
 
   mod.def("load_case", &hm::load_case, py::arg("path"),
           "Reads and validates a YAML case file; raises InputError('key.path: reason').");

@@ -32,6 +32,10 @@ class BuiltMesh(unittest.TestCase):
         self.assertEqual(len(self.case.wells), 1)
         self.assertEqual(self.case.wells[0]["name"], "P1")
         self.assertEqual(len(self.case.wells[0]["trajectory"]), 3)
+        # The defaults (docs/case-format.md), as meshed; nothing fitted or clipped in a box.
+        self.assertEqual((self.case.wells[0]["rings"], self.case.wells[0]["sectors"]), (6, 12))
+        self.assertEqual(self.case.wells[0]["segment_length"], 4.0)
+        self.assertIsInstance(self.case.notes, list)
 
     def test_csr_faces_and_cells(self):
         m = self.mesh
