@@ -556,19 +556,23 @@ void refine_near_wells(CaseSpec& cs) {
   use_model(r, std::make_shared<const CornerPointModel>(std::move(*refined_m)));
 }
 
-// A corner-point model whose faults step by a fraction of a layer near a well: its layers split there
-// (meshgen/case/corner_point_fault_steps.hpp) so that the two sides meet face to face in the cavities.
+// Each well's path and the reach within which a fault step counts for it: its cavity's, (dilation + 2)
+// drainage radii, times kFaultStepReach.
+std::vector<FaultStepRequest> fault_step_requests(const CaseSpec& cs) {
+  std::vector<FaultStepRequest> requests;
+  for (const WellSpec& w : cs.wells)
+    requests.push_back({w.trajectory, kFaultStepReach * (cs.transition.dilation + 2) * w.drainage_radius});
+  return requests;
+}
+
 // Fault steps too thin to split, moved onto the other side's layer boundary near the wells
 // (snap_thin_fault_steps). In the model the wells are meshed in: the refinement's pillars between a
 // pillar near a well and one beyond would otherwise keep a part of the step.
 void snap_fault_steps_near_wells(CaseSpec& cs) {
   ReservoirSpec& r = cs.reservoir;
   if (!r.corner_point || cs.wells.empty()) return;
-  std::vector<FaultStepRequest> requests;
-  for (const WellSpec& w : cs.wells)
-    requests.push_back({w.trajectory, kFaultStepReach * (cs.transition.dilation + 2) * w.drainage_radius});
   CornerPointModel snapped = *r.corner_point;
-  const SnappedSteps snaps = snap_thin_fault_steps(snapped, requests);
+  const SnappedSteps snaps = snap_thin_fault_steps(snapped, fault_step_requests(cs));
   if (snaps.corners == 0) return;
   cs.notes.push_back("reservoir: " + std::to_string(snaps.corners) + " cell corners on faults near the wells moved by "
                      "at most " + fmt6(snaps.largest) + " m (under " + fmt6(100 * kMinStepFraction) +
@@ -577,13 +581,12 @@ void snap_fault_steps_near_wells(CaseSpec& cs) {
   use_model(r, std::make_shared<const CornerPointModel>(std::move(snapped)));
 }
 
+// A corner-point model whose faults step by a fraction of a layer near a well: its layers split there
+// (meshgen/case/corner_point_fault_steps.hpp) so that the two sides meet face to face in the cavities.
 void split_fault_steps_near_wells(CaseSpec& cs) {
   ReservoirSpec& r = cs.reservoir;
   if (!r.corner_point || cs.wells.empty()) return;
-  std::vector<FaultStepRequest> requests;
-  for (const WellSpec& w : cs.wells)
-    requests.push_back({w.trajectory, kFaultStepReach * (cs.transition.dilation + 2) * w.drainage_radius});
-  const FaultStepSplit split = fault_step_children(*r.corner_point, requests);
+  const FaultStepSplit split = fault_step_children(*r.corner_point, fault_step_requests(cs));
   if (!split.splits()) return;
   const double cells = double(r.corner_point->nx) * r.corner_point->ny *
                        std::accumulate(split.children.begin(), split.children.end(), 0.0);

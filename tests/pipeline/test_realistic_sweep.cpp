@@ -271,6 +271,17 @@ TEST(RealisticSweep, FlatEndsWithLargeRingRatioMeshAndPassFvcheck) {
   }
 }
 
+namespace {
+// A full-sweep seed drawn at kv/kh 0.01 whose well crosses the top or bottom, without optimisation:
+// it must mesh and pass every check.
+void expect_kvkh001_crossing_case_meshes(uint32_t seed) {
+  RealisticOptions o = sweep_options(seed);
+  o.kv_kh = 0.01;
+  ASSERT_TRUE(o.cross_top_bottom && !o.optimize);  // the generator still draws the through-the-boundary case
+  expect_meshes(make_realistic_case(seed, o), o);
+}
+}  // namespace
+
 // A well inclined 55 degrees through the top and bottom at kv/kh 0.01 (full-sweep seed 1064 with
 // HM_SWEEP_KVKH=0.01; R 8 m in 11.7 m cells 4.2 m thick, flat ends, no optimisation): the transition
 // cell under the top where the well enters had its outer-boundary face at 43.9 degrees from its
@@ -278,14 +289,7 @@ TEST(RealisticSweep, FlatEndsWithLargeRingRatioMeshAndPassFvcheck) {
 // session 17). Its cavity touches the boundary planes, which the repair pass now handles (the sites'
 // images in every rebuild) and judges (faces in a plane as fvcheck judges a boundary face); 3 repairs
 // mend it. It must mesh and pass every check (about 2 s in Release).
-TEST(RealisticSweep, BoundaryFaceFailingOrthogonalityIsRepaired) {
-  const uint32_t seed = 1064;
-  RealisticOptions o = sweep_options(seed);
-  o.kv_kh = 0.01;
-  ASSERT_TRUE(o.cross_top_bottom && !o.optimize);  // the generator still draws the through-the-boundary case
-  const RealisticCase rc = make_realistic_case(seed, o);
-  expect_meshes(rc, o);
-}
+TEST(RealisticSweep, BoundaryFaceFailingOrthogonalityIsRepaired) { expect_kvkh001_crossing_case_meshes(1064); }
 
 // A vertical well through the top and bottom at kv/kh 0.01 (full-sweep seed 1170 with HM_SWEEP_KVKH=0.01,
 // no optimisation): in the permeability frame (z stretched 10 times) every face was within the
@@ -294,12 +298,7 @@ TEST(RealisticSweep, BoundaryFaceFailingOrthogonalityIsRepaired) {
 // cells at their written, physical positions (TransitionOptions::frame); 25 repairs mend it. It must
 // mesh and pass every check (about 1 s in Release).
 TEST(RealisticSweep, FacesOffPlanarOnlyAsWrittenAreRepairedInThePermeabilityFrame) {
-  const uint32_t seed = 1170;
-  RealisticOptions o = sweep_options(seed);
-  o.kv_kh = 0.01;
-  ASSERT_TRUE(o.cross_top_bottom && !o.optimize);  // the generator still draws the through-the-boundary case
-  const RealisticCase rc = make_realistic_case(seed, o);
-  expect_meshes(rc, o);
+  expect_kvkh001_crossing_case_meshes(1170);
 }
 
 // The optimiser kept site moves whose rebuilt cells were not convex (full-sweep seed 1009: 2 cells,
