@@ -237,6 +237,7 @@ OuterFaceFit fit_outer_faces(const WellSpec& ws, double clearance) {
   const double allowed = clearance / kSurfaceGapMargin, R = ws.drainage_radius;
   auto chord = [R](int n) { return 2 * R * std::sin(kPi / n); };
   OuterFaceFit fit{ws.sectors, ws.segment_length, true};
+  if (!(clearance > 0)) return fit.fits = false, fit;  // the surface reaches into the block: no face fits
   // A face's circumcentre lies R cos(pi / sectors) from the axis: its sphere reaches no node farther.
   const double sphere = 0.5 * std::hypot(chord(fit.sectors), fit.segment_length);
   if (R * std::cos(kPi / fit.sectors) + sphere <= R + clearance) return fit;

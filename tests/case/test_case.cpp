@@ -905,16 +905,23 @@ TEST(CornerPointPath, SurfaceClearanceIsTheNearestSurfaceNodeBesideThePath) {
 // chord by a segment, about a circumcentre R cos(pi / sectors) from the axis) cannot reach the
 // surface's nodes; else spheres kSurfaceGapMargin times inside the clearance whenever it says they fit,
 // sectors raised before the segment is shortened, to at most 4 x; no fit only when even 4 x the
-// sectors leave a chord as wide as the sphere allowed.
+// sectors leave a chord as wide as the sphere allowed, or when the surface reaches into the block (a
+// clearance <= 0: the user's values, unchanged).
 TEST(CornerPointPath, OuterFacesAreFittedInsideTheSurfaceClearance) {
   int fitted = 0, raised = 0, refused = 0;
   for (double R : {3.0, 6.0, 15.0})
     for (int sectors : {8, 12, 13})
       for (double segment : {1.0, 4.0, 10.0})
-        for (double clearance : {0.05, 0.5, 1.5, 2.5, 4.0, 8.0}) {
+        for (double clearance : {-1.0, 0.0, 0.05, 0.5, 1.5, 2.5, 4.0, 8.0}) {
           WellSpec ws;
           ws.drainage_radius = R, ws.sectors = sectors, ws.segment_length = segment;
           const OuterFaceFit fit = fit_outer_faces(ws, clearance);
+          if (clearance <= 0) {  // the surface inside the block: nothing fits, nothing changes
+            EXPECT_FALSE(fit.fits);
+            EXPECT_EQ(fit.sectors, sectors);
+            EXPECT_EQ(fit.segment_length, segment);
+            continue;
+          }
           const double allowed = clearance / kSurfaceGapMargin;
           auto chord = [R](int n) { return 2 * R * std::sin(M_PI / n); };
           const double sphere = 0.5 * std::hypot(chord(sectors), segment);
