@@ -194,8 +194,8 @@ double surface_clearance(const CornerPointModel& m, const WellSpec& ws) {
   auto beyond_ends = [&](Vec3 q) {
     return dot(q - path[0], path[1] - path[0]) < 0 || dot(q - path[n - 1], path[n - 1] - path[n - 2]) > 0;
   };
-  // A column whose pillars (straight, from its top cell's top to its bottom cell's bottom) pass
-  // beside the path's box in plan holds no node near it.
+  // A column whose plan box (its pillars are straight, from its top cell's top to its bottom cell's
+  // bottom) lies farther than the reach from the path in plan holds no node near it.
   std::vector<Vec3> plan_path;
   for (const Vec3& p : path) plan_path.push_back({p.x, p.y, 0});
   auto column_near = [&](int i, int j) {

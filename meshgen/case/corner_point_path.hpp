@@ -77,7 +77,8 @@ double surface_clearance(const CornerPointModel& m, const WellSpec& ws);
 /// R cos(pi / sectors) from the axis plus the sphere's radius <= R + clearance); else the spheres made
 /// kSurfaceGapMargin times smaller than the clearance: the sectors raised first (at most to 4 x
 /// ws.sectors) until the chord is at most sqrt(2) of the radius allowed, then the segment shortened;
-/// `fits` is false (ws's values) when even that is not enough, or when the clearance is not positive.
+/// `fits` is false when even that is not enough (`sectors` then the most tried), or when the clearance
+/// is not positive (ws's values).
 struct OuterFaceFit {
   int sectors = 0;
   double segment_length = 0;
