@@ -173,6 +173,21 @@ struct ShapeFailures {
   int64_t count = 0;  ///< failing cells
 };
 
+// Marks the cells of a submesh that fail convexity or the FV centre inside, and both cells of each
+// face that fails planarity (fvcheck's checks at their defaults): the shape checks whose verdict a
+// permeability frame's map can change (angles, relative tolerances; written_frame_failures).
+void mark_affine_shape_failures(const PolyMesh& sub, const MeshGeometry& geo, std::vector<char>& cell) {
+  const CheckOptions opt;
+  for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)})
+    for (int c = 0; c < sub.n_cells(); ++c) cell[c] |= r.failing[c];
+  const CheckResult planarity = check_planarity(sub, geo, opt);
+  for (int f = 0; f < sub.n_faces(); ++f)
+    if (planarity.failing[f]) {
+      cell[sub.face_owner[f]] = 1;
+      if (sub.face_neighbour[f] >= 0) cell[sub.face_neighbour[f]] = 1;
+    }
+}
+
 // Whether every node of the submesh's face f lies in one of the outer-boundary planes (the
 // extraction puts the free vertices of those faces in the plane exactly).
 bool in_outer_plane(const PolyMesh& sub, int f, const std::vector<MirrorPlane>& planes) {
@@ -208,16 +223,11 @@ ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& gl
           face_orthogonality_of(sub, geo, f, outside_centres[polygon[f]]) < opt.min_orthogonality_deg)
         out.cell[sub.face_owner[f]] = 1;
   }
-  for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)})
-    for (int c = 0; c < sub.n_cells(); ++c) out.cell[c] |= r.failing[c];
+  mark_affine_shape_failures(sub, geo, out.cell);
   const std::vector<double> qo = face_orthogonality(sub, geo);
-  const CheckResult planarity = check_planarity(sub, geo, opt);
-  for (int f = 0; f < sub.n_faces(); ++f) {
-    const bool skewed = sub.face_neighbour[f] >= 0 && qo[f] < opt.min_orthogonality_deg;
-    if (!skewed && !planarity.failing[f]) continue;
-    out.cell[sub.face_owner[f]] = 1;
-    if (sub.face_neighbour[f] >= 0) out.cell[sub.face_neighbour[f]] = 1;
-  }
+  for (int f = 0; f < sub.n_faces(); ++f)
+    if (sub.face_neighbour[f] >= 0 && qo[f] < opt.min_orthogonality_deg)
+      out.cell[sub.face_owner[f]] = 1, out.cell[sub.face_neighbour[f]] = 1;
   out.count = std::count(out.cell.begin(), out.cell.end(), 1);
   return out;
 }
@@ -229,17 +239,8 @@ ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& gl
 std::vector<char> written_frame_failures(PolyMesh sub, const PermeabilityFrame& f, Vec3 origin) {
   for (Vec3& p : sub.nodes) p = as_written(to_physical(f, p), origin);
   for (Vec3& p : sub.cell_fv_center) p = as_written(to_physical(f, p), origin);
-  const MeshGeometry geo = compute_geometry(sub);
-  const CheckOptions opt;
   std::vector<char> cell(sub.n_cells(), 0);
-  for (const CheckResult& r : {check_convexity(sub, geo, opt), check_auto_centering(sub, geo, opt)})
-    for (int c = 0; c < sub.n_cells(); ++c) cell[c] |= r.failing[c];
-  const CheckResult planarity = check_planarity(sub, geo, opt);
-  for (int f = 0; f < sub.n_faces(); ++f)
-    if (planarity.failing[f]) {
-      cell[sub.face_owner[f]] = 1;
-      if (sub.face_neighbour[f] >= 0) cell[sub.face_neighbour[f]] = 1;
-    }
+  mark_affine_shape_failures(sub, compute_geometry(sub), cell);
   return cell;
 }
 
