@@ -503,8 +503,9 @@ void refine_near_wells(CaseSpec& cs) {
   std::vector<RefinementRequest> requests;
   for (const WellSpec& w : cs.wells) {
     const double size = r.near_well_cell_size > 0 ? r.near_well_cell_size : w.drainage_radius;
-    requests.push_back({w.trajectory, size, cs.transition.dilation * w.drainage_radius + 2 * size,
-                        r.near_well_cell_size == 0, r.near_well_grading});
+    const bool automatic = r.near_well_cell_size == 0;
+    requests.push_back({w.trajectory, size, cs.transition.dilation * w.drainage_radius + 2 * size, automatic,
+                        automatic, r.near_well_grading});
   }
   std::vector<StraightenRequest> upright;
   for (const RefinementRequest& q : requests)
@@ -529,11 +530,12 @@ void refine_near_wells(CaseSpec& cs) {
   refine_and_turn();
   // Where the pillars lean obliquely (turned upright, or refused) the columns are split into equal
   // children: graded ones failed there (Reek's OP_2, whose turn graded children also refuse;
-  // docs/corner-point.md, "Graded children").
+  // docs/corner-point.md, "Graded children"). Pillars turned upright no longer lean.
   bool regrade = false;
   for (size_t w = 0; w < outcomes.size(); ++w) {
     const bool oblique = outcomes[w].straightened || outcomes[w].wall_angle_deg < kStraightenWallAngleBelow;
     if (oblique && requests[w].graded) requests[w].graded = false, regrade = true;
+    if (outcomes[w].straightened && requests[w].limit_by_lean) requests[w].limit_by_lean = false, regrade = true;
   }
   if (regrade) refine_and_turn();
   for (size_t w = 0; w < outcomes.size(); ++w) {

@@ -104,6 +104,45 @@ double layer_thickness(const CornerPointModel& m, int i, int j, double s, double
   return 0;
 }
 
+// Whether layer k is one of several children of a layer split at fault steps.
+bool is_step_child(const CornerPointModel& m, int k) {
+  if (m.parent_layer.empty()) return false;
+  return (k > 0 && m.parent_layer[k - 1] == m.parent_layer[k]) ||
+         (k + 1 < m.nz && m.parent_layer[k + 1] == m.parent_layer[k]);
+}
+
+// Largest lean from the vertical (radians) of the 4 pillars of column (i, j).
+double column_lean(const CornerPointModel& m, int i, int j) {
+  double lean = 0;
+  for (int dj = 0; dj < 2; ++dj)
+    for (int di = 0; di < 2; ++di) {
+      const double* p = pillar(m, i + di, j + dj);
+      const double dz = std::abs(p[5] - p[2]);
+      if (dz > 0) lean = std::max(lean, std::atan(std::hypot(p[3] - p[0], p[4] - p[1]) / dz));
+    }
+  return lean;
+}
+
+// The widest cells whose top and bottom faces near depth z (within `reach`) keep the next layer's
+// corners out of their triangles' diametral spheres on the leaning pillars of column (i, j); infinity
+// where the pillars are vertical (kLeanSphereMargin).
+double lean_limited_size(const CornerPointModel& m, int i, int j, double s, double t, double z, double reach) {
+  const double sin_2lean = std::sin(2 * std::min(column_lean(m, i, j), std::atan(1.0)));
+  if (!(sin_2lean > 0)) return std::numeric_limits<double>::infinity();
+  const auto w = bilinear_weights(s, t);
+  double thinnest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < m.nz; ++k) {
+    if (!is_step_child(m, k)) continue;
+    double top = 0, bottom = 0;
+    for (int a = 0; a < 4; ++a) {
+      top += w[a] * m.zcorn[zcorn_index(m, i, j, k, a)];
+      bottom += w[a] * m.zcorn[zcorn_index(m, i, j, k, 4 | a)];
+    }
+    if (bottom > top && bottom >= z - reach && top <= z + reach) thinnest = std::min(thinnest, bottom - top);
+  }
+  return std::sqrt(2.0) * thinnest / (kLeanSphereMargin * sin_2lean);
+}
+
 // What one path point asks of one slice: children of `size` within `reach` of it, growing beyond.
 // Its distance from parameter s across the slice is d + |s - s_ref| width (s_ref: the point's own
 // parameter when the slice holds it, d = 0; else the slice's end nearer to it, d its distance).
@@ -185,6 +224,7 @@ void for_each_ask(const CornerPointModel& m, const RefinementRequest& r, double 
     double size = r.cell_size;
     if (const double h = layer_thickness(m, ip, jp, s, t, x.z); r.limit_by_layer && h > 0)
       size = std::min(size, kCellsPerLayerThickness * h);
+    if (r.limit_by_lean) size = std::min(size, lean_limited_size(m, ip, jp, s, t, x.z, r.reach));
     auto ask = [&](int slice, bool along_i, int holder, double at, Vec3 lo, Vec3 hi) {
       const double width = plan_distance(lo, hi);
       if (!(width > wider_than * size)) return;

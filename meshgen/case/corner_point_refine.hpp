@@ -34,6 +34,9 @@ struct RefinementRequest {
   double reach = 0;
   /// Also no wider than kCellsPerLayerThickness x the thickness of the layer the path is in (auto).
   bool limit_by_layer = false;
+  /// Also no wider than the layers split at fault steps within reach allow on the column's leaning
+  /// pillars (kLeanSphereMargin; auto, where the pillars near the path are not turned upright).
+  bool limit_by_lean = false;
   /// Children that grow away from the path across a slice; false: a slice this well asks for is
   /// split into equal children, as many as the largest ask on it needs where it is nearest.
   bool graded = true;
@@ -53,6 +56,13 @@ constexpr double kCellsPerLayerThickness = 1.5;
 /// In a model whose layers are split at fault steps, a child's thickness counts as at least this
 /// fraction of its parent's for limit_by_layer (measured: docs/corner-point.md, "Fault steps").
 constexpr double kStepChildSizing = 0.5;
+/// With limit_by_lean, near-well cells are at most sqrt(2) h / (this x sin(2 lean)) wide, h the
+/// thinnest child of a layer split at fault steps within reach of the path (kStepChildSizing sizes
+/// them for limit_by_layer as thicker than they are) and lean the column's largest pillar lean (at most 45
+/// degrees): a square cell face of half-diagonal R holds, in its triangles' diametral sphere, the
+/// corner of the next layer h away along a pillar leaning toward it by lean when h < R sin(2 lean)
+/// (docs/corner-point.md, "Thin layers on leaning pillars").
+constexpr double kLeanSphereMargin = 1.25;
 /// Beyond `reach` the target size grows by this much per metre of distance from the path, so
 /// that neighbouring slices differ by a bounded ratio and refinement dies out within a few
 /// model columns.

@@ -20,6 +20,7 @@
 #include "../exporters/exporter_test_support.hpp"
 #include "corner_point_test_models.hpp"
 #include "model_cell_volumes.hpp"
+#include "meshgen/case/corner_point_fault_steps.hpp"
 #include "meshgen/case/corner_point_refine.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
@@ -370,6 +371,41 @@ RefinementRequest vertical_request(const hmtest::LayeredModel& g, double x, doub
 }
 
 }  // namespace
+
+// Layers split at a fault's step of 0.45 m (of 5 m layers) on pillars leaning 6 degrees: a wall face of
+// a cell as wide as the layers allow (1.5 x the parent's half thickness) holds, in its triangles'
+// diametral sphere, the next layer's corner 0.45 m along a pillar leaning toward it (horizontal sweep
+// seed 2: 154 triangles not Delaunay admissible). The columns near the well are then no wider than
+// sqrt(2) h / (kLeanSphereMargin sin(2 lean)) for h the thin child; without the step, or with
+// limit_by_lean off, the lean asks for nothing.
+TEST(NearWellRefinement, ThinStepChildrenOnLeaningPillarsNarrowTheColumns) {
+  TempDir tmp("cprefinelean");
+  hmtest::LayeredModel g;
+  g.nx = g.ny = 8, g.nz = 6, g.dx = g.dy = 40, g.dz = 5, g.pillar_deg = 6, g.pillar_azimuth_deg = 45;
+  g.fault_i = 4;
+  const double x = 150, z = g.layer_top(2, x, 160) + 0.5 * g.dz;
+  const std::vector<Vec3> path{{x, 60, z}, {x, 260, z}};
+  auto narrowest_child = [&](double throw_m, bool limit_by_lean) {
+    g.throw_m = throw_m;
+    const CornerPointModel read = read_model(tmp, g);
+    const FaultStepSplit split = fault_step_children(read, {{path, 30}});
+    EXPECT_EQ(split.splits(), throw_m > 0);
+    const CornerPointModel m = split.splits() ? layers_split_at_fault_steps(read, split) : read;
+    const ColumnSplits s = near_well_splits(m, {{path, 8, 20, true, limit_by_lean}});
+    double narrowest = std::numeric_limits<double>::infinity();
+    for (const auto* bounds : {&s.i_bounds, &s.j_bounds})
+      for (const std::vector<double>& b : *bounds)
+        for (size_t k = 0; k + 1 < b.size(); ++k) narrowest = std::min(narrowest, g.dx * (b[k + 1] - b[k]));
+    return narrowest;
+  };
+  const double lean_size = std::sqrt(2.0) * 0.45 / (kLeanSphereMargin * std::sin(2 * 6 * M_PI / 180));
+  const double stepped = narrowest_child(0.45, true), stepped_no_lean = narrowest_child(0.45, false);
+  EXPECT_LE(stepped, 1.05 * lean_size);
+  EXPECT_GT(stepped_no_lean, 1.3 * lean_size) << "the layers' own limit already narrows the columns";
+  EXPECT_DOUBLE_EQ(narrowest_child(0, true), narrowest_child(0, false));
+  std::printf("[ lean ] narrowest child: %.3f m with the lean limit (%.3f m), %.3f m without\n", stepped, lean_size,
+              stepped_no_lean);
+}
 
 // Two wells: a well whose columns are narrow for its own size keeps them alone, but where the children
 // of another well's columns cross its reach (or the slices next to it) its own slices there are split

@@ -361,6 +361,18 @@ TEST(CornerPointSweep, CiThreeWellCaseMeshesSoundly) {
   std::printf("[ cp sweep ] %s: %s %s (%.1f s)\n", c.label.c_str(), outcome_name(r.outcome), r.reason.c_str(), r.seconds);
 }
 
+// Horizontal seed 2: a fault's steps split layers near the well into children 0.43 m thick, on pillars
+// leaning 6 degrees. With columns sized by the layers alone (3.2 m) the next layer's corner on a leaning
+// pillar lay in the diametral sphere of 154 wall triangles (stage transition, exit 1, sessions 28-36);
+// the columns there are now narrowed for the lean (kLeanSphereMargin; docs/corner-point.md, "Thin
+// layers on leaning pillars"). Without the optimiser, whose moves do not bear on it: about 11 s.
+TEST(CornerPointSweep, CiHorizontalSeed2ThinStepChildrenOnLeaningPillarsMesh) {
+  const CornerPointSweepCase c = make_horizontal_case(2);
+  const CaseResult r = mesh_corner_point_case(c, false);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << c.label << ": " << r.reason;
+  std::printf("[ cp sweep ] %s: %s %s (%.1f s)\n", c.label.c_str(), outcome_name(r.outcome), r.reason.c_str(), r.seconds);
+}
+
 // A horizontal producer from a survey in a model at UTM coordinates (per-cell rock, kv/kh from the
 // generator) meshes soundly (the self-check runs), and the same model with its frame at (0, 0) meshes to
 // the same cells and faces, with the same volumes to round-off: the result does not depend on where the
