@@ -37,6 +37,18 @@ TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& g
   return q;
 }
 
+Stats transition_orthogonality_in_mesh(const PolyMesh& mesh, const MeshGeometry& geo) {
+  std::vector<double> q_o(mesh.n_cells(), 90.0);
+  std::vector<bool> is_transition(mesh.n_cells());
+  for (int c = 0; c < mesh.n_cells(); ++c) {
+    is_transition[c] = mesh.cell_region[c] == kTransition;
+    if (!is_transition[c]) continue;
+    for (const int32_t* f = mesh.cell_begin(c); f != mesh.cell_end(c); ++f)
+      q_o[c] = std::min(q_o[c], face_orthogonality_of(mesh, geo, *f, boundary_flux_point(mesh, geo, *f)));
+  }
+  return stats_of(q_o, is_transition);
+}
+
 namespace {
 
 Stats merged(const Stats& a, const Stats& b) {

@@ -48,6 +48,11 @@ struct TransitionQuality {
 TransitionQuality transition_quality(const PolyMesh& mesh, const MeshGeometry& geo, const std::vector<double>& h_ref);
 /// Adds the figures of disjoint sets of transition cells (other cavities) into `total`.
 void add_quality(TransitionQuality& total, const TransitionQuality& q);
+/// Q_O(V) over the transition cells of the assembled mesh, as fvcheck and the self-check measure it:
+/// each face toward its neighbour's FV centre (a boundary face toward its flux point). Unlike
+/// transition_quality on a cavity's own submesh, whose constrained polygons are boundary faces
+/// measured to their centroid (the paper's Table 2), this is the orthogonality the fluxes get.
+Stats transition_orthogonality_in_mesh(const PolyMesh& mesh, const MeshGeometry& geo);
 
 struct HybridMesh {
   PolyMesh mesh;
@@ -65,6 +70,7 @@ struct HybridMesh {
   /// their own (transition_submesh: the cavity polygons are boundary faces).
   TransitionQuality transition_before;
   TransitionQuality transition_after;   ///< after optimisation (when optimized)
+  Stats transition_q_o_in_mesh;         ///< transition_orthogonality_in_mesh of the finished mesh
   bool optimized = false;
   SiteOptimizeReport optimize_report;   ///< summed over the cavities (rounds: the largest)
   int transition_builds = 0;         ///< transition meshes built, all cavities and rounds (refused ones too)

@@ -71,6 +71,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
   if (!h.transition_reports.empty()) {
     nlohmann::json t;
     t["before"] = to_json(h.transition_before);
+    t["in_mesh"] = {{"Q_O", stats_json(h.transition_q_o_in_mesh)}};
     if (h.optimized) {
       t["after"] = to_json(h.transition_after);
       double transition_s = 0, optimize_s = 0;

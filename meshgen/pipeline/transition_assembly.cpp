@@ -103,6 +103,7 @@ void summarize_transitions(HybridMesh& out, const std::vector<TransitionCells>& 
     a.rounds = std::max(a.rounds, o.rounds);
     a.proposed += o.proposed, a.kept += o.kept, a.refused += o.refused, a.invalid += o.invalid;
   }
+  out.transition_q_o_in_mesh = transition_orthogonality_in_mesh(out.mesh, out.geometry);
 }
 
 }  // namespace hm

@@ -43,6 +43,7 @@ void fill_cell_maps(HybridMesh& out, const TransitionCellMaps& maps);
 /// out.optimized, out.transition_before/after (each cavity's cells on their own, its polygons
 /// their boundary faces: only the transition cells are measured) and out.optimize_report (summed,
 /// rounds: the largest) from the cavities' transitions; `coords`: the cavities' node coordinates.
+/// out.transition_q_o_in_mesh from out.mesh and out.geometry (assembled before).
 void summarize_transitions(HybridMesh& out, const std::vector<TransitionCells>& transitions,
                            const std::vector<Vec3>& coords);
 

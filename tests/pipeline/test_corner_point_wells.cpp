@@ -24,6 +24,7 @@
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/cavity/cavity_corner_point.hpp"
 #include "meshgen/grids/corner_point_grid.hpp"
+#include "meshgen/core/fv_quality.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "../exporters/exporter_test_support.hpp"
 #include "corner_point_test_models.hpp"
@@ -307,6 +308,29 @@ TEST(CornerPointWells, VerticalWellInTiltedLayersMeshes) {
   EXPECT_EQ(again.mesh.face_nodes, out.mesh.face_nodes);
   EXPECT_EQ(again.mesh.cell_faces, out.mesh.cell_faces);
   EXPECT_EQ(again.mesh.nodes, out.mesh.nodes);
+}
+
+// The summary's in-mesh Q_O of the transition cells is fvcheck's measure (each face toward its
+// neighbour's FV centre, boundary faces toward their flux point), not the paper's Table 2 measure on a
+// cavity's own submesh, where a corner-point wall triangle whose circumcentre lies outside it (its
+// site's foot) is far from its centroid: there the paper's figure says nothing of the fluxes.
+TEST(CornerPointWells, TransitionOrthogonalityInTheMeshIsWhatTheFluxesSee) {
+  TempDir tmp("cpwells");
+  const TiltedModel g;
+  const CaseSpec cs = case_of(tmp, g, vertical_well(90, 90, 1034, 1046));
+  const HybridMesh out = build_hybrid_mesh(cs);
+  const std::vector<double> q_o = cell_min_of_faces(out.mesh, face_orthogonality(out.mesh, out.geometry));
+  std::vector<bool> transition(out.mesh.n_cells());
+  for (int c = 0; c < out.mesh.n_cells(); ++c) transition[c] = out.mesh.cell_region[c] == kTransition;
+  const Stats expected = stats_of(q_o, transition);
+  ASSERT_GT(expected.count, 0);
+  EXPECT_EQ(out.transition_q_o_in_mesh.count, expected.count);
+  EXPECT_DOUBLE_EQ(out.transition_q_o_in_mesh.min, expected.min);
+  EXPECT_NEAR(out.transition_q_o_in_mesh.mean, expected.mean, 1e-12 * expected.mean);
+  EXPECT_GE(out.transition_q_o_in_mesh.min, 45.0);  // the self-check's bound
+  std::printf("[ Q_O ] transition cells in the mesh: min %.2f mean %.2f deg; the paper's submesh measure: min %.4g mean "
+              "%.2f deg\n", out.transition_q_o_in_mesh.min, out.transition_q_o_in_mesh.mean,
+              out.transition_after.q_o.min, out.transition_after.q_o.mean);
 }
 
 // A deviated well across columns, with inclined, non-parallel pillars (no model face is planar).
