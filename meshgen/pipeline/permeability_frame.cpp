@@ -85,11 +85,12 @@ void check_scaled_bends(const std::vector<Vec3>& physical, const std::vector<Vec
   for (size_t k = 1; k + 1 < scaled.size(); ++k) {
     const double deg = bend_degrees(scaled[k] - scaled[k - 1], scaled[k + 1] - scaled[k]);
     if (!(deg > kMaxBlockBendDegrees * (1 + kBendLimitTolerance))) continue;
-    char text[320];
+    char text[512];
     std::snprintf(text, sizeof text,
                   ".trajectory: the bend at point %zu, %.4g degrees as given, is %.4g degrees in the permeability "
                   "frame (metric: permeability, K = %.4g, %.4g, %.4g mD), over the %.4g-degree limit of a radial "
-                  "block: smooth the bend, or mesh with metric: euclidean (docs/anisotropy.md)",
+                  "block: smooth the bend (over several block radii), give a smaller drainage_radius, or mesh with "
+                  "metric: euclidean (docs/anisotropy.md, \"Bends sharpened by the frame\")",
                   k, bend_degrees(physical[k] - physical[k - 1], physical[k + 1] - physical[k]), deg, f.k.x, f.k.y,
                   f.k.z, kMaxBlockBendDegrees);
     throw InputError(key + text);

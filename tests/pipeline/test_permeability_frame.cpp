@@ -190,6 +190,8 @@ TEST(PermeabilityFrame, BendSharpenedPastTheBlocksLimitIsRefusedWithBothAngles) 
               std::string::npos)
         << message;
     EXPECT_NE(message.find("metric: euclidean"), std::string::npos) << message;
+    EXPECT_NE(message.find("give a smaller drainage_radius"), std::string::npos) << message;
+    EXPECT_NE(message.find("(docs/anisotropy.md, \"Bends sharpened by the frame\")"), std::string::npos) << message;
   }
 }
 
