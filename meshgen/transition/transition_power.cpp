@@ -148,46 +148,74 @@ std::vector<int32_t> intersect(const std::vector<int32_t>& a, const std::vector<
 // vertex, encoded as -1 - class.
 using Token = int64_t;
 
-// A free power vertex this close to the segment between its two neighbours in a face, relative to
-// that segment's length, lies on that edge: the dual of a tetrahedron of five nearly co-spherical sites
-// (mirror images across a boundary plane make them), rounded off the edge by the vertex computation
-// (measured 8e-9 in realistic sweep seed 1521).
-constexpr double kVertexOnEdge = 1e-6;
+// Three vertices whose angle at the middle one is this close to 0 or 180 degrees (its sine, in radians)
+// lie on one line: the duals of tetrahedra of nearly co-spherical sites (mirror images across a boundary
+// plane make them), rounded off the line by the vertex computation (measured: 8e-9 m off the middle of a
+// 2 m edge in realistic sweep seed 1521, 1e-9 m along a line of five vertices 0.1-5 m apart in seed 1405).
+// An angle, not a distance: a vertex microns from one neighbour and metres from the other is a corner of
+// a sliver face, never on a line by a distance relative to the edge (seed 1256).
+constexpr double kVertexOnLine = 1e-6;
 
-// Free vertices that lie inside an edge, between the same two vertices a and b in every face holding
-// them, are dropped from those faces: a face cycle holding only a, the vertex and b has no area (two
-// cells that touch along the edge only), and a cell around the edge without the vertex would see it
-// hang on its edge. Returns the faces left with fewer than 3 vertices.
+// The sine of the angle at x between the directions to a and b is below kVertexOnLine.
+bool on_one_line(Vec3 a, Vec3 x, Vec3 b) {
+  const Vec3 u = a - x, v = b - x;
+  const double lengths = norm(u) * norm(v);
+  return lengths > 0 && norm(cross(u, v)) <= kVertexOnLine * lengths;
+}
+
+// True when every vertex of the cycle is on one line with its two neighbours: a face of no area (a
+// segment traversed back and forth), where two cells touch along an edge only.
+template <class Position>
+bool collinear_cycle(const std::vector<Token>& c, Position position) {
+  const size_t n = c.size();
+  for (size_t k = 0; k < n; ++k)
+    if (!on_one_line(position(c[(k + n - 1) % n]), position(c[k]), position(c[(k + 1) % n]))) return false;
+  return true;
+}
+
+// True when the vertex at c[k] lies on the segment between its two neighbours in c (an angle of 180
+// degrees there).
+template <class Position>
+bool inside_its_edge(const std::vector<Token>& c, size_t k, Position position) {
+  const size_t n = c.size();
+  const Token ta = c[(k + n - 1) % n], tb = c[(k + 1) % n];
+  if (ta == tb) return false;
+  const Vec3 a = position(ta), b = position(tb), x = position(c[k]);
+  return dot(a - x, b - x) < 0 && on_one_line(a, x, b);
+}
+
+// Power vertices of nearly co-circular sites fall, rounded, along one line (the circle's axis): faces
+// of no area join them, and each cell around the line holds its own subset of them, which would hang on
+// its neighbours' edges. A free vertex is dropped from every face when, in each face holding it, it lies
+// inside the edge between its neighbours or the whole face lies on a line; repeated until none is left
+// (each drop can straighten its neighbours' edges). A face of no area whose vertices all go is removed;
+// one that keeps three (the corners of a sliver face elsewhere) stays as it was. Returns the faces left
+// with fewer than 3 vertices.
 template <class Position>
 int drop_vertices_inside_edges(std::vector<std::vector<Token>>& cycles, Position position) {
-  std::map<Token, std::vector<std::pair<size_t, size_t>>> uses;  // free vertex -> (face, index)
-  for (size_t i = 0; i < cycles.size(); ++i)
-    if (cycles[i].size() >= 3)
-      for (size_t k = 0; k < cycles[i].size(); ++k)
-        if (cycles[i][k] < 0) uses[cycles[i][k]].push_back({i, k});
-  std::set<Token> dropped;
-  for (const auto& [v, at] : uses) {
-    std::pair<Token, Token> ends{0, 0};
-    bool inside = true;
-    for (size_t u = 0; u < at.size() && inside; ++u) {
-      const std::vector<Token>& c = cycles[at[u].first];
-      const size_t n = c.size(), k = at[u].second;
-      Token a = c[(k + n - 1) % n], b = c[(k + 1) % n];
-      if (a > b) std::swap(a, b);
-      if (u == 0) ends = {a, b};
-      if (a == b || std::make_pair(a, b) != ends) inside = false;
-    }
-    if (!inside) continue;
-    const Vec3 a = position(ends.first), b = position(ends.second), x = position(v);
-    const double len2 = norm2(b - a), t = dot(x - a, b - a) / len2;
-    if (!(len2 > 0 && t > 0 && t < 1)) continue;
-    if (norm(x - (a + t * (b - a))) <= kVertexOnEdge * std::sqrt(len2)) dropped.insert(v);
-  }
+  std::vector<char> collinear(cycles.size());
+  for (size_t i = 0; i < cycles.size(); ++i) collinear[i] = cycles[i].size() >= 3 && collinear_cycle(cycles[i], position);
   int degenerate = 0;
-  for (std::vector<Token>& c : cycles) {
-    if (c.size() < 3) continue;
-    c.erase(std::remove_if(c.begin(), c.end(), [&](Token t) { return dropped.count(t) > 0; }), c.end());
-    degenerate += c.size() < 3;
+  for (bool dropped_any = true; dropped_any;) {
+    dropped_any = false;
+    std::map<Token, bool> straight;  // free vertex -> inside its edge (or in a face of no area) so far
+    for (size_t i = 0; i < cycles.size(); ++i) {
+      const std::vector<Token>& c = cycles[i];
+      if (c.size() < 3) continue;
+      for (size_t k = 0; k < c.size(); ++k)
+        if (c[k] < 0) {
+          auto [it, fresh] = straight.try_emplace(c[k], true);
+          it->second = it->second && (collinear[i] || inside_its_edge(c, k, position));
+        }
+    }
+    for (std::vector<Token>& c : cycles) {
+      if (c.size() < 3) continue;
+      const size_t before = c.size();
+      c.erase(std::remove_if(c.begin(), c.end(), [&](Token t) { return t < 0 && straight.at(t); }), c.end());
+      if (c.size() == before) continue;
+      dropped_any = true;
+      degenerate += c.size() < 3;
+    }
   }
   return degenerate;
 }
