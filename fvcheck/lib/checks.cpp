@@ -715,7 +715,7 @@ CheckResult check_orthogonality(const PolyMesh& m, const MeshGeometry& geo, cons
   r.id_kind = IdKind::Face;
   const bool k_metric = !(m.metric_scale == Vec3{1, 1, 1});
   if (k_metric) {
-    r.values = face_k_nonorthogonality(m, geo);
+    r.values = face_frame_nonorthogonality(m, geo);
     for (double& v : r.values) v = 90.0 - v;
   } else {
     r.values = face_orthogonality(m, geo);

@@ -91,7 +91,9 @@ CheckResult check_volume(const PolyMesh& mesh, const MeshGeometry& geo, const Ch
 /// Dual orthogonality per face (paper eq. 8, FV centres; boundary faces use the FV centre
 /// and the face centroid). values[f] = Q_O(F) in degrees; violation when < min_orthogonality_deg.
 /// worst = min Q_O. A mesh built in a permeability frame (metric_scale != 1, docs/anisotropy.md)
-/// is measured in the K metric: values[f] = 90 - face_k_nonorthogonality (measure k_metric = 1).
+/// is measured in the metric of the K it was built for: values[f] = 90 -
+/// face_frame_nonorthogonality (measure k_metric = 1); each cell's own K, where its anisotropy
+/// differs, is the report's K-non-orthogonality (face_k_nonorthogonality).
 CheckResult check_orthogonality(const PolyMesh& mesh, const MeshGeometry& geo, const CheckOptions& opt = {});
 
 /// Auto-centering: the FV centre lies strictly on the inner side of every face plane.

@@ -51,7 +51,8 @@ struct FvReport {
   std::vector<double> k_angle_interior_cell;  ///< the same over interior faces only
   Stats k_angle_all, k_angle_interior_all;
   /// The mesh was built in a permeability frame (metric_scale != 1): the orthogonality check
-  /// measures Q_O in the K metric (90 - K-non-orthogonality); q_o_* stay Euclidean.
+  /// measures Q_O in the metric of the frame's K (90 - face_frame_nonorthogonality); q_o_* stay
+  /// Euclidean, k_angle_* use each cell's own K.
   bool k_metric = false;
   std::vector<int32_t> cell_region;          ///< copy of the mesh's regions (histograms per region)
   Stats q_s_all, q_o_all, q_p_all;           ///< over all cells

@@ -182,13 +182,17 @@ std::vector<double> face_orthogonality(const PolyMesh& m, const MeshGeometry& ge
   return q;
 }
 
-std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometry& geo) {
+namespace {
+
+// The K-non-orthogonality of every face with sqrt(K) of cell c = root_k(c) (a factor on it changes
+// nothing).
+template <class RootK>
+std::vector<double> nonorthogonality_in(const PolyMesh& m, const MeshGeometry& geo, RootK root_k) {
   std::vector<double> q(m.n_faces(), 0.0);
   // In the cell's K^-1/2-scaled coordinates (K isotropic there): n_s = K^1/2 n, d_s = K^-1/2 d,
   // n_s . d_s = n . d; atan2 stays accurate near 0.
   auto angle = [&](int c, Vec3 area, Vec3 d) {
-    const Vec3 k = m.cell_perm[c];
-    const Vec3 r{std::sqrt(k.x), std::sqrt(k.y), std::sqrt(k.z)};
+    const Vec3 r = root_k(c);
     const Vec3 ns{r.x * area.x, r.y * area.y, r.z * area.z}, ds{d.x / r.x, d.y / r.y, d.z / r.z};
     return std::atan2(norm(cross(ds, ns)), std::fabs(dot(ds, ns))) * kDeg;
   };
@@ -207,6 +211,19 @@ std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometr
     }
   });
   return q;
+}
+
+}  // namespace
+
+std::vector<double> face_k_nonorthogonality(const PolyMesh& m, const MeshGeometry& geo) {
+  return nonorthogonality_in(m, geo, [&](int c) {
+    const Vec3 k = m.cell_perm[c];
+    return Vec3{std::sqrt(k.x), std::sqrt(k.y), std::sqrt(k.z)};
+  });
+}
+
+std::vector<double> face_frame_nonorthogonality(const PolyMesh& m, const MeshGeometry& geo) {
+  return nonorthogonality_in(m, geo, [&](int) { return m.metric_scale; });
 }
 
 std::vector<double> face_planarity(const PolyMesh& m, const MeshGeometry& geo) {

@@ -47,6 +47,13 @@ double face_orthogonality_of(const PolyMesh& mesh, const MeshGeometry& geo, int 
 /// degenerate face. With isotropic K it is 90 - Q_O(F).
 std::vector<double> face_k_nonorthogonality(const PolyMesh& mesh, const MeshGeometry& geo);
 
+/// The same angle with one K for every cell, the one the mesh was built orthogonal for: K ~ S^2,
+/// S = mesh.metric_scale (the permeability frame, docs/anisotropy.md). Equal to
+/// face_k_nonorthogonality where the cells' K are that K up to a factor; where the rock's anisotropy
+/// varies from cell to cell (a corner-point model's), it is what the construction guarantees and
+/// face_k_nonorthogonality is what the fluxes see.
+std::vector<double> face_frame_nonorthogonality(const PolyMesh& mesh, const MeshGeometry& geo);
+
 /// Q_P(F) in degrees for every face (eq. 10): the largest angle between the face normal and
 /// the normals of the fan triangles (G, A_i, A_{i+1}), G the mean of the face's nodes.
 /// Fan triangles of area <= 1e-12 * face area have no normal and are skipped; a face of zero

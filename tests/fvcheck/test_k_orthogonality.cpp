@@ -68,3 +68,30 @@ TEST(KOrthogonality, OrthogonalityCheckIsInTheMeshsMetric) {
   ASSERT_FALSE(kr.by_region.empty());
   EXPECT_NEAR(kr.by_region[0].k_angle_interior.max, k_angle, 1e-12);
 }
+
+// A mesh built in a permeability frame is judged in the metric of the K it was built for (the
+// frame's, metric_scale); the report's K-non-orthogonality uses each cell's own K. The same sheared
+// pair as above, the frame's K = (100, 100, 1), the second cell's rock isotropic: the frame metric
+// sees the K-orthogonal face of the first cell's K on both sides (the check passes), the cells' own K
+// see the second side at its Euclidean angle, 63 degrees (reported, not judged).
+TEST(KOrthogonality, OrthogonalityCheckJudgesTheMetricTheMeshWasBuiltFor) {
+  PolyMesh m = fvtest::box_grid(2, 1, 1);
+  for (Vec3& k : m.cell_perm) k = {100, 100, 1};
+  const double t = 2.0;
+  for (Vec3& p : m.nodes) p.x += t * p.z;
+  for (Vec3& c : m.cell_fv_center) c.x += t * c.z;
+  m.metric_scale = {std::sqrt(100 / std::cbrt(1e4)), std::sqrt(100 / std::cbrt(1e4)), std::sqrt(1 / std::cbrt(1e4))};
+  const MeshGeometry g = compute_geometry(m);
+  const int f = interior_face(m);
+  const double built_for = face_k_nonorthogonality(m, g)[f];  // every cell has the frame's K here
+  EXPECT_NEAR(face_frame_nonorthogonality(m, g)[f], built_for, 1e-9);
+  m.cell_perm[m.face_neighbour[f]] = {50, 50, 50};
+  EXPECT_NEAR(face_frame_nonorthogonality(m, g)[f], built_for, 1e-9);
+  const double own = face_k_nonorthogonality(m, g)[f];
+  EXPECT_NEAR(own, 90.0 - face_orthogonality(m, g)[f], 1e-9);
+  EXPECT_GT(own, 45.0);
+  const FvReport r = run_fvcheck(m, CheckOptions{});
+  EXPECT_TRUE(r.k_metric);
+  EXPECT_EQ(r.find("orthogonality")->violations, 0) << report_summary_text(r);
+  EXPECT_NEAR(r.k_angle_interior_all.max, own, 1e-9);
+}
