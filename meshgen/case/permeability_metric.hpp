@@ -11,7 +11,7 @@ namespace hm {
 struct PermeabilityFrame {
   Vec3 scale{1, 1, 1};  ///< diagonal of S; product 1
   Vec3 origin;          ///< fixed point of the map: the reservoir's min corner
-  Vec3 k{0, 0, 0};      ///< the K the frame is built for (geometric means, mD)
+  Vec3 k{0, 0, 0};      ///< the K the frame is built for (mD; permeability_frame says how)
   bool identity() const { return scale == Vec3{1, 1, 1}; }
 };
 
@@ -20,8 +20,10 @@ struct PermeabilityFrame {
 Vec3 frame_scale(Vec3 k);
 
 /// The case's frame: identity for `metric: euclidean` or isotropic rock; else one frame per case
-/// from the geometric mean of kx, ky, kz over the reservoir cells the wells' trajectories pass
-/// through (sampled every segment_length / 4), the whole grid when there are no wells.
+/// for K = kx (1, ky/kx, kz/kx): kx the geometric mean and the ratios the medians over the reservoir
+/// cells the wells' trajectories pass through (sampled every segment_length / 4; in a corner-point
+/// model the active cells whose centre lies within a drainage radius of a path), the whole grid when
+/// there are no wells.
 PermeabilityFrame permeability_frame(const CaseSpec& cs);
 
 Vec3 to_scaled(const PermeabilityFrame& f, Vec3 x);

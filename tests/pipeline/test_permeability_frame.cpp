@@ -46,6 +46,34 @@ TEST(PermeabilityFrame, ScaleHasUnitDeterminantAndIsExactlyOneForIsotropicRock) 
   EXPECT_FALSE(permeability_frame(cs).identity());
 }
 
+// Per-cell rock: the frame's anisotropy is the median of the cells' ratios along the wells, which a
+// few tight cells (kz/kx 1e-3, as shale streaks are) do not drag along; their geometric mean would
+// (kz/kx 0.063 here instead of 0.1). The level is the geometric mean of kx.
+TEST(PermeabilityFrame, FrameAnisotropyIsTheMedianOfTheCellsRatios) {
+  CaseSpec cs;
+  cs.metric = MeshMetric::Permeability;
+  ReservoirSpec& r = cs.reservoir;
+  r.x = r.y = {0, 10};
+  for (int k = 0; k <= 10; ++k) r.z.push_back(k);
+  for (int k = 0; k < 10; ++k) {
+    const double kx = 10.0 * (k + 1);
+    r.cell_permx.push_back(kx);
+    r.cell_permy.push_back(kx);
+    r.cell_permz.push_back((k == 3 || k == 7 ? 1e-3 : 0.1) * kx);
+    r.cell_poro.push_back(0.2);
+  }
+  WellSpec w;
+  w.trajectory = {{5, 5, 0.5}, {5, 5, 9.5}};
+  w.segment_length = 1;
+  cs.wells.push_back(w);
+  const PermeabilityFrame f = permeability_frame(cs);
+  EXPECT_NEAR(f.k.z / f.k.x, 0.1, 1e-15);
+  EXPECT_NEAR(f.k.y / f.k.x, 1.0, 1e-15);
+  double log_kx = 0;
+  for (double kx : r.cell_permx) log_kx += std::log(kx);
+  EXPECT_NEAR(f.k.x, std::exp(log_kx / 10), 1e-12 * f.k.x);
+}
+
 // Peaceman's anisotropic equivalent radius: for a vertical well with kz = sqrt(kx ky) the
 // scaled frame's cross-section is the 2D frame's, and (a + b) / 2 is his r_w'; for any kz it is
 // his r_w' times the uniform factor sqrt(k0 / sqrt(kx ky)) that the 3D frame applies to the
