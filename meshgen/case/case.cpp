@@ -877,11 +877,6 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
     else fail("metric", "expected permeability or euclidean, got " + describe(*m));
   }
   cs.reservoir = read_reservoir(f.required("reservoir"), base_dir, cs.notes);
-  // A true corner-point model is meshed in its own frame (docs/case-format.md): the frame of K
-  // would be ignored, and the mesh not K-orthogonal as asked.
-  if (cs.metric == MeshMetric::Permeability && cs.reservoir.corner_point)
-    fail("metric", "permeability is not implemented for a corner-point model (reservoir.grdecl with cells that are "
-                   "not axis-aligned boxes): its cells are meshed in the model's own frame; use metric: euclidean");
   if (auto t = f.get("transition")) cs.transition = read_transition(*t);
   if (auto fl = f.get("fluid")) cs.fluid = read_fluid(*fl);
   if (auto wells = f.get("wells"); wells && !wells->IsNull()) {

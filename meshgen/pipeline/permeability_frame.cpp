@@ -1,6 +1,7 @@
 #include "permeability_frame.hpp"
 
 #include "meshgen/case/case_limits.hpp"
+#include "meshgen/case/grdecl.hpp"
 #include "meshgen/case/meshed_trajectory.hpp"
 
 #include <algorithm>
@@ -99,6 +100,18 @@ void check_scaled_bends(const std::vector<Vec3>& physical, const std::vector<Vec
 
 }  // namespace
 
+std::shared_ptr<const CornerPointModel> scaled_corner_point_model(const CornerPointModel& m, const PermeabilityFrame& f) {
+  auto out = std::make_shared<CornerPointModel>(m);
+  for (size_t i = 0; i < out->coord.size(); ++i) {
+    const int d = static_cast<int>(i % 3);
+    out->coord[i] = f.origin[d] + (out->coord[i] - f.origin[d]) / f.scale[d];
+  }
+  for (double& z : out->zcorn) z = f.origin.z + (z - f.origin.z) / f.scale.z;
+  out->pinch.threshold /= f.scale.z;
+  out->pinch.max_empty_gap /= f.scale.z;
+  return out;
+}
+
 CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
   CaseSpec out = cs;
   if (f.identity()) return out;
@@ -106,6 +119,7 @@ CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
   for (double& v : r.x) v = f.origin.x + (v - f.origin.x) / f.scale.x;
   for (double& v : r.y) v = f.origin.y + (v - f.origin.y) / f.scale.y;
   for (double& v : r.z) v = f.origin.z + (v - f.origin.z) / f.scale.z;
+  if (r.corner_point) r.corner_point = scaled_corner_point_model(*r.corner_point, f);
   for (size_t i = 0; i < out.wells.size(); ++i) {
     WellSpec& w = out.wells[i];
     double length = 0, scaled_length = 0, radius_sum = 0, area_radius_sum = 0;
@@ -123,7 +137,9 @@ CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
     check_scaled_bends(cs.wells[i].trajectory, w.trajectory, f, "wells[" + std::to_string(i) + "]");
     w.radius = radius_sum / length;
     const double inscribed = scaled_block_radius(f.scale, w.drainage_radius);
-    w.drainage_radius = out.wells.size() == 1
+    // A corner-point model's paths were fitted to its surface with the physical block: the inscribed
+    // block lies inside it. The box's rule for the area radius knows only a box.
+    w.drainage_radius = out.wells.size() == 1 && !r.corner_point
                             ? fitted_block_radius(r, w, inscribed, area_radius_sum / length,
                                                   "wells[" + std::to_string(i) + "]")
                             : inscribed;
@@ -138,6 +154,7 @@ CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f) {
 }
 
 FrameUnmapper::FrameUnmapper(const PermeabilityFrame& f, const ReservoirSpec& phys) : frame(f), physical(&phys) {
+  if (phys.corner_point) return;  // x, y, z only divide its bounding box: no node lies on them
   const std::vector<double>* axes[3] = {&phys.x, &phys.y, &phys.z};
   for (int d = 0; d < 3; ++d)
     for (double v : *axes[d]) scaled_axis[d].push_back(frame.origin[d] + (v - frame.origin[d]) / frame.scale[d]);
@@ -148,6 +165,7 @@ Vec3 FrameUnmapper::operator()(Vec3 xs) const {
   const std::vector<double>* axes[3] = {&physical->x, &physical->y, &physical->z};
   for (int d = 0; d < 3; ++d) {
     const std::vector<double>& a = scaled_axis[d];
+    if (a.empty()) continue;
     const auto it = std::lower_bound(a.begin(), a.end(), xs[d]);
     if (it != a.end() && *it == xs[d]) x[d] = (*axes[d])[it - a.begin()];
   }

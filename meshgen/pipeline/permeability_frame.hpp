@@ -39,11 +39,20 @@ double area_block_radius(Vec3 scale, Vec3 unit_axis, double R);
 /// trajectory_md the physical measured depths (perforations keep their meaning). The
 /// rock (per cell or uniform) stays physical. Throws InputError when the scaled radius is not
 /// below the scaled drainage radius.
+/// A corner-point model is scaled with it (scaled_corner_point_model), and its wells keep the
+/// inscribed radius (their paths were fitted to the model's surface with the physical block).
 CaseSpec scaled_case(const CaseSpec& cs, const PermeabilityFrame& f);
+
+/// A corner-point model as seen in frame f: its pillars (COORD) and depths (ZCORN) mapped, and PINCH's
+/// thicknesses with the depths. A pillar point at a depth maps to the scaled pillar's point at the
+/// scaled depth (the map is affine), so the cells are the scaled cells; rock, multipliers and
+/// connections stay as they are.
+std::shared_ptr<const CornerPointModel> scaled_corner_point_model(const CornerPointModel& m, const PermeabilityFrame& f);
 
 /// Maps a position of the scaled frame back; a coordinate equal to a scaled reservoir node
 /// coordinate gets the user's coordinate of that node exactly (the reservoir's planes stay the
-/// user's planes, not x' * s off by ulps).
+/// user's planes, not x' * s off by ulps). A corner-point model's nodes are put back by
+/// build_hybrid_mesh from the model itself.
 struct FrameUnmapper {
   FrameUnmapper(const PermeabilityFrame& f, const ReservoirSpec& physical);
   Vec3 operator()(Vec3 x_scaled) const;

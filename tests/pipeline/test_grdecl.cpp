@@ -333,29 +333,26 @@ int64_t interior_faces_between_columns(const HybridMesh& out, int i0, int i1) {
 
 }  // namespace
 
-// The synthetic faulted model meshes as its own cells: one mesh cell per active cell of non-zero
-// volume, every face matched (the self-check's conformity, closure and volume checks pass: they
-// would throw), the fault faces split where the two sides' edges cross, and the total volume
-// equal to OPM's active volume.
-// metric: permeability is refused on a true corner-point model (its cells are meshed in the model's
-// frame, never the frame of K) and accepted on a model of axis-aligned boxes, which is meshed as its axes.
-TEST(CornerPoint, PermeabilityMetricIsRefusedNamingTheKey) {
+// metric: permeability is taken on a true corner-point model (meshed in the frame of K, its nodes put
+// back: CornerPointWells.PermeabilityMetricMakesTheNearWellCellsKOrthogonal) and on a model of
+// axis-aligned boxes, which is meshed as its axes.
+TEST(CornerPoint, PermeabilityMetricIsTakenOnBothKindsOfModel) {
   TempDir tmp;
   write(tmp.path / "CPG.GRDECL", SyntheticCpg{}.text());
   write(tmp.path / "BOX.GRDECL", grdecl_of_box(kX, kY, kZ, false));
-  try {
-    load_case(write(tmp.path / "cpg.yaml", "name: cpg\nmetric: permeability\nreservoir: {grdecl: CPG.GRDECL}\n"));
-    ADD_FAILURE() << "a corner-point model with metric: permeability was accepted";
-  } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("metric: permeability is not implemented for a corner-point model", 0), 0u)
-        << e.what();
-  }
+  const CaseSpec cpg = load_case(write(tmp.path / "cpg.yaml", "name: cpg\nmetric: permeability\nreservoir: {grdecl: CPG.GRDECL}\n"));
+  EXPECT_TRUE(cpg.reservoir.corner_point);
+  EXPECT_EQ(cpg.metric, MeshMetric::Permeability);
   const CaseSpec box = load_case(write(tmp.path / "box.yaml", "name: box\nmetric: permeability\nreservoir: {grdecl: "
                                                               "BOX.GRDECL}\n" + std::string(kGrdeclWell)));
   EXPECT_FALSE(box.reservoir.corner_point);
   EXPECT_EQ(box.metric, MeshMetric::Permeability);
 }
 
+// The synthetic faulted model meshes as its own cells: one mesh cell per active cell of non-zero
+// volume, every face matched (the self-check's conformity, closure and volume checks pass: they
+// would throw), the fault faces split where the two sides' edges cross, and the total volume
+// equal to OPM's active volume.
 TEST(CornerPoint, FaultedPinchedModelMeshesAsItsCells) {
   TempDir tmp;
   const SyntheticCpg g;

@@ -58,6 +58,7 @@ struct TiltedModel {
   std::string keywords;           // GRDECL text appended (multipliers, FAULTS; multiplier_keywords)
   int pinch_k = -1;               // a layer that thins from dz to 0 over 2 dx toward pinch_x and is 0 beyond
   double pinch_x = 100;
+  double kv_kh = 0;               // > 0: PERMY = PERMX and PERMZ = kv_kh PERMX in every cell (one anisotropy)
 
   double depth(int i_col, int I, int J, int k) const {
     const double x = dx * I, y = dy * J;
@@ -85,7 +86,15 @@ struct TiltedModel {
     }
     o << "/\nPERMX\n";
     for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
-    o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
+    if (kv_kh > 0) {
+      o << "/\nPERMY\n";
+      for (int c = 0; c < n; ++c) o << 50 + (c % 7) * 30 << "\n";
+      o << "/\nPERMZ\n";
+      for (int c = 0; c < n; ++c) o << kv_kh * (50 + (c % 7) * 30) << "\n";
+      o << "/\nPORO\n";
+    } else {
+      o << "/\nPERMY\n" << n << "*120 /\nPERMZ\n" << n << "*12 /\nPORO\n";
+    }
     for (int c = 0; c < n; ++c) o << 0.15 + 0.01 * (c % 5) << "\n";
     o << "/\n" << keywords;
     return o.str();
