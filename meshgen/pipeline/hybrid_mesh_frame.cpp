@@ -81,7 +81,19 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
   scaled_opts.written_origin = Vec3{};  // the scaled frame's positions are not the written ones
   scaled_opts.frame = frame;
   scaled_opts.frame_written_origin = opts.written_origin;
-  HybridMesh out = build(scaled_case(cs, frame), scaled_opts);
+  HybridMesh out;
+  try {
+    out = build(scaled_case(cs, frame), scaled_opts);
+  } catch (const MeshingError& e) {
+    // A corner-point model's layers are not split for the frame, which stretches them against the columns
+    // (docs/anisotropy.md, "Corner-point models"): the transition's refusals there say so.
+    if (!corner_point || e.stage != "transition") throw;
+    throw MeshingError(e.stage, e.wells,
+                       std::string(e.what()) + "; metric: permeability stretches the model's layers " +
+                           fmt_scale(frame.scale.x / frame.scale.z) +
+                           " times against its columns, and a corner-point model's layers are not split for it: "
+                           "metric: euclidean meshes without the stretch (docs/anisotropy.md, \"Corner-point models\")");
+  }
   const auto t0 = std::chrono::steady_clock::now();
   out.frame = frame;
   PhysicalModelNodes model_nodes;
