@@ -356,6 +356,28 @@ TEST(CornerPointSweep, CiSubsetMeshesSoundly) {
   }
 }
 
+// metric: permeability on seed 1 (149 m columns refined to 7.5 m, 4.28 m layers, per-cell kv/kh near 0.09):
+// the frame stretches the layers 3.6 times against the columns, which are not split for it, and the
+// transition is refused (walls not Delaunay admissible after 5 enlargements). The refusal is data: stage
+// transition, and the message names the stretch and metric: euclidean, with which the seed meshes
+// (CiSubsetMeshesSoundly; docs/anisotropy.md, "Corner-point models"). About 1 s.
+TEST(CornerPointSweep, LayersTheFrameStretchesAreRefusedNamingTheWayOut) {
+  const CornerPointSweepCase c = make_corner_point_case(1);
+  hmtest::TempDir tmp("cpsweep");
+  std::ofstream(tmp.path / "M.GRDECL") << c.model.text();
+  std::ofstream(tmp.path / "c.yaml") << "name: s\nmetric: permeability\nreservoir: {grdecl: M.GRDECL}\n" << c.wells;
+  const CaseSpec cs = load_case((tmp.path / "c.yaml").string());
+  try {
+    build_hybrid_mesh(cs);
+    ADD_FAILURE() << "seed 1 meshed in the permeability frame: the refusal this test pins is gone (update the docs)";
+  } catch (const MeshingError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.stage, "transition") << what;
+    EXPECT_NE(what.find("stretches the model's layers"), std::string::npos) << what;
+    EXPECT_NE(what.find("metric: euclidean meshes without the stretch"), std::string::npos) << what;
+  }
+}
+
 // Three wells in the model of seed 3 (a fault of 0.25 layer under the producer): an injector's reach
 // holds the producer's fault-step cells, so its cells are split too ("Fault steps", wells beside the
 // split cells). About 5 s.
