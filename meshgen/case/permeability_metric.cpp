@@ -76,7 +76,7 @@ PermeabilityFrame permeability_frame(const CaseSpec& cs) {
   f.k = r.permeability;
   if (cs.metric != MeshMetric::Permeability) return f;
   if (!r.cell_permx.empty()) {
-    // Geometric mean over the cells near the trajectories (each cell once).
+    // The cells near the trajectories, each once.
     std::vector<int> cells = r.corner_point ? corner_point_cells_near_paths(cs) : box_cells_on_paths(cs);
     if (cells.empty())
       for (size_t c = 0; c < r.cell_permx.size(); ++c) cells.push_back(static_cast<int>(c));
