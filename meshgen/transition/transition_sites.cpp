@@ -637,8 +637,11 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
     left = n;
     if (n == 0) {
       // Converged: hold the wall columns under boundary planes, and correct again if that moved
-      // a site (a bounded number of times; the self-check judges the mesh either way).
-      if (column_rounds++ == kMaxColumnRounds || align_wall_columns(set, cavity, coords, frames) == 0) return corrections;
+      // a site (a bounded number of times, and not after the last iteration, which could not
+      // correct it; the self-check judges the mesh either way).
+      if (column_rounds++ == kMaxColumnRounds || it == max_iterations ||
+          align_wall_columns(set, cavity, coords, frames) == 0)
+        return corrections;
       enforce_empty_spheres(set, cavity, coords, grid, frames);
       shrunk_at.resize(set.sites.size(), -1000);
       continue;
