@@ -28,6 +28,7 @@
 #include "meshgen/case/corner_point_straighten.hpp"
 #include "meshgen/case/grdecl.hpp"
 #include "meshgen/case/meshed_trajectory.hpp"
+#include "meshgen/case/permeability_metric.hpp"
 #include "meshgen/case/segment_distance.hpp"
 #include "meshgen/case/survey.hpp"
 #include "meshgen/core/polymesh.hpp"
@@ -605,6 +606,40 @@ void split_fault_steps_near_wells(CaseSpec& cs) {
   use_model(r, model);
 }
 
+// A corner-point model meshed in a permeability frame that stretches its layers against its columns:
+// the layers near the wells split so that their scaled cells there are at most
+// reservoir.near_well_layer_aspect times taller than wide, the two sides of a fault face to face
+// (frame_layer_children). The reach is the fault steps' in the frame: a scaled distance is up to
+// max(s) physical metres.
+void split_corner_point_layers_for_the_frame(CaseSpec& cs) {
+  ReservoirSpec& r = cs.reservoir;
+  if (!r.corner_point || cs.wells.empty() || cs.metric != MeshMetric::Permeability || !(r.near_well_layer_aspect > 0))
+    return;
+  const PermeabilityFrame frame = permeability_frame(cs);
+  if (frame.identity()) return;
+  const Vec3 s = frame.scale;
+  std::vector<FaultStepRequest> requests = fault_step_requests(cs);
+  for (FaultStepRequest& q : requests) q.reach *= std::max({s.x, s.y, s.z});
+  const FaultStepSplit split = frame_layer_children(*r.corner_point, requests, s, r.near_well_layer_aspect);
+  if (!split.splits()) return;
+  const double cells = double(r.corner_point->nx) * r.corner_point->ny *
+                       std::accumulate(split.children.begin(), split.children.end(), 0.0);
+  if (cells > kMaxCells)
+    fail("reservoir.near_well_layer_aspect", "splitting the layers near the wells for the permeability frame gives " +
+                                                 fmt_count(cells) + " cells > " + fmt_count(kMaxCells) +
+                                                 ": give a larger aspect, 0 (off), or metric: euclidean");
+  auto model = std::make_shared<const CornerPointModel>(layers_split_at_fault_steps(*r.corner_point, split));
+  std::ostringstream note;
+  note << "reservoir: layers near the wells split for the permeability frame (children at most "
+       << fmt6(split.child_thickness) << " m thick there: scaled, at most " << r.near_well_layer_aspect
+       << " x taller than the narrowest near-well cell is wide; reservoir.near_well_layer_aspect, faults face to face):";
+  for (size_t k = 0; k < split.children.size(); ++k)
+    if (split.children[k] > 1) note << " k" << k + 1 << " x" << split.children[k];
+  note << "; the mesh and the deck have " << model->nz << " layers instead of " << r.corner_point->nz;
+  cs.notes.push_back(note.str());
+  use_model(r, model);
+}
+
 ReservoirSpec read_reservoir(const YAML::Node& n, const std::string& base_dir, std::vector<std::string>& notes) {
   const Fields f(n, "reservoir",
                  {"x", "y", "z", "grdecl", "permeability", "porosity", "initial_pressure", "near_well_cell_size",
@@ -898,6 +933,7 @@ CaseSpec read_case(const YAML::Node& root, const std::string& base_dir) {
   split_fault_steps_near_wells(cs);
   refine_near_wells(cs);
   snap_fault_steps_near_wells(cs);
+  split_corner_point_layers_for_the_frame(cs);
   clip_paths_to_model(cs, as_given, SurfaceGapRule::SurfaceFaces, true);
   fit_blocks_to_the_surface(cs);
   check_wells(cs);

@@ -262,6 +262,107 @@ FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<
   return out;
 }
 
+namespace {
+
+// A ratio of lengths within this relative amount of an integer n gives n parts, not n + 1.
+constexpr double kPartsRounding = 1e-12;
+
+// The permeability frame's children depths inside (top, bottom) at one pillar side: the boundaries of
+// the sides offset against it (fp may be null: no fault at the pillar) and the equal parts, no thicker
+// than t, of each interval between them. A function of the interval alone, so that the two sides of a
+// fault, which share the interval, get the same depths bit for bit.
+std::vector<double> frame_depths(const FaultPillar* fp, int a, double top, double bottom, double t) {
+  std::vector<double> cuts{top};
+  if (fp && bottom > top)
+    for (double z : steps_inside(fp->boundaries, fp->offset[a], top, bottom, std::numeric_limits<size_t>::max()))
+      cuts.push_back(z);
+  cuts.push_back(bottom);
+  std::vector<double> out;
+  for (size_t g = 0; g + 1 < cuts.size(); ++g) {
+    if (g > 0) out.push_back(cuts[g]);
+    const double length = cuts[g + 1] - cuts[g];
+    const int parts = std::max(1, static_cast<int>(std::ceil(length / t * (1 - kPartsRounding))));
+    for (int c = 1; c < parts; ++c) out.push_back(cuts[g] + length * c / parts);
+  }
+  return out;
+}
+
+// The pillars whose columns are offset against each other (FaultPillar), by increasing pillar.
+std::vector<FaultPillar> fault_pillars_of(const CornerPointModel& m) {
+  const PillarColumns pc{m};
+  std::vector<FaultPillar> out;
+  FaultPillar fp;
+  for (int J = 0; J <= m.ny; ++J)
+    for (int I = 0; I <= m.nx; ++I) {
+      for (int a = 0; a < 4; ++a) fp.boundaries[a] = pc.present(I, J, a) ? column_boundaries(pc, I, J, a) : std::vector<double>{};
+      fp.offset = offset_columns(pc, I, J, fp.boundaries);
+      if (std::none_of(fp.offset.begin(), fp.offset.end(), [](const auto& row) { return row[0] || row[1] || row[2] || row[3]; }))
+        continue;
+      fp.pillar = I + (m.nx + 1) * J;
+      out.push_back(fp);
+    }
+  return out;
+}
+
+// The narrowest plan width of the near active cells of non-zero thickness, scaled: each cell's edges
+// along i and along j (top and bottom), divided by the frame's lateral scales.
+double narrowest_scaled_width(const CornerPointModel& m, const std::vector<char>& near, Vec3 scale) {
+  double width = std::numeric_limits<double>::infinity();
+  for (size_t c = 0; c < m.n_cells(); ++c) {
+    if (!near[c] || !m.actnum[c]) continue;
+    const std::array<Vec3, 8> q = cell_corners(m, c);
+    for (auto [u, v] : {std::pair{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}}) {
+      const Vec3 e = q[v] - q[u];
+      const double plan = std::hypot(e.x / scale.x, e.y / scale.y);
+      if (plan > 0) width = std::min(width, plan);
+    }
+  }
+  return width;
+}
+
+}  // namespace
+
+FaultStepSplit frame_layer_children(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells, Vec3 scale,
+                                    double aspect) {
+  FaultStepSplit out;
+  out.children.assign(m.nz, 1);
+  if (wells.empty() || !(aspect > 0)) return out;
+  out.near = cells_near(m, wells, std::vector<char>(wells.size(), 1));
+  const double width = narrowest_scaled_width(m, out.near, scale);
+  if (!std::isfinite(width)) return out;
+  out.fault_pillars = fault_pillars_of(m);
+  const int np = (m.nx + 1) * (m.ny + 1);
+  std::vector<const FaultPillar*> fault_pillar(np, nullptr);
+  for (const FaultPillar& fp : out.fault_pillars) fault_pillar[fp.pillar] = &fp;
+  const PillarColumns pc{m};
+  auto children_with = [&](double t) {
+    std::vector<int> children(m.nz, 1);
+    for (int k = 0; k < m.nz; ++k)
+      for (int J = 0; J <= m.ny; ++J)
+        for (int I = 0; I <= m.nx; ++I)
+          for (int a = 0; a < 4; ++a) {
+            if (!pc.present(I, J, a)) continue;
+            const size_t c = PillarColumns::column_i(I, a) + size_t(m.nx) * (PillarColumns::column_j(J, a) + size_t(m.ny) * k);
+            if (!out.near[c] || !m.actnum[c]) continue;
+            const auto depths = frame_depths(fault_pillar[I + (m.nx + 1) * J], a, pc.top(I, J, a, k), pc.bottom(I, J, a, k), t);
+            children[k] = std::max(children[k], 1 + static_cast<int>(depths.size()));
+          }
+    return children;
+  };
+  double t = aspect * width * scale.z, thickest = 0;
+  for (size_t c = 0; c < m.n_cells(); ++c)
+    if (out.near[c] && m.actnum[c]) {
+      const std::array<Vec3, 8> q = cell_corners(m, c);
+      for (int a = 0; a < 4; ++a) thickest = std::max(thickest, q[4 | a].z - q[a].z);
+    }
+  if (thickest <= t) return out;
+  std::vector<int> children = children_with(t);
+  while (*std::max_element(children.begin(), children.end()) > kMaxFrameChildren) children = children_with(t *= 1.25);
+  out.children = std::move(children);
+  out.child_thickness = t;
+  return out;
+}
+
 CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const FaultStepSplit& split) {
   const PillarColumns pc{m};
   const int np = (m.nx + 1) * (m.ny + 1);
@@ -298,6 +399,11 @@ CornerPointModel layers_split_at_fault_steps(const CornerPointModel& m, const Fa
           const double top = pc.top(I, J, a, k), bottom = pc.bottom(I, J, a, k);
           if (!near_cell(I, J, a)) {  // whole in the first child, the others of zero thickness at its bottom
             depth[size_t(p) * 4 + a].assign(size_t(n - 1), bottom);
+            continue;
+          }
+          if (split.child_thickness > 0) {  // the frame's split: every near side by its own intervals
+            auto& d = depth[size_t(p) * 4 + a] = frame_depths(fault_pillar[p], a, top, bottom, split.child_thickness);
+            d.resize(size_t(n - 1), bottom);
             continue;
           }
           if (!(bottom > top) || !fault_pillar[p]) continue;

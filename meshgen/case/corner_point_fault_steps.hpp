@@ -23,6 +23,9 @@ constexpr double kMinStepFraction = 0.05;
 /// first ones, from the top).
 constexpr int kMaxStepChildren = 4;
 
+/// At most this many children per layer in the permeability frame's split (frame_layer_children).
+constexpr int kMaxFrameChildren = 16;
+
 /// A step counts within this many times a well's cavity reach, (dilation + 2) drainage radii, of its
 /// path: the cavity may grow beyond its dilation (Gabriel rounds, enlargements).
 constexpr double kFaultStepReach = 1.0;
@@ -52,6 +55,10 @@ struct FaultStepSplit {
   std::vector<char> near;
   int64_t steps = 0;          ///< cell corners on a fault pillar within reach that asked for a split
   std::vector<FaultPillar> fault_pillars;  ///< every such pillar of the model, by increasing pillar
+  /// 0: the fault steps' split (fault_step_children). > 0: the permeability frame's
+  /// (frame_layer_children): near the wells each interval between a pillar side's own and its offset
+  /// sides' boundaries is split into equal children no thicker than this (m).
+  double child_thickness = 0;
   bool splits() const;
 };
 
@@ -77,12 +84,25 @@ SnappedSteps snap_thin_fault_steps(CornerPointModel& m, const std::vector<FaultS
 /// many children as the most such boundaries in one corner, plus one.
 FaultStepSplit fault_step_children(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells);
 
+/// Children for the permeability frame, which stretches the layers against the columns by s_x / s_z
+/// (docs/anisotropy.md, "Corner-point models"): the active cells within reach of the wells are split
+/// so that, scaled by `scale`, they are at most `aspect` times taller than the narrowest of them is
+/// wide. At every pillar near a well the children end at the boundaries of the columns offset against
+/// it (a fault's other side) and at its own, each interval between them in equal parts no thicker than
+/// child_thickness: the two sides of a fault get the same depths and meet face to face. A layer with
+/// fewer parts at a pillar than its children gets the rest of zero thickness at its bottom there.
+/// Children all 1 when no near cell is taller than that; child_thickness grows (by 5/4) until no layer
+/// needs more than kMaxFrameChildren.
+FaultStepSplit frame_layer_children(const CornerPointModel& m, const std::vector<FaultStepRequest>& wells, Vec3 scale,
+                                    double aspect);
+
 /// The model with layer k split into split.children[k] children. Cells near the wells (split.near):
 /// on each side of each fault pillar the children end exactly at the other side's boundaries (the same
 /// ZCORN values); elsewhere a pillar takes the fractions of the nearest pillar that has them (breadth
 /// first over the columns, so that cells sharing a pillar keep sharing their corners), equal children
-/// where none is near. The other cells keep their whole thickness in their first child, the others of
-/// zero thickness at its bottom (not meshed; the cells above and below connect as in the model as read,
+/// where none is near (the frame's split instead cuts every near pillar side by its own intervals:
+/// frame_layer_children). The other cells keep their whole thickness in their first child, the others
+/// of zero thickness at its bottom (not meshed; the cells above and below connect as in the model as read,
 /// `across_pinched_layers` counting layers as read). The parent's top and bottom stay bit for bit. Rock,
 /// ACTNUM and the x/y multipliers are the parent's in every child; MULTZ acts on the bottom of the
 /// children that end at the parent's bottom, MULTZ- on the top of the one that starts at its top.

@@ -19,7 +19,8 @@ constexpr int kMaxLayerChildren = 16;
 /// Children per layer for the case's permeability frame: a layer within reach of a well whose
 /// cells there are, in the scaled frame, taller than `reservoir.near_well_layer_aspect` x the
 /// narrowest of their scaled lateral widths is split into that many equal layers. All 1 for an
-/// identity frame (metric: euclidean, isotropic rock), a corner-point model or no wells.
+/// identity frame (metric: euclidean, isotropic rock), a corner-point model (split by load_case with
+/// frame_layer_children, meshgen/case/corner_point_fault_steps.hpp) or no wells.
 std::vector<int> near_well_layer_children(const CaseSpec& cs);
 
 /// The case with those layers split: reservoir.z gets the children's planes, per-cell rock is

@@ -85,14 +85,18 @@ HybridMesh build_hybrid_mesh(const CaseSpec& cs, const PipelineOptions& opts) {
   try {
     out = build(scaled_case(cs, frame), scaled_opts);
   } catch (const MeshingError& e) {
-    // A corner-point model's layers are not split for the frame, which stretches them against the columns
-    // (docs/anisotropy.md, "Corner-point models"): the transition's refusals there say so.
+    // The frame stretches a corner-point model's layers against its columns, split near the wells only
+    // as far as reservoir.near_well_layer_aspect asks (docs/anisotropy.md, "Corner-point models"): the
+    // transition's refusals there say so, and what meshes without the stretch.
     if (!corner_point || e.stage != "transition") throw;
+    const double aspect = cs.reservoir.near_well_layer_aspect;
+    const std::string split = aspect > 0 ? "split near the wells to cells at most " + fmt_scale(aspect) +
+                                               " times taller than wide (reservoir.near_well_layer_aspect)"
+                                         : "not split for it (reservoir.near_well_layer_aspect: 0)";
     throw MeshingError(e.stage, e.wells,
                        std::string(e.what()) + "; metric: permeability stretches the model's layers " +
-                           fmt_scale(frame.scale.x / frame.scale.z) +
-                           " times against its columns, and a corner-point model's layers are not split for it: "
-                           "metric: euclidean meshes without the stretch (docs/anisotropy.md, \"Corner-point models\")");
+                           fmt_scale(frame.scale.x / frame.scale.z) + " times against its columns, " + split +
+                           ": metric: euclidean meshes without the stretch (docs/anisotropy.md, \"Corner-point models\")");
   }
   const auto t0 = std::chrono::steady_clock::now();
   out.frame = frame;

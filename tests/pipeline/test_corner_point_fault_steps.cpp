@@ -267,3 +267,80 @@ TEST(FaultSteps, ThinStepsNearAWellAreSnappedOntoTheOtherSide) {
   CornerPointModel fractional = read_model(tmp, faulted_model());
   EXPECT_EQ(snap_thin_fault_steps(fractional, well).corners, 0);
 }
+
+// The permeability frame's split (frame_layer_children; docs/anisotropy.md, "Corner-point models"):
+// near the well every child is no thicker than the thickness the aspect asks for, at every pillar; on
+// the fault's pillars the two sides' children end at the same depths (each interval between the two
+// sides' boundaries split alike), so they meet face to face; the children tile their parents; cells
+// beyond reach stay whole. A frame that does not stretch the layers past the aspect splits nothing.
+TEST(FaultSteps, FrameChildrenMeetAcrossTheFaultAndAreNoThickerThanAsked) {
+  TempDir tmp("cpsteps_frame");
+  const CornerPointModel m = read_model(tmp, faulted_model());
+  const std::vector<FaultStepRequest> well{{{{125, 75, 1000}, {125, 75, 1012}}, 20}};
+  const Vec3 scale{1.5, 1.5, 1 / 2.25};  // kv/kh 0.088: layers 3.4 times taller against the columns
+  // 30 m columns, scaled 20 m wide; aspect 0.1: children at most 2 x 0.444 = 0.889 m thick (2 m layers,
+  // a 0.8 m throw: 0.8 + 2 x 0.6 at the fault's pillars, 3 x 0.667 elsewhere).
+  const FaultStepSplit split = frame_layer_children(m, well, scale, 0.1);
+  ASSERT_TRUE(split.splits());
+  EXPECT_NEAR(split.child_thickness, 0.1 * 20 * scale.z, 1e-5);  // the columns' plan edges: 30 m and a little
+  for (int k = 0; k < m.nz; ++k) EXPECT_EQ(split.children[k], 3) << "layer " << k;
+  EXPECT_FALSE(frame_layer_children(m, well, scale, 1.5).splits());  // 20 m scaled wide, 4.5 m tall
+  const CornerPointModel r = layers_split_at_fault_steps(m, split);
+  ASSERT_EQ(r.nz, 3 * m.nz);
+  check_corner_point_geometry(r, "frame split");
+
+  int64_t faults = 0;
+  const std::vector<double> parent_volume = cell_volumes(m, &faults), child_volume = cell_volumes(r, &faults);
+  std::vector<double> sum(parent_volume.size(), 0.0);
+  for (size_t c = 0; c < r.n_cells(); ++c) sum[r.parent_cell[c]] += child_volume[c];
+  int near = 0, far = 0;
+  for (size_t p = 0; p < parent_volume.size(); ++p) {
+    EXPECT_NEAR(sum[p] / parent_volume[p], 1.0, 1e-12) << "model cell " << p;
+    (split.near[p] ? near : far)++;
+  }
+  EXPECT_GT(near, 0);
+  EXPECT_GT(far, 0);
+  for (size_t c = 0; c < r.n_cells(); ++c) {
+    const size_t p = static_cast<size_t>(r.parent_cell[c]);
+    if (!split.near[p]) {
+      const bool first = c / (size_t(r.nx) * r.ny) == size_t(3 * (p / (size_t(m.nx) * m.ny)));
+      EXPECT_NEAR(child_volume[c], first ? parent_volume[p] : 0.0, 1e-12 * parent_volume[p]) << "cell " << c;
+      continue;
+    }
+    for (int q = 0; q < 4; ++q) {
+      const double thick = corner(r, c, q + 4).z - corner(r, c, q).z;
+      EXPECT_GE(thick, 0) << "cell " << c;
+      EXPECT_LE(thick, split.child_thickness * (1 + 1e-12)) << "cell " << c << " corner " << q;
+    }
+  }
+  // On the fault's pillars (line i = 4), near the well: every child depth of one side within the range
+  // both sides span is a depth of the other side.
+  int pillars = 0;
+  for (int J = 0; J <= m.ny; ++J)
+    for (int j : {J - 1, J}) {
+      if (j < 0 || j >= m.ny) continue;
+      auto near_depths = [&](int i) {
+        std::set<double> out;
+        const int q = (4 > i ? 1 : 0) | (J > j ? 2 : 0);
+        for (int k = 0; k < r.nz; ++k) {
+          const size_t c = i + size_t(r.nx) * (j + size_t(r.ny) * k);
+          if (!split.near[static_cast<size_t>(r.parent_cell[c])]) continue;
+          out.insert(r.zcorn[zcorn_index(r, i, j, k, q)]), out.insert(r.zcorn[zcorn_index(r, i, j, k, 4 | q)]);
+        }
+        return out;
+      };
+      const std::set<double> left = near_depths(3), right = near_depths(4);
+      if (left.empty() || right.empty()) continue;
+      ++pillars;
+      const double lo = std::max(*left.begin(), *right.begin()), hi = std::min(*left.rbegin(), *right.rbegin());
+      int matched = 0;
+      for (const std::set<double>* side : {&left, &right})
+        for (double z : *side)
+          if (z >= lo && z <= hi) {
+            EXPECT_TRUE(left.count(z) && right.count(z)) << "pillar (4, " << J << ") depth " << z;
+            ++matched;
+          }
+      EXPECT_GT(matched, 10);
+    }
+  EXPECT_GT(pillars, 0);
+}

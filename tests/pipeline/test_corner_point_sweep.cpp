@@ -241,13 +241,17 @@ CornerPointSweepCase make_horizontal_case(uint32_t seed, int wells = 1, bool at_
 }
 
 // The case as meshgen reads it (files in a temporary folder). HM_CP_SWEEP_METRIC=permeability: meshed
-// in the frame of K (docs/anisotropy.md, "Corner-point models").
+// in the frame of K (docs/anisotropy.md, "Corner-point models"); HM_CP_SWEEP_LAYER_ASPECT=A: the case's
+// reservoir.near_well_layer_aspect.
 CaseSpec load_sweep_case(const CornerPointSweepCase& c) {
   hmtest::TempDir tmp("cpsweep");
   std::ofstream(tmp.path / "M.GRDECL") << c.model.text();
   const char* metric = std::getenv("HM_CP_SWEEP_METRIC");
+  const char* aspect = std::getenv("HM_CP_SWEEP_LAYER_ASPECT");
   std::ofstream(tmp.path / "c.yaml") << "name: s\n" << (metric ? "metric: " + std::string(metric) + "\n" : "")
-                                     << "reservoir: {grdecl: M.GRDECL}\n" << c.wells;
+                                     << "reservoir: {grdecl: M.GRDECL"
+                                     << (aspect ? ", near_well_layer_aspect: " + std::string(aspect) : "") << "}\n"
+                                     << c.wells;
   return load_case((tmp.path / "c.yaml").string());
 }
 
@@ -357,19 +361,32 @@ TEST(CornerPointSweep, CiSubsetMeshesSoundly) {
 }
 
 // metric: permeability on seed 1 (149 m columns refined to 7.5 m, 4.28 m layers, per-cell kv/kh near 0.09):
-// the frame stretches the layers 3.6 times against the columns, which are not split for it, and the
-// transition is refused (walls not Delaunay admissible after 5 enlargements). The refusal is data: stage
-// transition, and the message names the stretch and metric: euclidean, with which the seed meshes
-// (CiSubsetMeshesSoundly; docs/anisotropy.md, "Corner-point models"). About 1 s.
-TEST(CornerPointSweep, LayersTheFrameStretchesAreRefusedNamingTheWayOut) {
+// the frame stretches the layers 3.6 times against the columns. Split near the well for the frame
+// (frame_layer_children, the default reservoir.near_well_layer_aspect 1.5) the seed meshes, the self-check
+// passing; with the split off (aspect 0) the transition is refused (walls not Delaunay admissible after 5
+// enlargements), and the refusal is data: stage transition, the message naming the stretch and
+// metric: euclidean, with which the seed meshes (CiSubsetMeshesSoundly; docs/anisotropy.md,
+// "Corner-point models"). About 2 s.
+TEST(CornerPointSweep, LayersTheFrameStretchesAreSplitForIt) {
   const CornerPointSweepCase c = make_corner_point_case(1);
   hmtest::TempDir tmp("cpsweep");
   std::ofstream(tmp.path / "M.GRDECL") << c.model.text();
-  std::ofstream(tmp.path / "c.yaml") << "name: s\nmetric: permeability\nreservoir: {grdecl: M.GRDECL}\n" << c.wells;
-  const CaseSpec cs = load_case((tmp.path / "c.yaml").string());
+  auto load = [&](const std::string& aspect) {
+    std::ofstream(tmp.path / "c.yaml") << "name: s\nmetric: permeability\nreservoir: {grdecl: M.GRDECL" << aspect << "}\n"
+                                       << c.wells;
+    return load_case((tmp.path / "c.yaml").string());
+  };
+  const CaseSpec split = load(""), whole = load(", near_well_layer_aspect: 0");
+  ASSERT_TRUE(split.reservoir.corner_point && whole.reservoir.corner_point);
+  EXPECT_GT(split.reservoir.corner_point->nz, whole.reservoir.corner_point->nz);
+  EXPECT_TRUE(std::any_of(split.notes.begin(), split.notes.end(), [](const std::string& n) {
+    return n.find("layers near the wells split for the permeability frame") != std::string::npos;
+  }));
+  const HybridMesh mesh = build_hybrid_mesh(split);  // throws MeshingError if a check fails
+  EXPECT_GT(mesh.transition_after.cells, 0);
   try {
-    build_hybrid_mesh(cs);
-    ADD_FAILURE() << "seed 1 meshed in the permeability frame: the refusal this test pins is gone (update the docs)";
+    build_hybrid_mesh(whole);
+    ADD_FAILURE() << "seed 1 meshed in the frame without the split: the refusal this test pins is gone (update the docs)";
   } catch (const MeshingError& e) {
     const std::string what = e.what();
     EXPECT_EQ(e.stage, "transition") << what;
@@ -442,7 +459,8 @@ TEST(CornerPointSweep, CiHorizontalSurveyWellMeshesWhereverTheModelSits) {
 // HM_LONG_TESTS=1: every seed in a forked child; no crash, hang or mesh failing a check; the table.
 // HM_CP_SWEEP_CASES seeds (30) from HM_CP_SWEEP_FIRST (1), HM_CP_SWEEP_WELLS wells (1; 2: the
 // producer and an injector beside it; 3: and a second injector across the producer from the first),
-// HM_CP_SWEEP_LIMIT_S seconds per case (900), HM_CP_SWEEP_METRIC the case's metric (none: euclidean). Run it alone (--gtest_filter=...SweepTable):
+// HM_CP_SWEEP_LIMIT_S seconds per case (900), HM_CP_SWEEP_METRIC the case's metric (none: euclidean), HM_CP_SWEEP_LAYER_ASPECT its
+// reservoir.near_well_layer_aspect. Run it alone (--gtest_filter=...SweepTable):
 // after a test that meshed in this process the thread pool exists, and a forked child can hang on it.
 // Seed 6 of the horizontal sweep with two wells: 4.0M model cells after the near-well refinement and
 // one merged cavity of 148,814 transition cells, whose raw diagram has two cells failing convexity
