@@ -47,10 +47,10 @@ std::vector<double> cell_volumes(const CornerPointModel& m, int64_t* fault_faces
   return hmtest::model_cell_volumes(m);
 }
 
-// The split model r of m (every layer split into the same number of children): the children's volumes
+// The split model r of m: the children's volumes
 // sum to their parent's, there are cells near the well and beyond it, and beyond it a cell is whole in
 // its first child, the others of zero thickness (not meshed).
-void expect_children_tile_their_parents(const CornerPointModel& m, const CornerPointModel& r, const FaultStepSplit& split,
+void expect_children_tile_their_parents(const CornerPointModel& r, const FaultStepSplit& split,
                                         const std::vector<double>& parent_volume, const std::vector<double>& child_volume) {
   std::vector<double> sum(parent_volume.size(), 0.0);
   for (size_t c = 0; c < r.n_cells(); ++c) sum[r.parent_cell[c]] += child_volume[c];
@@ -61,11 +61,11 @@ void expect_children_tile_their_parents(const CornerPointModel& m, const CornerP
   }
   EXPECT_GT(near, 0);
   EXPECT_GT(far, 0);
-  const size_t children = static_cast<size_t>(r.nz / m.nz);
   for (size_t c = 0; c < r.n_cells(); ++c) {
     const size_t p = static_cast<size_t>(r.parent_cell[c]);
     if (split.near[p]) continue;
-    const bool first = c / (size_t(r.nx) * r.ny) == children * (p / (size_t(m.nx) * m.ny));
+    const size_t k = c / (size_t(r.nx) * r.ny);
+    const bool first = k == 0 || r.parent_layer[k - 1] != r.parent_layer[k];
     EXPECT_NEAR(child_volume[c], first ? parent_volume[p] : 0.0, 1e-12 * parent_volume[p]) << "cell " << c;
   }
 }
@@ -195,7 +195,7 @@ TEST(FaultSteps, ChildrenTileTheirParentsAndMeetAcrossTheFault) {
   EXPECT_GT(faults_before, 0);
   std::printf("[ figures  ] fault faces: %lld before, %lld after (between cells near the well and the others)\n",
               static_cast<long long>(faults_before), static_cast<long long>(faults_after));
-  expect_children_tile_their_parents(m, r, split, parent_volume, child_volume);
+  expect_children_tile_their_parents(r, split, parent_volume, child_volume);
 
   // On the fault's pillars (line i = 4), between cells near the well: every child depth of one side is a
   // depth of the other side, within the range both sides span.
@@ -287,39 +287,51 @@ TEST(FaultSteps, ThinStepsNearAWellAreSnappedOntoTheOtherSide) {
   EXPECT_EQ(snap_thin_fault_steps(fractional, well).corners, 0);
 }
 
-// The permeability frame's split (frame_layer_children; docs/anisotropy.md, "Corner-point models"):
-// near the well every child is no thicker than the thickness the aspect asks for, at every pillar; on
-// the fault's pillars the two sides' children end at the same depths (each interval between the two
-// sides' boundaries split alike), so they meet face to face; the children tile their parents; cells
-// beyond reach stay whole. A frame that does not stretch the layers past the aspect splits nothing.
+// The permeability frame's split of `m` near `well` with this aspect, checked: the children tile their
+// parents; near the well every child is no thicker than the split asks for; on the fault's pillars
+// (line I = 4) every child depth of one side within the range both sides span is a depth of the other.
+// Returns the children per layer.
+std::vector<int> expect_frame_split_meets_across_the_fault(const CornerPointModel& m,
+                                                           const std::vector<FaultStepRequest>& well, Vec3 scale,
+                                                           double aspect) {
+  const FaultStepSplit split = frame_layer_children(m, well, scale, aspect);
+  EXPECT_TRUE(split.splits());
+  EXPECT_NEAR(split.child_thickness, aspect * 20 * scale.z, 1e-5);  // the columns' plan edges: 30 m and a little
+  const CornerPointModel r = layers_split_at_fault_steps(m, split);
+  check_corner_point_geometry(r, "frame split");
+  int64_t faults = 0;
+  const std::vector<double> parent_volume = cell_volumes(m, &faults), child_volume = cell_volumes(r, &faults);
+  expect_children_tile_their_parents(r, split, parent_volume, child_volume);
+  for (size_t c = 0; c < r.n_cells(); ++c) {
+    const size_t p = static_cast<size_t>(r.parent_cell[c]);
+    if (!split.near[p]) continue;
+    for (int q = 0; q < 4; ++q) {
+      const double thick = corner(r, c, q + 4).z - corner(r, c, q).z;
+      EXPECT_GE(thick, 0) << "cell " << c << " corner " << q;
+      EXPECT_LE(thick, split.child_thickness * (1 + 1e-12)) << "cell " << c << " corner " << q;
+    }
+  }
+  EXPECT_GT(expect_near_depths_match_across_the_fault(m, r, split, 10), 0);
+  return split.children;
+}
+
+// The permeability frame's split (frame_layer_children; docs/anisotropy.md, "Corner-point models") of
+// 2 m layers with a 0.8 m throw, beside a well; cells beyond reach stay whole. Children at most 0.889 m:
+// 0.8 + 2 x 0.6 at the fault's pillars, 3 x 0.667 elsewhere. At most 1 m: 1 + 2 parts at the fault's
+// pillars, 2 elsewhere and a third of zero thickness. A growth fault (2.5 m layers beyond it, 2 m before)
+// gives the layers different counts of children (3 to 4) and each side at the fault its own intervals:
+// still face to face. A frame that does not stretch the layers past the aspect splits nothing.
 TEST(FaultSteps, FrameChildrenMeetAcrossTheFaultAndAreNoThickerThanAsked) {
   TempDir tmp("cpsteps_frame");
   const CornerPointModel m = read_model(tmp, faulted_model());
   const std::vector<FaultStepRequest> well{{{{125, 75, 1000}, {125, 75, 1012}}, 20}};
   const Vec3 scale{1.5, 1.5, 1 / 2.25};  // kv/kh 0.088: layers 3.4 times taller against the columns
-  // 30 m columns, scaled 20 m wide; aspect 0.1: children at most 2 x 0.444 = 0.889 m thick (2 m layers,
-  // a 0.8 m throw: 0.8 + 2 x 0.6 at the fault's pillars, 3 x 0.667 elsewhere).
-  const FaultStepSplit split = frame_layer_children(m, well, scale, 0.1);
-  ASSERT_TRUE(split.splits());
-  EXPECT_NEAR(split.child_thickness, 0.1 * 20 * scale.z, 1e-5);  // the columns' plan edges: 30 m and a little
-  for (int k = 0; k < m.nz; ++k) EXPECT_EQ(split.children[k], 3) << "layer " << k;
+  // 30 m columns, scaled 20 m wide: children at most aspect x 20 x 0.444 m thick.
+  EXPECT_EQ(expect_frame_split_meets_across_the_fault(m, well, scale, 0.1), std::vector<int>(size_t(m.nz), 3));
+  EXPECT_EQ(expect_frame_split_meets_across_the_fault(m, well, scale, 1 / (20 * scale.z)), std::vector<int>(size_t(m.nz), 3));
+  hmtest::LayeredModel growth = faulted_model();
+  growth.dz_beyond_fault = 2.5;
+  const CornerPointModel g = read_model(tmp, growth);
+  EXPECT_EQ(expect_frame_split_meets_across_the_fault(g, well, scale, 1 / (20 * scale.z)), (std::vector<int>{4, 3, 4, 3, 4, 3}));
   EXPECT_FALSE(frame_layer_children(m, well, scale, 1.5).splits());  // 20 m scaled wide, 4.5 m tall
-  const CornerPointModel r = layers_split_at_fault_steps(m, split);
-  ASSERT_EQ(r.nz, 3 * m.nz);
-  check_corner_point_geometry(r, "frame split");
-
-  int64_t faults = 0;
-  const std::vector<double> parent_volume = cell_volumes(m, &faults), child_volume = cell_volumes(r, &faults);
-  expect_children_tile_their_parents(m, r, split, parent_volume, child_volume);
-  for (size_t c = 0; c < r.n_cells(); ++c) {
-    if (!split.near[static_cast<size_t>(r.parent_cell[c])]) continue;
-    for (int q = 0; q < 4; ++q) {
-      const double thick = corner(r, c, q + 4).z - corner(r, c, q).z;
-      EXPECT_GE(thick, 0) << "cell " << c;
-      EXPECT_LE(thick, split.child_thickness * (1 + 1e-12)) << "cell " << c << " corner " << q;
-    }
-  }
-  // On the fault's pillars (line i = 4), near the well: every child depth of one side within the range
-  // both sides span is a depth of the other side.
-  EXPECT_GT(expect_near_depths_match_across_the_fault(m, r, split, 10), 0);
 }

@@ -192,6 +192,7 @@ struct LayeredModel {
   int nx = 7, ny = 7, nz = 40, fault_i = -1;
   double dx = 100, dy = 100, dz = 3, dip_deg = 5, pillar_deg = 0, pillar_azimuth_deg = 0, throw_m = 0;
   double x_origin = 0, y_origin = 0, map_turn_deg = 0, kv_kh = 0.1;
+  double dz_beyond_fault = 0;  ///< > 0: the layers' thickness in the columns beyond the fault (a growth fault)
   bool map_axes = false, rock = false;
   unsigned rock_seed = 1;
 
@@ -210,7 +211,8 @@ struct LayeredModel {
   }
 
   double depth(int i_col, int I, int J, int k) const {
-    double z = 1000 + dz * k + std::tan(dip_deg * M_PI / 180) * dx * I + 0.01 * dy * J;
+    const double thickness = fault_i > 0 && i_col >= fault_i && dz_beyond_fault > 0 ? dz_beyond_fault : dz;
+    double z = 1000 + thickness * k + std::tan(dip_deg * M_PI / 180) * dx * I + 0.01 * dy * J;
     if (fault_i > 0 && i_col >= fault_i) z += throw_m;
     return z;
   }
