@@ -245,7 +245,7 @@ std::vector<double> face_planarity(const PolyMesh& m, const MeshGeometry& geo) {
       for (int i = 0; i < k; ++i) {
         const Vec3 t = cross(m.nodes[v[i]] - g, m.nodes[v[(i + 1) % k]] - g);  // 2 * triangle area vector
         const double ta = norm(t);
-        if (!(ta > 2e-12 * a)) continue;
+        if (!(ta > 2 * kPlanarityNegligibleArea * a)) continue;
         worst = std::max(worst, std::acos(clamp_unit(std::fabs(dot(n, t)) / ta)) * kDeg);
       }
       q[f] = worst;

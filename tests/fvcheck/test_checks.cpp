@@ -472,6 +472,42 @@ TEST(Planarity, ExactValueOfALiftedCorner) {
   EXPECT_EQ(check_planarity(flat, compute_geometry(flat)).worst, 0.0);
 }
 
+// A unit cube whose corner (1, 0, 1) has a second node 7e-7 from it along the top edge, `lift` above the
+// top face's plane, in the top face and the side face y = 0 (near-coincident power vertices of nearly
+// co-spherical sites, each computed to ~1e-7 m: realistic sweep seed 2781). The fan triangle between
+// the two carries 2.5e-7 of the face's area and its normal is rounding (kPlanarityNegligibleArea): not
+// judged, so a lift of 3e-7 leaves the faces planar (31 degrees when it was judged); a lift of 0.1 tilts
+// the node's larger fan triangles, and planarity fails.
+PolyMesh cube_with_micro_edge(double lift) {
+  std::vector<Vec3> pts;
+  for (int c = 0; c < 8; ++c) pts.push_back({double(c & 1), double((c >> 1) & 1), double((c >> 2) & 1)});
+  pts.push_back({1 - 7e-7, 0, 1 + lift});
+  const int32_t n[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  std::vector<std::vector<int32_t>> faces;
+  for (const CellFace& f : box_faces(n)) {
+    std::vector<int32_t> v = f.nodes;
+    for (size_t i = 0; i < v.size(); ++i) {
+      const int32_t a = v[i], b = v[(i + 1) % v.size()];
+      if ((a == 5 && b == 4) || (a == 4 && b == 5)) {
+        v.insert(v.begin() + static_cast<long>(i + 1), 8);
+        break;
+      }
+    }
+    faces.push_back(v);
+  }
+  return single_cell(pts, faces, {0.5, 0.5, 0.5});
+}
+
+TEST(Planarity, FanTrianglesOfNegligibleAreaAreNotJudged) {
+  const PolyMesh rounding = cube_with_micro_edge(3e-7), lifted = cube_with_micro_edge(0.1);
+  const std::vector<double> q = face_planarity(rounding, compute_geometry(rounding));
+  EXPECT_LT(*std::max_element(q.begin(), q.end()), 1e-4);
+  EXPECT_TRUE(check_planarity(rounding, compute_geometry(rounding)).ok());
+  const CheckResult r = check_planarity(lifted, compute_geometry(lifted));
+  EXPECT_FALSE(r.ok());
+  EXPECT_GT(r.worst, 15.0);
+}
+
 // ---------------------------------------------------------------- shape quality
 TEST(ShapeQuality, ExactValuesOnABox) {
   MeshBuilder b;
