@@ -55,11 +55,9 @@ std::vector<double> face_k_nonorthogonality(const PolyMesh& mesh, const MeshGeom
 std::vector<double> face_frame_nonorthogonality(const PolyMesh& mesh, const MeshGeometry& geo);
 
 /// A fan triangle of Q_P with at most this fraction of its face's area is not judged: it carries
-/// nothing of the face's area vector, and its normal is set by rounding (the two ends of a
-/// micro-edge, near-coincident power vertices of nearly co-spherical sites, computed each to
-/// ~1e-7 m: realistic sweep seed 2781 at kv/kh 0.1, a fan triangle of 5e-8 of its face tilted 29
-/// degrees in a face planar to 4e-8 of its size). A vertex off the face's plane makes its other,
-/// larger fan triangles lean: they are judged.
+/// nothing of the face's area vector, and its normal is set by rounding (a micro-edge between
+/// near-coincident power vertices; docs/robustness.md, "Micro-edges judged for planarity"). A vertex
+/// off the face's plane still tilts its other, larger fan triangles, which are judged.
 constexpr double kPlanarityNegligibleArea = 1e-6;
 
 /// Q_P(F) in degrees for every face (eq. 10): the largest angle between the face normal and
