@@ -403,6 +403,22 @@ class SiteOptimizer {
   static std::array<int, 4> key_of(const TransitionCells& t, int32_t v) {
     return v >= t.base_node_id ? t.new_node_sites[v - t.base_node_id] : std::array<int, 4>{-1, -1, -1, v};
   }
+  // The site that moves when site s does: a polygon's internal site for its mirror.
+  int mover_of(int s) const {
+    const Site& site = set_.sites[s];
+    if (site.kind == SiteKind::ExternalMirror && site.polygon >= 0) return set_.internal_of[site.polygon];
+    return s;
+  }
+  // The movable sites of a removal's two power spheres (its tag's two quadruples).
+  std::vector<int> sphere_movers(const std::array<int, 9>& tag) const {
+    std::vector<int> out;
+    const int ns = static_cast<int>(set_.sites.size());
+    for (int k = 0; k < 8; ++k) {
+      const bool constrained_node = tag[k / 4 * 4] < 0;  // {-1, -1, -1, node}: no sphere
+      if (!constrained_node && tag[k] < ns && mover_of(tag[k]) >= 0) out.push_back(mover_of(tag[k]));
+    }
+    return out;
+  }
   SiteState state(int s) const { return {set_.sites[s].p, set_.sites[s].w2, set_.sites[s].t}; }
   void restore(int s, const SiteState& st) {
     Site& site = set_.sites[s];
@@ -600,9 +616,15 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     m.region = region_of(m.site);
     for (int c : m.region)
       if (moved[out.cell_site[c]]) return;
+    // A removal solves for its edge's two power spheres as they are: none of their sites may
+    // move in the same round (else the edge comes back, docs/optimization.md "The sliver pass").
+    const std::vector<int> spheres = m.removal ? sphere_movers(m.tag) : std::vector<int>{};
+    for (int s : spheres)
+      if (moved[s]) return;
     restore(m.site, m.after);
     moved[m.site] = 1;
     for (int c : m.region) locked[out.cell_site[c]] = 1;
+    for (int s : spheres) locked[s] = 1;
     locked[m.site] = 1;
     moves.push_back(m);
   };
@@ -845,7 +867,9 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
   // Faces above checkMesh's skewness limit left: a few more rounds against them alone.
   for (int extra = 0; extra < kSkewRounds; ++extra) {
     ++rep.rounds;
-    if (!optimizer.round(out, rep, true) || optimizer.skewed_left() == 0) break;
+    // A round whose steps were all refused has tagged them: the next tries each face's next step.
+    if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
+    if (optimizer.skewed_left() == 0) break;
   }
   // Cells failing a shape check left: rounds of repairs while untried options remain.
   for (int extra = 0; extra < kRepairRounds && optimizer.failing_now() != 0; ++extra) {
