@@ -409,15 +409,25 @@ class SiteOptimizer {
     if (site.kind == SiteKind::ExternalMirror && site.polygon >= 0) return set_.internal_of[site.polygon];
     return s;
   }
-  // The movable sites of a removal's two power spheres (its tag's two quadruples).
+  // The movable sites of a removal's two power spheres (its tag's two quadruples); an image
+  // through an outer-boundary plane stands for its site.
   std::vector<int> sphere_movers(const std::array<int, 9>& tag) const {
     std::vector<int> out;
     const int ns = static_cast<int>(set_.sites.size());
     for (int k = 0; k < 8; ++k) {
-      const bool constrained_node = tag[k / 4 * 4] < 0;  // {-1, -1, -1, node}: no sphere
-      if (!constrained_node && tag[k] < ns && mover_of(tag[k]) >= 0) out.push_back(mover_of(tag[k]));
+      if (tag[k / 4 * 4] < 0) continue;  // {-1, -1, -1, node}: a constrained node, no sphere
+      int s = tag[k];
+      if (s >= ns) s = s - ns < static_cast<int>(image_origin_.size()) ? image_origin_[s - ns] : -1;
+      if (s >= 0 && mover_of(s) >= 0) out.push_back(mover_of(s));
     }
     return out;
+  }
+  // The site of each image, in the order with_images (transition_power.cpp) numbers them from ns.
+  void number_images() {
+    image_origin_.clear();
+    for (size_t k = 0; k < images_.planes.size(); ++k)
+      for (size_t s = 0; s < set_.sites.size(); ++s)
+        if (set_.sites[s].alive && set_.sites[s].kind != SiteKind::Guard) image_origin_.push_back(static_cast<int>(s));
   }
   SiteState state(int s) const { return {set_.sites[s].p, set_.sites[s].w2, set_.sites[s].t}; }
   void restore(int s, const SiteState& st) {
@@ -451,6 +461,7 @@ class SiteOptimizer {
   const TransitionOptions& opt_;
   std::vector<Vec3> outside_centres_;  // a copy: the repairs round them (as written)
   const BoundaryImages& images_;
+  std::vector<int> image_origin_;  // number_images
   std::vector<int> side_;  // [plane * sites + site]: the side of each outer-boundary plane a site starts on
   static int plane_side(Vec3 p, const MirrorPlane& m) { return p[m.axis] < m.value ? -1 : p[m.axis] > m.value ? 1 : 0; }
   // Every site on the side of each outer-boundary plane it started on: its image stays beyond it.
@@ -546,6 +557,7 @@ bool SiteOptimizer::trial_step(int s, int other, bool away, int size, Move* m) {
 
 bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only) {
   slab_.reset(set_);
+  number_images();
   // The diagram's measurement: the one the previous round took of the diagram it left, if any.
   Measured now = next_ ? std::move(*next_) : measure(out);
   next_.reset();
