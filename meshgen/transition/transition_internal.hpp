@@ -106,6 +106,11 @@ struct SiteSet {
   int emptiness_fixes = 0;       ///< sites moved because their sphere held a cavity vertex
 };
 
+/// The site of each image of `set` through `planes` outer-boundary planes, in the order of their
+/// ids (the power diagram numbers the images from set.sites.size() on): per plane, every live site
+/// but the guards.
+std::vector<int> imaged_sites(const SiteSet& set, size_t planes);
+
 /// Places the internal polygon site s at O + t n with the weight of its constrained vertices
 /// (and re-derives its reflection, if its polygon has one).
 void place_polygon_site(SiteSet& set, int s, double t, const Cavity& cavity, const std::vector<Vec3>& coords,

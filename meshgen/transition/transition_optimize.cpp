@@ -422,13 +422,7 @@ class SiteOptimizer {
     }
     return out;
   }
-  // The site of each image, in the order with_images (transition_power.cpp) numbers them from ns.
-  void number_images() {
-    image_origin_.clear();
-    for (size_t k = 0; k < images_.planes.size(); ++k)
-      for (size_t s = 0; s < set_.sites.size(); ++s)
-        if (set_.sites[s].alive && set_.sites[s].kind != SiteKind::Guard) image_origin_.push_back(static_cast<int>(s));
-  }
+  void number_images() { image_origin_ = imaged_sites(set_, images_.planes.size()); }
   SiteState state(int s) const { return {set_.sites[s].p, set_.sites[s].w2, set_.sites[s].t}; }
   void restore(int s, const SiteState& st) {
     Site& site = set_.sites[s];
@@ -461,7 +455,7 @@ class SiteOptimizer {
   const TransitionOptions& opt_;
   std::vector<Vec3> outside_centres_;  // a copy: the repairs round them (as written)
   const BoundaryImages& images_;
-  std::vector<int> image_origin_;  // number_images
+  std::vector<int> image_origin_;  // the site of each image (imaged_sites), numbered from ns
   std::vector<int> side_;  // [plane * sites + site]: the side of each outer-boundary plane a site starts on
   static int plane_side(Vec3 p, const MirrorPlane& m) { return p[m.axis] < m.value ? -1 : p[m.axis] > m.value ? 1 : 0; }
   // Every site on the side of each outer-boundary plane it started on: its image stays beyond it.

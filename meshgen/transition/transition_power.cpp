@@ -261,29 +261,38 @@ struct RawFace {
   bool stray = false;          // t is the image of another site (zero area in exact geometry)
 };
 
+}  // namespace
+
+std::vector<int> imaged_sites(const SiteSet& set, size_t planes) {
+  std::vector<int> out;
+  for (size_t k = 0; k < planes; ++k)
+    for (size_t s = 0; s < set.sites.size(); ++s)
+      if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard) out.push_back(static_cast<int>(s));
+  return out;
+}
+
+namespace {
 // The real sites plus, per outer-boundary plane, the image of every live site.
 SiteSet with_images(const SiteSet& real, const BoundaryImages& images) {
   SiteSet set = real;
-  const int n = static_cast<int>(real.sites.size());
-  for (int k = 0; k < static_cast<int>(images.planes.size()); ++k)
-    for (int s = 0; s < n; ++s) {
-      const Site& r = real.sites[s];
-      if (!r.alive || r.kind == SiteKind::Guard) continue;
-      Site im;
-      im.kind = SiteKind::Image;
-      im.p = reflect(r.p, images.planes[k]);
-      im.w2 = r.w2;
-      im.unchecked = false;
-      im.vertices = images.image_of(k, r.vertices);
-      im.image_of = s;
-      im.plane = k;
-      set.sites.push_back(std::move(im));
-    }
+  const std::vector<int> sites = imaged_sites(real, images.planes.size());
+  const size_t per_plane = sites.size() / std::max<size_t>(images.planes.size(), 1);
+  for (size_t i = 0; i < sites.size(); ++i) {
+    const int s = sites[i], k = static_cast<int>(i / per_plane);
+    const Site& r = real.sites[s];
+    Site im;
+    im.kind = SiteKind::Image;
+    im.p = reflect(r.p, images.planes[k]);
+    im.w2 = r.w2;
+    im.unchecked = false;
+    im.vertices = images.image_of(k, r.vertices);
+    im.image_of = s;
+    im.plane = k;
+    set.sites.push_back(std::move(im));
+  }
   return set;
 }
-}  // namespace
 
-namespace {
 // The regular triangulation of the live sites of `set` plus 8 far guard points of weight 0
 // (ids ns .. ns + 7), vertex info = site id.
 void triangulate(const SiteSet& set, Regular& rt) {
