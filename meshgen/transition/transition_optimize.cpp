@@ -623,7 +623,8 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     for (int c : m.region)
       if (moved[out.cell_site[c]]) return;
     // A removal solves for its edge's two power spheres as they are: none of their sites may
-    // move in the same round (else the edge comes back, docs/optimization.md "The sliver pass").
+    // move in the same round (else the edge comes back: docs/optimization.md, "Removals that undid
+    // each other").
     const std::vector<int> spheres = m.removal ? sphere_movers(m.tag) : std::vector<int>{};
     for (int s : spheres)
       if (moved[s]) return;
