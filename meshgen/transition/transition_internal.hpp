@@ -106,10 +106,10 @@ struct SiteSet {
   int emptiness_fixes = 0;       ///< sites moved because their sphere held a cavity vertex
 };
 
-/// The site of each image of `set` through `planes` outer-boundary planes, in the order of their
-/// ids (the power diagram numbers the images from set.sites.size() on): per plane, every live site
-/// but the guards.
-std::vector<int> imaged_sites(const SiteSet& set, size_t planes);
+/// The sites that get an image through each outer-boundary plane (every live site but the guards),
+/// in the order of the images' ids: the power diagram numbers the image of imaged_sites[i] through
+/// plane k as set.sites.size() + k * imaged_sites.size() + i.
+std::vector<int> imaged_sites(const SiteSet& set);
 
 /// Places the internal polygon site s at O + t n with the weight of its constrained vertices
 /// (and re-derives its reflection, if its polygon has one).

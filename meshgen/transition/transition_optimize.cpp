@@ -417,12 +417,13 @@ class SiteOptimizer {
     for (int k = 0; k < 8; ++k) {
       if (tag[k / 4 * 4] < 0) continue;  // {-1, -1, -1, node}: a constrained node, no sphere
       int s = tag[k];
-      if (s >= ns) s = s - ns < static_cast<int>(image_origin_.size()) ? image_origin_[s - ns] : -1;
+      const int images = static_cast<int>(image_origin_.size()) * static_cast<int>(images_.planes.size());
+      if (s >= ns) s = s - ns < images ? image_origin_[(s - ns) % image_origin_.size()] : -1;
       if (s >= 0 && mover_of(s) >= 0) out.push_back(mover_of(s));
     }
     return out;
   }
-  void number_images() { image_origin_ = imaged_sites(set_, images_.planes.size()); }
+  void number_images() { image_origin_ = images_.empty() ? std::vector<int>{} : imaged_sites(set_); }
   SiteState state(int s) const { return {set_.sites[s].p, set_.sites[s].w2, set_.sites[s].t}; }
   void restore(int s, const SiteState& st) {
     Site& site = set_.sites[s];
@@ -455,7 +456,7 @@ class SiteOptimizer {
   const TransitionOptions& opt_;
   std::vector<Vec3> outside_centres_;  // a copy: the repairs round them (as written)
   const BoundaryImages& images_;
-  std::vector<int> image_origin_;  // the site of each image (imaged_sites), numbered from ns
+  std::vector<int> image_origin_;  // imaged_sites: the site of image ns + k * size + i is [i]
   std::vector<int> side_;  // [plane * sites + site]: the side of each outer-boundary plane a site starts on
   static int plane_side(Vec3 p, const MirrorPlane& m) { return p[m.axis] < m.value ? -1 : p[m.axis] > m.value ? 1 : 0; }
   // Every site on the side of each outer-boundary plane it started on: its image stays beyond it.

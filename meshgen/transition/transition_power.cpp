@@ -263,11 +263,10 @@ struct RawFace {
 
 }  // namespace
 
-std::vector<int> imaged_sites(const SiteSet& set, size_t planes) {
+std::vector<int> imaged_sites(const SiteSet& set) {
   std::vector<int> out;
-  for (size_t k = 0; k < planes; ++k)
-    for (size_t s = 0; s < set.sites.size(); ++s)
-      if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard) out.push_back(static_cast<int>(s));
+  for (size_t s = 0; s < set.sites.size(); ++s)
+    if (set.sites[s].alive && set.sites[s].kind != SiteKind::Guard) out.push_back(static_cast<int>(s));
   return out;
 }
 
@@ -275,21 +274,20 @@ namespace {
 // The real sites plus, per outer-boundary plane, the image of every live site.
 SiteSet with_images(const SiteSet& real, const BoundaryImages& images) {
   SiteSet set = real;
-  const std::vector<int> sites = imaged_sites(real, images.planes.size());
-  const size_t per_plane = sites.size() / std::max<size_t>(images.planes.size(), 1);
-  for (size_t i = 0; i < sites.size(); ++i) {
-    const int s = sites[i], k = static_cast<int>(i / per_plane);
-    const Site& r = real.sites[s];
-    Site im;
-    im.kind = SiteKind::Image;
-    im.p = reflect(r.p, images.planes[k]);
-    im.w2 = r.w2;
-    im.unchecked = false;
-    im.vertices = images.image_of(k, r.vertices);
-    im.image_of = s;
-    im.plane = k;
-    set.sites.push_back(std::move(im));
-  }
+  const std::vector<int> sites = imaged_sites(real);
+  for (int k = 0; k < static_cast<int>(images.planes.size()); ++k)
+    for (int s : sites) {
+      const Site& r = real.sites[s];
+      Site im;
+      im.kind = SiteKind::Image;
+      im.p = reflect(r.p, images.planes[k]);
+      im.w2 = r.w2;
+      im.unchecked = false;
+      im.vertices = images.image_of(k, r.vertices);
+      im.image_of = s;
+      im.plane = k;
+      set.sites.push_back(std::move(im));
+    }
   return set;
 }
 

@@ -225,7 +225,7 @@ double openfoam_skewness(const hm::PolyMesh& mesh, const hm::MeshGeometry& geo, 
 // The shipped examples through the pipeline (accuracy_bent: hemispherical end caps and a bend;
 // layered_grdecl: a corner-point deck): checkMesh accepts the whole hybrid mesh with the right cell
 // count and our total volume; one wellbore patch per well. meshgen's mesh of layered_grdecl had a
-// face at skewness 4.25 until session 41 (docs/optimization.md, "Rounds").
+// face at skewness 4.25 until session 41 (docs/optimization.md, "Removals that undid each other").
 class CheckMeshExample : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(CheckMeshExample, HybridMeshPasses) {
