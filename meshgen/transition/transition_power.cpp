@@ -191,27 +191,30 @@ bool inside_its_edge(const std::vector<Token>& c, size_t k, Position position) {
 // (each drop can straighten its neighbours' edges). A face of no area whose vertices all go is removed;
 // one that keeps three (the corners of a sliver face elsewhere) stays as it was. Returns the faces left
 // with fewer than 3 vertices.
+// Free vertices are tokens -1 - class with class < n_classes.
 template <class Position>
-int drop_vertices_inside_edges(std::vector<std::vector<Token>>& cycles, Position position) {
+int drop_vertices_inside_edges(std::vector<std::vector<Token>>& cycles, int n_classes, Position position) {
   std::vector<char> collinear(cycles.size());
   for (size_t i = 0; i < cycles.size(); ++i) collinear[i] = cycles[i].size() >= 3 && collinear_cycle(cycles[i], position);
   int degenerate = 0;
+  std::vector<char> straight(n_classes);  // per free vertex: inside its edge (or in a face of no area) in every face so far
   for (bool dropped_any = true; dropped_any;) {
     dropped_any = false;
-    std::map<Token, bool> straight;  // free vertex -> inside its edge (or in a face of no area) so far
+    std::fill(straight.begin(), straight.end(), 1);
     for (size_t i = 0; i < cycles.size(); ++i) {
       const std::vector<Token>& c = cycles[i];
       if (c.size() < 3) continue;
       for (size_t k = 0; k < c.size(); ++k)
         if (c[k] < 0) {
-          auto [it, fresh] = straight.try_emplace(c[k], true);
-          it->second = it->second && (collinear[i] || inside_its_edge(c, k, position));
+          char& s = straight[static_cast<size_t>(-1 - c[k])];
+          s = s && (collinear[i] || inside_its_edge(c, k, position));
         }
     }
     for (std::vector<Token>& c : cycles) {
       if (c.size() < 3) continue;
       const size_t before = c.size();
-      c.erase(std::remove_if(c.begin(), c.end(), [&](Token t) { return t < 0 && straight.at(t); }), c.end());
+      c.erase(std::remove_if(c.begin(), c.end(), [&](Token t) { return t < 0 && straight[static_cast<size_t>(-1 - t)]; }),
+              c.end());
       if (c.size() == before) continue;
       dropped_any = true;
       degenerate += c.size() < 3;
@@ -639,7 +642,7 @@ std::vector<int> extract_power_cells(Regular& rt, const SiteSet& set, int n_real
         throw std::runtime_error("transition: the cell of site " + std::to_string(faces[i].s) +
                                  " reaches the image of a cavity vertex through an outer-boundary plane");
   }
-  removed += drop_vertices_inside_edges(cycles, [&](Token tk) { return tk >= 0 ? coords[tk] : class_info(static_cast<int>(-1 - tk)).point; });
+  removed += drop_vertices_inside_edges(cycles, nc, [&](Token tk) { return tk >= 0 ? coords[tk] : class_info(static_cast<int>(-1 - tk)).point; });
   rep.removed_faces = removed;
 
   // ---- number the free vertices by their class key (deterministic)
