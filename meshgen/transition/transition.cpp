@@ -17,7 +17,7 @@ namespace hm {
 using namespace transition_detail;
 
 namespace {
-constexpr int kMaxCorrectionIterations = 100;
+constexpr int kMaxCorrectionIterations = 400;
 constexpr int kMaxHiddenRepairs = 8;
 constexpr double kHiddenShrink = 0.7;
 

@@ -2,7 +2,10 @@
 // auto-centering correction. CGAL-free.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -140,6 +143,30 @@ double max_t(const SiteSet& set, int q, const std::vector<PolygonFrame>& frames)
 double min_t(const std::vector<PolygonFrame>& frames, int q) { return 1.0001 * kMinT * frames[q].radius; }
 
 namespace {
+
+// A hash of what the correction's next iteration depends on: every site's kind, liveness, point and
+// weight, and how recently it was shrunk (only whether within kNoGrowAfterShrink matters).
+uint64_t correction_state_hash(const SiteSet& set, const std::vector<int>& shrunk_at, int it, int no_grow_after_shrink) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a over the state's words
+  auto mix = [&](uint64_t word) {
+    for (int b = 0; b < 8; ++b) h = (h ^ ((word >> (8 * b)) & 0xff)) * 1099511628211ull;
+  };
+  auto bits = [](double v) {
+    uint64_t u;
+    std::memcpy(&u, &v, sizeof u);
+    return u;
+  };
+  mix(set.sites.size());
+  for (size_t s = 0; s < set.sites.size(); ++s) {
+    const Site& site = set.sites[s];
+    mix(static_cast<uint64_t>(site.kind) * 2 + (site.alive ? 1 : 0));
+    if (!site.alive) continue;
+    mix(bits(site.p.x)), mix(bits(site.p.y)), mix(bits(site.p.z)), mix(bits(site.w2));
+    const int since = s < shrunk_at.size() ? it - shrunk_at[s] : no_grow_after_shrink + 1;
+    mix(static_cast<uint64_t>(std::min(since, no_grow_after_shrink + 1)));
+  }
+  return h;
+}
 
 // Whether shrink_or_split can still change site s: boxes can be split, polygon sites (or
 // the partner of a reflection) can move while above their minimal distance.
@@ -577,8 +604,15 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
   constexpr int kNoGrowAfterShrink = 3;
   int column_rounds = 0;
   constexpr int kMaxColumnRounds = 8;
+  // The iterations are deterministic in the sites' state: a state met again would be met forever
+  // (a cycle of shrinks and growths), so the correction stops there rather than at the cap.
+  std::set<uint64_t> states_seen;
+  bool cycled = false;
   for (int it = 1; it <= max_iterations; ++it) {
     *iterations = it;
+    const bool cycling = !states_seen.insert(correction_state_hash(set, shrunk_at, it, kNoGrowAfterShrink)).second;
+    const bool last = it == max_iterations || cycling;
+    cycled = cycling;
     // A pair is examined when |Pi Pj|^2 <= max(wi^2, wj^2): each site looks for the others
     // within its own radius (x-sorted window), and a pair seen from both sides is counted
     // once, from its smaller index.
@@ -611,7 +645,7 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
         const int large = si.w2 > sj.w2 ? i : j, small = si.w2 > sj.w2 ? j : i;
         if (!set.sites[small].internal()) continue;
         ++n;
-        if (it == max_iterations) ++pair_kinds[site_label(set, large, cavity, frames) + " > " + site_label(set, small, cavity, frames)];
+        if (last) ++pair_kinds[site_label(set, large, cavity, frames) + " > " + site_label(set, small, cavity, frames)];
         involved[large] = involved[small] = 1;
         // The larger weight moves toward its polygon (5.5.2) when that helps (the smaller site in
         // front of its polygon); a box is split. Otherwise the smaller site moves: away from its
@@ -639,14 +673,14 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
       // Converged: hold the wall columns under boundary planes, and correct again if that moved
       // a site (a bounded number of times, and not after the last iteration, which could not
       // correct it; the self-check judges the mesh either way).
-      if (column_rounds++ == kMaxColumnRounds || it == max_iterations ||
+      if (column_rounds++ == kMaxColumnRounds || last ||
           align_wall_columns(set, cavity, coords, frames) == 0)
         return corrections;
       enforce_empty_spheres(set, cavity, coords, grid, frames);
       shrunk_at.resize(set.sites.size(), -1000);
       continue;
     }
-    if (it == max_iterations) {
+    if (last) {
       stuck.assign(fix.size(), 0);
       for (size_t s = 0; s < fix.size(); ++s) stuck[s] = fix[s] || grow[s] || involved[s] || deep[s] < kInf;
       break;
@@ -676,8 +710,10 @@ int correct_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& c
     enforce_empty_spheres(set, cavity, coords, grid, frames);
   }
   std::ostringstream os;
-  os << "transition: site correction did not converge after " << max_iterations << " iterations (" << left
-     << " pairs left";
+  os << "transition: site correction did not converge "
+     << (cycled ? "(iteration " + std::to_string(*iterations) + " repeats an earlier one: a cycle)"
+                : "after " + std::to_string(max_iterations) + " iterations")
+     << " (" << left << " pairs left";
   {
     std::vector<std::pair<int, std::string>> by_count;
     for (const auto& [k, v] : pair_kinds) by_count.push_back({-v, k});

@@ -381,6 +381,19 @@ TEST(RealisticSweep, SliverRemovalsDoNotUndoEachOther) {
   expect_meshes(make_realistic_case(optimised_seed, oo), oo);
 }
 
+// A wave of shrinks along a long well (docs/transition.md, "Correction"): with 10 m segments the
+// well polygons of one sector line are nearly coplanar and their sites' pairs tolerate a height
+// difference of about segment^2 / (2 t); a site shrunk for one pair then fails the pair with the
+// next polygon along the line, one polygon per iteration. Seed 3484 (three wells of R 100-195 m in
+// 99 m cells, hemispherical caps, field coordinates) needed between 100 and 150 iterations and was
+// refused at the former cap of 100 ("2 pairs left: 2 well > well"). It must mesh and pass every check.
+TEST(RealisticSweep, ShrinkWaveAlongALongWellConverges) {
+  const uint32_t seed = 3484;
+  const RealisticOptions o = sweep_options(seed);
+  ASSERT_TRUE(o.field_origin && o.caps == RealisticOptions::Caps::Hemisphere);
+  expect_meshes(make_realistic_case(seed, o), o);
+}
+
 // The optimiser kept site moves whose rebuilt cells were not convex (full-sweep seed 1009: 2 cells,
 // 1021: 1 cell, both straight from the raw diagram's convex cells); its acceptance now refuses a
 // move that makes a cell fail a shape check of the self-check (transition_optimize.cpp,

@@ -295,6 +295,53 @@ TEST(Transition, SiteCorrection) {
   EXPECT_EQ(s.t, 0.1);                                   // the smaller did not
 }
 
+// A correction that cannot converge stops where its state repeats (the iterations are deterministic
+// in it, so they would cycle until the cap) and says so. Two coplanar well triangles whose quad is
+// not Delaunay: the far vertex of one lies inside the other's circumcircle, so no sphere through that
+// triangle is empty and no height of the two sites satisfies both the emptiness and condition (6).
+TEST(Transition, SiteCorrectionStopsAtACycle) {
+  using namespace transition_detail;
+  const std::vector<Vec3> coords = {{0, 0, 0}, {2, 0, 0}, {1, 1.2, 0}, {1, -0.3, 0}};
+  Cavity cav;
+  for (const std::vector<int32_t>& nodes : {std::vector<int32_t>{0, 1, 2}, std::vector<int32_t>{0, 3, 1}}) {
+    ConstrainedFace f;
+    f.nodes = nodes;
+    f.side = FaceSide::Well;
+    cav.faces.push_back(f);
+  }
+  cav.vertices = {0, 1, 2, 3};
+  std::vector<PolygonFrame> frames;
+  for (const ConstrainedFace& f : cav.faces) frames.push_back(fit_polygon(f.nodes, coords));
+  ASSERT_GT(frames[0].normal.z, 0);  // both open toward +z
+  ASSERT_GT(frames[1].normal.z, 0);
+  SiteSet set;
+  set.internal_of = {0, 1};
+  set.external_of = {-1, -1};
+  for (int q = 0; q < 2; ++q) {
+    Site s;
+    s.kind = SiteKind::InternalPolygon;
+    s.polygon = q;
+    s.polygons = {q};
+    s.vertices = cav.faces[q].nodes;
+    std::sort(s.vertices.begin(), s.vertices.end());
+    s.t = 0.5;
+    s.p = frames[q].center + s.t * frames[q].normal;
+    s.w2 = frames[q].radius * frames[q].radius + s.t * s.t;
+    set.sites.push_back(s);
+  }
+  ReservoirGrid grid;
+  int iterations = 0;
+  constexpr int kCap = 400;
+  try {
+    correct_sites(set, cav, coords, grid, frames, kCap, &iterations);
+    FAIL() << "a quad that is not Delaunay cannot be corrected";
+  } catch (const TransitionError& e) {
+    EXPECT_NE(std::string(e.what()).find("repeats an earlier one: a cycle"), std::string::npos) << e.what();
+    EXPECT_EQ(e.polygons, (std::vector<int32_t>{0, 1}));
+  }
+  EXPECT_LT(iterations, kCap);
+}
+
 // Hidden sites are detected, never dropped silently: a site sitting on another one with a
 // smaller weight has no power cell; build_power_cells names it and emits nothing, and the
 // same set without it gives one cell per internal site.
