@@ -585,11 +585,14 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   };
 
   // Candidate edges: shorter than G3 h (h: the largest reference length of the cells around),
-  // with a free end; shortest relative length first, ties by node ids.
+  // with a free end; shortest relative length first, ties by node ids. In the rounds against
+  // skewness (skew_only): short edges between free vertices of a cell with a skewed face, whose tiny
+  // faces are what checkMesh finds skewed.
   struct Candidate {
     double rel, len, h;
     int32_t a, b;
     size_t first, last;  // range in edge_cell
+    bool for_skew;
   };
   std::vector<Candidate> cand;
   for (size_t i = 0; i < edge_cell.size();) {
@@ -601,16 +604,23 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     const bool free_end = global[a] >= out.base_node_id || global[b] >= out.base_node_id;
     const bool both_free = global[a] >= out.base_node_id && global[b] >= out.base_node_id;
     const double len = norm(sub.nodes[a] - sub.nodes[b]);
-    bool of_failing_cell = false;
-    for (size_t k = i; k < j; ++k) of_failing_cell = of_failing_cell || now.failing.cell[edge_cell[k][2]];
-    bool wanted = false;
+    bool of_failing_cell = false, of_skewed_cell = false;
+    for (size_t k = i; k < j; ++k) {
+      of_failing_cell = of_failing_cell || now.failing.cell[edge_cell[k][2]];
+      of_skewed_cell = of_skewed_cell || skewed[edge_cell[k][2]] > 0;
+    }
+    const bool short_between_free = both_free && len < opt_.g_remove * h;
+    bool wanted = false, for_skew = false;
     switch (pass_) {
-      case Pass::Optimize: wanted = free_end && len < opt_.g_expand * h; break;
+      case Pass::Optimize:
+        for_skew = skew_only;
+        wanted = skew_only ? short_between_free && of_skewed_cell : free_end && len < opt_.g_expand * h;
+        break;
       case Pass::Slivers: wanted = both_free && len < kSliverEdge * h; break;
       // A failing cell's short edge between two free vertices (nearly co-spherical sites) is removed.
-      case Pass::Repairs: wanted = both_free && of_failing_cell && len < opt_.g_remove * h; break;
+      case Pass::Repairs: wanted = short_between_free && of_failing_cell; break;
     }
-    if (wanted && h > 0) cand.push_back({len / h, len, h, a, b, i, j});
+    if (wanted && h > 0) cand.push_back({len / h, len, h, a, b, i, j, for_skew});
     i = j;
   }
   std::sort(cand.begin(), cand.end(), [&](const Candidate& x, const Candidate& y) {
@@ -654,7 +664,6 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     if (best.site >= 0) admit(best);
   }
   for (const Candidate& e : cand) {
-    if (skew_only && pass_ != Pass::Repairs) break;
     std::vector<int> around;  // sites of the cells around the edge
     for (size_t k = e.first; k < e.last; ++k) around.push_back(out.cell_site[edge_cell[k][2]]);
     bool busy = false;
@@ -689,6 +698,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
         m.removal = removal;
         if (pass_ == Pass::Slivers) m.kind = MoveKind::SliverRemoval;
         if (pass_ == Pass::Repairs) m.kind = MoveKind::Repair;
+        if (e.for_skew) m.kind = MoveKind::SkewStep;
         if (shift < best_shift) best = m, best_shift = shift;
       }
     }

@@ -5,14 +5,17 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <string>
 #include <thread>
 
 #include "fvcheck/lib/report.hpp"
+#include "meshgen/core/fv_quality.hpp"
 #include "meshgen/grids/well_block.hpp"
 #include "meshgen/pipeline/hybrid_mesh.hpp"
 #include "meshgen/pipeline/local_frame.hpp"
@@ -31,6 +34,14 @@ inline const char* outcome_name(Outcome o) {
     case Outcome::Hang: return "hang";
   }
   return "?";
+}
+
+/// How mesh_and_check reports checkMesh's largest face skewness of a meshed case in its reason.
+inline constexpr const char* kSkewnessTag = "checkMesh skewness ";
+/// That skewness, NaN when the reason has none.
+inline double reported_skewness(const std::string& reason) {
+  const size_t at = reason.find(kSkewnessTag);
+  return at == std::string::npos ? std::nan("") : std::atof(reason.c_str() + at + std::string(kSkewnessTag).size());
 }
 
 struct CaseResult {
@@ -96,6 +107,12 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
       for (const auto& [k, v] : c.counts)
         if (res.outcome == Outcome::Meshed && k == "boundary_faces_below_threshold_at_centroid" && v > 0)
           res.reason = "passes; the centroid rule would fail " + std::to_string(v) + " boundary faces";
+    // checkMesh's skewness (its limit is 4; fvcheck reproduces it), for the sweep's tally.
+    if (res.outcome == Outcome::Meshed) {
+      const std::vector<double> skew = openfoam_face_skewness(h.mesh);
+      const double worst = skew.empty() ? 0.0 : *std::max_element(skew.begin(), skew.end());
+      res.reason += (res.reason.empty() ? "" : "; ") + std::string(kSkewnessTag) + std::to_string(worst);
+    }
   });
 }
 
