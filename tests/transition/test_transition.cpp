@@ -2,6 +2,7 @@
 // assembled with the reservoir cells and the inner blocks through one MeshBuilder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <set>
 
@@ -232,6 +233,29 @@ TEST(Transition, NonAdmissibleCavityIsRefusedThenEnlarged) {
   EXPECT_LE(refusals, 2);
 }
 
+// One internal site per polygon of `cav` (no external sites), polygon q's at height t[q].
+transition_detail::SiteSet polygon_sites(const Cavity& cav, const std::vector<transition_detail::PolygonFrame>& frames,
+                                         const std::vector<double>& t) {
+  using namespace transition_detail;
+  SiteSet set;
+  set.internal_of.assign(cav.faces.size(), -1);
+  set.external_of.assign(cav.faces.size(), -1);
+  for (size_t q = 0; q < cav.faces.size(); ++q) {
+    Site s;
+    s.kind = SiteKind::InternalPolygon;
+    s.polygon = static_cast<int>(q);
+    s.polygons = {static_cast<int>(q)};
+    s.vertices = cav.faces[q].nodes;
+    std::sort(s.vertices.begin(), s.vertices.end());
+    s.t = t[q];
+    s.p = frames[q].center + t[q] * frames[q].normal;
+    s.w2 = frames[q].radius * frames[q].radius + t[q] * t[q];
+    set.internal_of[q] = static_cast<int>(q);
+    set.sites.push_back(s);
+  }
+  return set;
+}
+
 // Pass/fail pair for the site correction (5.5.3): a large site whose radical plane with a
 // small neighbour does not separate them is moved toward its polygon until condition (6)
 // holds; with one iteration allowed the same set fails with the documented message.
@@ -256,24 +280,7 @@ TEST(Transition, SiteCorrection) {
   for (const ConstrainedFace& f : cav.faces) frames.push_back(fit_polygon(f.nodes, coords));
   EXPECT_NEAR(frames[0].radius, 1.0, 1e-15);
   EXPECT_NEAR(frames[1].center.x, 2.0, 1e-15);
-  auto make = [&]() {
-    SiteSet set;
-    set.internal_of = {0, 1};
-    set.external_of = {-1, -1};
-    const double t[2] = {3.0, 0.1};
-    for (int q = 0; q < 2; ++q) {
-      Site s;
-      s.kind = SiteKind::InternalPolygon;
-      s.polygon = q;
-      s.polygons = {q};
-      s.vertices = cav.faces[q].nodes;
-      s.t = t[q];
-      s.p = frames[q].center + t[q] * frames[q].normal;
-      s.w2 = frames[q].radius * frames[q].radius + t[q] * t[q];
-      set.sites.push_back(s);
-    }
-    return set;
-  };
+  auto make = [&]() { return polygon_sites(cav, frames, {3.0, 0.1}); };
   ReservoirGrid grid;
   SiteSet bad = make();
   int iterations = 0;
@@ -314,21 +321,7 @@ TEST(Transition, SiteCorrectionStopsAtACycle) {
   for (const ConstrainedFace& f : cav.faces) frames.push_back(fit_polygon(f.nodes, coords));
   ASSERT_GT(frames[0].normal.z, 0);  // both open toward +z
   ASSERT_GT(frames[1].normal.z, 0);
-  SiteSet set;
-  set.internal_of = {0, 1};
-  set.external_of = {-1, -1};
-  for (int q = 0; q < 2; ++q) {
-    Site s;
-    s.kind = SiteKind::InternalPolygon;
-    s.polygon = q;
-    s.polygons = {q};
-    s.vertices = cav.faces[q].nodes;
-    std::sort(s.vertices.begin(), s.vertices.end());
-    s.t = 0.5;
-    s.p = frames[q].center + s.t * frames[q].normal;
-    s.w2 = frames[q].radius * frames[q].radius + s.t * s.t;
-    set.sites.push_back(s);
-  }
+  SiteSet set = polygon_sites(cav, frames, {0.5, 0.5});
   ReservoirGrid grid;
   int iterations = 0;
   constexpr int kCap = 400;
