@@ -147,9 +147,12 @@ namespace {
 // A hash of what the correction's next iteration depends on: every site's kind, liveness, point and
 // weight, and how recently it was shrunk (only whether within kNoGrowAfterShrink matters).
 uint64_t correction_state_hash(const SiteSet& set, const std::vector<int>& shrunk_at, int it, int no_grow_after_shrink) {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a over the state's words
-  auto mix = [&](uint64_t word) {
-    for (int b = 0; b < 8; ++b) h = (h ^ ((word >> (8 * b)) & 0xff)) * 1099511628211ull;
+  uint64_t h = 0x9e3779b97f4a7c15ull;
+  auto mix = [&](uint64_t word) {  // a word at a time: splitmix64's finaliser on the running value
+    h ^= word + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+    h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+    h ^= h >> 31;
   };
   auto bits = [](double v) {
     uint64_t u;
