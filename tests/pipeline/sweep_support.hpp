@@ -97,7 +97,8 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
     if (!fv.structure.ok) bad += "csr; ";
     for (const CheckResult& c : fv.checks)
       if (!c.ok()) bad += c.name + " " + std::to_string(c.violations) + "; ";
-    const double expected = box_minus_holes(rc.spec, h), got = total_volume(h.geometry);
+    // The domain meshed: the case's plan coordinates on the local frame's grid (local_frame.hpp).
+    const double expected = box_minus_holes(local_case(rc.spec), h), got = total_volume(h.geometry);
     if (!(std::abs(got - expected) <= 1e-9 * expected)) bad += "volume " + std::to_string(got / expected - 1) + "; ";
     res.outcome = bad.empty() ? Outcome::Meshed : Outcome::CheckFailed;
     res.reason = bad;

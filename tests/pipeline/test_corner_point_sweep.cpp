@@ -263,10 +263,11 @@ CaseResult mesh_corner_point_case(const CornerPointSweepCase& c, bool optimize =
     if (!optimize) cs.transition.optimize = false;
     CaseSpec user = cs;
     const HybridMesh h = build_hybrid_mesh_in_local_frame(user);  // throws if the self-check fails
-    CaseSpec bare = cs;
+    // The domain meshed: the case's plan coordinates on the local frame's grid (local_frame.hpp).
+    CaseSpec bare = local_case(cs);
     bare.wells.clear();
     double expected = total_volume(build_hybrid_mesh(bare).geometry);
-    const CaseSpec meshed = scaled_case(cs, h.frame);  // the wellbore of a permeability frame is the frame's
+    const CaseSpec meshed = scaled_case(local_case(cs), h.frame);  // the wellbore of a permeability frame is the frame's
     for (size_t w = 0; w < cs.wells.size(); ++w) expected -= exact_wellbore_hole_volume(meshed, static_cast<int>(w), h.blocks[w].sectors);
     const double got = total_volume(h.geometry);
     std::string bad;
@@ -453,7 +454,7 @@ TEST(CornerPointSweep, CiHorizontalSurveyWellMeshesWhereverTheModelSits) {
     const CaseSpec cs = load_sweep_case(c);
     PipelineOptions opts;
     opts.optimize = false;
-    return build_hybrid_mesh(translated_case(cs, -1.0 * case_origin(cs)), opts);
+    return build_hybrid_mesh(local_case(cs), opts);
   };
   const HybridMesh a = mesh(field), b = mesh(home);
   ASSERT_EQ(a.mesh.n_cells(), b.mesh.n_cells()) << field.label;

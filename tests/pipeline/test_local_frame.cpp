@@ -142,6 +142,44 @@ TEST(LocalFrame, TranslateMeshMovesPositionsOnly) {
   for (int c = 0; c < before.n_cells(); ++c) EXPECT_TRUE(h.mesh.cell_perm[c] == before.cell_perm[c]);
 }
 
+// local_case puts plan coordinates on the frame's grid (multiples of 2^-20 m) and keeps depths; a case
+// given in UTM and the same case given at the origin then give the same doubles, although the UTM
+// values themselves are rounded (136.087 + 6780000 is no double).
+TEST(LocalFrame, LocalCaseIsTheSameWhereverTheModelSits) {
+  CaseSpec cs;
+  cs.name = "box";
+  cs.reservoir.x = {0, 40.3, 100.7, 150};
+  cs.reservoir.y = {0, 33.3, 136.087, 200};
+  cs.reservoir.z = {1000.1, 1002.35, 1010};
+  WellSpec w;
+  w.trajectory = {{12.345, 136.087, 1000.5}, {75.01, 99.99, 1009.7}};
+  cs.wells = {w};
+  const CaseSpec home = local_case(cs);
+  for (const std::vector<double>* axis : {&home.reservoir.x, &home.reservoir.y})
+    for (double v : *axis) EXPECT_EQ(std::fmod(v, kFrameQuantum), 0.0) << v;
+  EXPECT_NEAR(home.reservoir.y[2], 136.087, kFrameQuantum / 2);
+  EXPECT_NE(home.reservoir.y[2], 136.087);  // rounded: not itself a multiple
+  EXPECT_EQ(home.reservoir.z, cs.reservoir.z);  // depths kept
+  EXPECT_EQ(home.wells[0].trajectory[0].z, 1000.5);
+  const Vec3 shift{452000, 6780000, 0};
+  const CaseSpec moved = translated_case(cs, shift);
+  ASSERT_NE(moved.reservoir.y[2] - shift.y, cs.reservoir.y[2]);  // the move itself rounds
+  const CaseSpec field = local_case(moved);
+  EXPECT_EQ(field.reservoir.x, home.reservoir.x);
+  EXPECT_EQ(field.reservoir.y, home.reservoir.y);
+  for (size_t i = 0; i < 2; ++i) EXPECT_TRUE(field.wells[0].trajectory[i] == home.wells[0].trajectory[i]) << i;
+
+  // Two grid nodes under the frame's resolution apart are refused, naming the key.
+  CaseSpec close = cs;
+  close.reservoir.x = {0, 40.3, 40.3 + 1e-7, 150};
+  try {
+    local_case(close);
+    ADD_FAILURE() << "accepted grid nodes 1e-7 m apart";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("reservoir.x: nodes 1 and 2", 0), 0u) << e.what();
+  }
+}
+
 // The self-check is a pass/fail pair on one mesh: the box meshes and passes; a node moved off
 // its faces' planes fails (planarity: its faces bend by far more than 15 degrees), a NaN
 // permeability fails "finite" (the cell and, through the NaN transmissibility of their shared
