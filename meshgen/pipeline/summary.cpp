@@ -85,7 +85,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
                            {"seconds_transition", transition_s},
                            {"seconds_optimize", optimize_s}};
     }
-    int corrections = 0, hidden = 0, snapped = 0, removed = 0, slivers = 0, repairs = 0, internal = 0, external = 0,
+    int corrections = 0, hidden = 0, snapped = 0, removed = 0, slivers = 0, skew_steps = 0, repairs = 0, internal = 0, external = 0,
         free = 0, dropped = 0;
     for (const TransitionReport& r : h.transition_reports) {
       corrections += r.site_corrections;
@@ -93,6 +93,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
       snapped += r.snapped_vertices;
       removed += r.removed_faces;
       slivers += r.sliver_removals;
+      skew_steps += r.skew_steps;
       repairs += r.repairs;
       internal += r.internal_sites;
       external += r.external_sites;
@@ -107,6 +108,7 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
     t["snapped_vertices"] = snapped;
     t["removed_faces"] = removed;
     t["sliver_removals"] = slivers;
+    t["skew_steps"] = skew_steps;
     t["repairs"] = repairs;
     t["builds"] = h.transition_builds;  // transition meshes built, refused ones included
     j["transition"] = t;

@@ -231,6 +231,10 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   int repairs = 0;
   // Not where the cavity reaches a boundary plane either (the same micro-edges).
   if (images.empty()) sliver_removals = remove_sliver_edges(set, cavity, node_coords, frames, options, outside, out);
+  // The raw diagram's tiny faces between large cells fail checkMesh's skewness (docs/transition.md,
+  // "checkMesh's skewness without optimisation"); the optimiser has rounds of its own against them.
+  int skew_steps = 0;
+  if (!optimize) skew_steps = reduce_skewness(set, cavity, node_coords, frames, options, outside, images, out);
   // optimize_sites ends with repair rounds of its own (steps, no removals).
   if (!optimize) repairs = repair_failing_cells(set, cavity, node_coords, frames, options, outside, images, out);
   if (raw) out.unoptimized = std::move(raw);
@@ -238,6 +242,7 @@ TransitionCells build_transition_with(const Cavity& cavity, const std::vector<Ve
   TransitionReport& r = out.report;
   r.optimization = optimization;
   r.sliver_removals = sliver_removals;
+  r.skew_steps = skew_steps;
   r.repairs = repairs;
   r.seconds_optimize = optimize ? seconds(t3, Clock::now()) : 0.0;
   r.seconds_delaunay = seconds(t0, t1);

@@ -74,6 +74,7 @@ struct TransitionReport {
   double seconds_optimize = 0;  ///< wall time of the site optimiser (0 when not run)
   SiteOptimizeReport optimization;
   int sliver_removals = 0;      ///< without optimisation: site moves that removed a sliver edge (docs/transition.md)
+  int skew_steps = 0;           ///< without optimisation: site moves that left fewer faces above checkMesh's skewness limit
   int repairs = 0;              ///< without optimisation: site moves that mended cells failing a shape check
 };
 

@@ -276,6 +276,16 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                         const std::vector<Vec3>& outside_centres, TransitionCells& out);
+/// Without optimisation, after remove_sliver_edges: up to 24 rounds of the optimiser's moves against
+/// checkMesh's skewness (a step of a skewed face's site, the removal of a short edge between free
+/// vertices of a cell with a skewed face), each kept when the cells around have fewer skewed faces
+/// (or the same count, a lower worst) and none newly fails a shape check or conformity, judged in
+/// the local frame; a cell with an edge shorter than kSliverEdge x h fails too (the pass runs after
+/// remove_sliver_edges). Returns the moves kept. `images`: as for repair_failing_cells.
+int reduce_skewness(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+                    const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+                    const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
+                    TransitionCells& out);
 /// Without optimisation, after remove_sliver_edges: rounds of repairs of the cells failing a shape
 /// check of the self-check, while some fail and untried moves remain: the removal of a failing cell's
 /// edge between two free vertices shorter than G2 h (nearly co-spherical sites), or a step of its site
