@@ -41,7 +41,7 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
   # pass's 17 min of test time: Reek and thin-layer refinement meshes of ~100k cells, a K-orthogonal case
   # meshed in two metrics; and the sliver test's 545k-cell benchmark grid, 7 s in Release), whose code paths the smaller corner-point, refinement and permeability-
   # frame tests that stay here exercise too.
-  asan_long='CornerPointSweep\.CiHorizontalSeed2.*|SiteOptimizer\.SliverPass.*|NearWellRefinement\.(ThinLayersInCoarseCellsMesh|Reek.*)|PermeabilityFrameMesh\.KOrthogonalNearTheWell.*|MeshgenReekExample\..*|CornerPointWells\.Reek.*'
+  asan_long='CornerPointSweep\.CiHorizontalSeed2.*|SiteOptimizer\.SliverPass.*|NearWellRefinement\.(ThinLayersInCoarseCellsMesh|Reek.*)|PermeabilityFrameMesh\.KOrthogonalNearTheWell.*|MeshgenReekExample\..*|CornerPointWells\.Reek.*|LocalFrame\.Optimised.*'
   (cd build-asan && ctest --output-on-failure -j"$jobs" \
     -E "^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation|MeshPictures|Examples/VtkAgreement|VtkAgreement|$asan_long)")
 fi
