@@ -264,6 +264,13 @@ std::vector<char> written_frame_failures(PolyMesh sub, const PermeabilityFrame& 
   return cell;
 }
 
+// A submesh built in permeability frame f at physical positions.
+PolyMesh physical_submesh(PolyMesh sub, const PermeabilityFrame& f) {
+  for (Vec3& p : sub.nodes) p = to_physical(f, p);
+  for (Vec3& p : sub.cell_fv_center) p = to_physical(f, p);
+  return sub;
+}
+
 // Node -> cells (CSR, cells ascending) and edge -> cells ((a, b, cell) with a < b, sorted) over a
 // submesh's node ids: built per node in cell order, so only each node's short list is sorted.
 struct Incidence {
@@ -397,7 +404,9 @@ class SiteOptimizer {
     m.sub = transition_submesh(t, coords_, &m.global);
     if (judges_as_written()) round_to_written_frame(m.sub, opt_.written_origin);
     m.qs = cell_shape_quality(m.sub, h_ref_);
-    m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
+    // checkMesh measures skewness where the mesh is written: a permeability frame's at physical positions.
+    m.skewed = opt_.frame.identity() ? skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew)
+                                     : skewed_faces_of_cells(physical_submesh(m.sub, opt_.frame), &m.skewed_faces, &m.max_skew);
     m.failing = shape_failures(m.sub, m.global, t, cavity_, outside_centres_, images_.planes);
     // Its removals can put a free vertex on a face it is not a corner of (seed 3348), or leave an
     // edge of a sliver's size (seed 2380).
@@ -873,54 +882,50 @@ bool has_sliver_edge(const TransitionCells& t) {
 }
 }  // namespace
 
+namespace {
+// Up to max_rounds rounds of one pass without optimisation on `out`, until done(optimizer) after a
+// round or a round proposes nothing: a round whose moves were all refused has tagged them, and the
+// next tries each one's next option. The first round measures the diagram. Returns the moves kept.
+template <class Done>
+int run_pass(Pass pass, int max_rounds, Done done, SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+             const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+             const std::vector<Vec3>& outside_centres, const BoundaryImages& images, TransitionCells& out) {
+  SiteOptimizeReport rep;
+  const std::vector<double> h_ref = out.h_ref;
+  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, pass);
+  while (rep.rounds < max_rounds) {
+    ++rep.rounds;
+    if (!optimizer.round(out, rep, pass != Pass::Slivers) && optimizer.proposed_last() == 0) break;
+    if (done(optimizer)) break;
+  }
+  out.h_ref = h_ref;
+  return rep.kept;
+}
+}  // namespace
+
 int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                         const std::vector<Vec3>& outside_centres, TransitionCells& out) {
   if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
-  SiteOptimizeReport rep;
-  const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, kNoImages, Pass::Slivers);
-  while (rep.rounds < kSliverRounds) {
-    ++rep.rounds;
-    // A round whose removals were all refused has tagged them: the next tries each sliver's next site.
-    if (!optimizer.round(out, rep, false) && optimizer.proposed_last() == 0) break;
-  }
-  out.h_ref = h_ref;
-  return rep.kept;
+  return run_pass(Pass::Slivers, kSliverRounds, [](const SiteOptimizer&) { return false; }, set, cavity, coords,
+                  frames, opt, outside_centres, kNoImages, out);
 }
 
 int reduce_skewness(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                     const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                     const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
                     TransitionCells& out) {
-  SiteOptimizeReport rep;
-  const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, Pass::Skewness);
-  // As the optimiser's rounds against skewness: a round whose steps were all refused has tagged
-  // them, and the next tries each face's next step. The first round measures the diagram.
-  while (rep.rounds < kRawSkewRounds) {
-    ++rep.rounds;
-    if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
-    if (optimizer.skewed_left() == 0) break;
-  }
-  out.h_ref = h_ref;
-  return rep.kept;
+  return run_pass(Pass::Skewness, kRawSkewRounds, [](const SiteOptimizer& o) { return o.skewed_left() == 0; }, set,
+                  cavity, coords, frames, opt, outside_centres, images, out);
 }
 
 int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                          const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                          const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
                          TransitionCells& out) {
-  SiteOptimizeReport rep;
-  const std::vector<double> h_ref = out.h_ref;
-  SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, Pass::Repairs);
-  // The first round measures the diagram; it proposes nothing when no cell fails.
-  while (rep.rounds < kRepairRounds && optimizer.failing_now() != 0) {
-    ++rep.rounds;
-    if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
-  }
-  out.h_ref = h_ref;
-  return rep.kept;
+  // It proposes nothing when no cell fails, the common case.
+  return run_pass(Pass::Repairs, kRepairRounds, [](const SiteOptimizer& o) { return o.failing_now() == 0; }, set,
+                  cavity, coords, frames, opt, outside_centres, images, out);
 }
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
