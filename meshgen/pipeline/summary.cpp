@@ -85,8 +85,8 @@ nlohmann::json make_summary(const CaseSpec& cs, const HybridMesh& h) {
                            {"seconds_transition", transition_s},
                            {"seconds_optimize", optimize_s}};
     }
-    int corrections = 0, hidden = 0, snapped = 0, removed = 0, slivers = 0, skew_steps = 0, repairs = 0, internal = 0, external = 0,
-        free = 0, dropped = 0;
+    int corrections = 0, hidden = 0, snapped = 0, removed = 0, slivers = 0, skew_steps = 0, repairs = 0, internal = 0,
+        external = 0, free = 0, dropped = 0;
     for (const TransitionReport& r : h.transition_reports) {
       corrections += r.site_corrections;
       hidden += r.hidden_sites;

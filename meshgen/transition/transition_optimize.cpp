@@ -405,8 +405,8 @@ class SiteOptimizer {
     if (judges_as_written()) round_to_written_frame(m.sub, opt_.written_origin);
     m.qs = cell_shape_quality(m.sub, h_ref_);
     // checkMesh measures skewness where the mesh is written: a permeability frame's at physical positions.
-    m.skewed = opt_.frame.identity() ? skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew)
-                                     : skewed_faces_of_cells(physical_submesh(m.sub, opt_.frame), &m.skewed_faces, &m.max_skew);
+    if (opt_.frame.identity()) m.skewed = skewed_faces_of_cells(m.sub, &m.skewed_faces, &m.max_skew);
+    else m.skewed = skewed_faces_of_cells(physical_submesh(m.sub, opt_.frame), &m.skewed_faces, &m.max_skew);
     m.failing = shape_failures(m.sub, m.global, t, cavity_, outside_centres_, images_.planes);
     // Its removals can put a free vertex on a face it is not a corner of (seed 3348), or leave an
     // edge of a sliver's size (seed 2380).
