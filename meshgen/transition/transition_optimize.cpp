@@ -19,6 +19,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <utility>
 
 #include "fvcheck/lib/checks.hpp"
 #include "meshgen/core/fv_quality.hpp"
@@ -252,23 +253,23 @@ ShapeFailures shape_failures(const PolyMesh& sub, const std::vector<int32_t>& gl
   return out;
 }
 
-// The cells of a submesh built in permeability frame f (not the identity) that fail convexity, the
-// FV centre inside or planarity once moved back to physical positions (to_physical) and rounded as
-// written about `origin`, where fvcheck judges them; orthogonality, which the K metric keeps, is
-// judged in the frame (shape_failures).
-std::vector<char> written_frame_failures(PolyMesh sub, const PermeabilityFrame& f, Vec3 origin) {
-  for (Vec3& p : sub.nodes) p = as_written(to_physical(f, p), origin);
-  for (Vec3& p : sub.cell_fv_center) p = as_written(to_physical(f, p), origin);
-  std::vector<char> cell(sub.n_cells(), 0);
-  mark_affine_shape_failures(sub, compute_geometry(sub), cell);
-  return cell;
-}
-
 // A submesh built in permeability frame f at physical positions.
 PolyMesh physical_submesh(PolyMesh sub, const PermeabilityFrame& f) {
   for (Vec3& p : sub.nodes) p = to_physical(f, p);
   for (Vec3& p : sub.cell_fv_center) p = to_physical(f, p);
   return sub;
+}
+
+// The cells of a submesh built in permeability frame f (not the identity) that fail convexity, the
+// FV centre inside or planarity once moved back to physical positions (to_physical) and rounded as
+// written about `origin`, where fvcheck judges them; orthogonality, which the K metric keeps, is
+// judged in the frame (shape_failures).
+std::vector<char> written_frame_failures(PolyMesh sub, const PermeabilityFrame& f, Vec3 origin) {
+  sub = physical_submesh(std::move(sub), f);
+  round_to_written_frame(sub, origin);
+  std::vector<char> cell(sub.n_cells(), 0);
+  mark_affine_shape_failures(sub, compute_geometry(sub), cell);
+  return cell;
 }
 
 // Node -> cells (CSR, cells ascending) and edge -> cells ((a, b, cell) with a < b, sorted) over a
