@@ -688,6 +688,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   };
   // Skewed faces first, worst first: one of their two sites moves a step (toward or away from
   // its polygon, or from the other site), kept if the cells around have fewer skewed faces.
+  std::vector<int> unstepped;  // skewed faces whose own sites have no step left
   for (int f : skewed_faces) {
     if (pass_ != Pass::Optimize && pass_ != Pass::Skewness) break;
     const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
@@ -702,6 +703,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
       if (!refused_.count(m.tag) && trial_step(s, other, k % 2 == 1, k < 4 ? 1 : 2, &m)) best = m;
     }
     if (best.site >= 0) admit(best);
+    else unstepped.push_back(f);
   }
   for (const Candidate& e : cand) {
     std::vector<int> around;  // sites of the cells around the edge
@@ -741,6 +743,30 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
         if (e.for_skew) m.kind = MoveKind::SkewStep;
         if (shift < best_shift) best = m, best_shift = shift;
       }
+    }
+    if (best.site >= 0) admit(best);
+  }
+  // Skewed faces whose own sites have no step left, last (their moves lock the most cells): a step of
+  // a face neighbour of either cell, which moves the two cells' centroids.
+  for (int f : unstepped) {
+    if (!skew_only && pass_ != Pass::Skewness) break;
+    const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
+    if (moved[s1] || moved[s2] || locked[s1] || locked[s2]) continue;
+    Move best;
+    for (int s : {s1, s2}) {
+      for (int n : region_of(s)) {
+        const int mover = out.cell_site[n];
+        if (mover == s1 || mover == s2 || moved[mover] || locked[mover]) continue;
+        const bool polygon = set_.sites[mover].kind == SiteKind::InternalPolygon;
+        for (int k = 0; k < 4 && best.site < 0; ++k) {
+          Move m;
+          m.tag = {-2, mover, polygon ? -1 : s, 8 + k, 0, 0, 0, 0, 0};
+          m.kind = MoveKind::SkewStep;
+          if (!refused_.count(m.tag) && trial_step(mover, s, k % 2 == 1, k < 2 ? 1 : 2, &m)) best = m;
+        }
+        if (best.site >= 0) break;
+      }
+      if (best.site >= 0) break;
     }
     if (best.site >= 0) admit(best);
   }
@@ -811,10 +837,20 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   for (const Move& m : moves) applied[m.site] = 1;
   bool unattributed = false;
   const std::vector<char> blamed = moved_sites_sharing_a_node(stray, now.sub, after.sub, out.cell_site, applied, &unattributed);
+  // Likewise a cell with more faces above checkMesh's limit in no move's region: a step against
+  // skewness is refused when its site's cell shares a node with one.
+  std::vector<char> stray_skewed(nc, 0);
+  for (int c = 0; c < nc; ++c) stray_skewed[c] = skewed2[c] > skewed[c];
+  for (const Move& m : moves)
+    for (int c : m.region) stray_skewed[c] = 0;
+  bool skew_unattributed = false;
+  const std::vector<char> skew_blamed =
+      moved_sites_sharing_a_node(stray_skewed, now.sub, after.sub, out.cell_site, applied, &skew_unattributed);
   std::vector<Move> kept;
   for (const Move& m : moves) {
     MoveEffect e;
     e.newly_failing = unattributed || blamed[m.site];
+    if (m.kind == MoveKind::SkewStep) e.newly_failing = e.newly_failing || skew_unattributed || skew_blamed[m.site];
     for (int c : m.region) {
       e.newly_failing = e.newly_failing || worse[c];
       e.q_s_before += qs[c], e.q_s_after += qs2[c], e.skewed_before += skewed[c], e.skewed_after += skewed2[c];
@@ -862,10 +898,10 @@ bool move_is_kept(const MoveEffect& e, MoveKind kind) {
   return e.skewed_after <= e.skewed_before && e.q_s_after > e.q_s_before + 1e-12;
 }
 
-constexpr int kSkewRounds = 8;
-// Without optimisation: measured on realistic seeds 3008 and 3041, 17 and 11 rounds reach no skewed
-// face, one more site move kept in nearly every round (docs/transition.md).
-constexpr int kRawSkewRounds = 24;
+// Rounds against checkMesh's skewness, with and without optimisation: a round keeps about one step per
+// skewed face, and some faces need a dozen or more (docs/optimization.md, "Steps of a skewed face's
+// neighbours").
+constexpr int kSkewRounds = 24;
 constexpr int kSliverRounds = 4;
 constexpr int kRepairRounds = 16;
 
@@ -916,7 +952,7 @@ int reduce_skewness(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
                     const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                     const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
                     TransitionCells& out) {
-  return run_pass(Pass::Skewness, kRawSkewRounds, [](const SiteOptimizer& o) { return o.skewed_left() == 0; }, set,
+  return run_pass(Pass::Skewness, kSkewRounds, [](const SiteOptimizer& o) { return o.skewed_left() == 0; }, set,
                   cavity, coords, frames, opt, outside_centres, images, out);
 }
 
