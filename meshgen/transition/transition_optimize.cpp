@@ -422,6 +422,14 @@ class SiteOptimizer {
     }
     return m;
   }
+  // A round's moves on the diagram `out` measured as `now`, in the pass's order of priority, at most
+  // one in a region and none refused before; their sites are moved.
+  std::vector<Move> propose(const TransitionCells& out, const Measured& now, const std::vector<int>& cell_of_site,
+                            bool skew_only);
+  // The moves (their regions in both diagrams) kept by what they did from `now` to `after`, the
+  // diagram `fresh` rebuilt with them (move_is_kept); the others' sites restored, their tags refused.
+  std::vector<Move> judge(const std::vector<Move>& moves, const TransitionCells& out, const Measured& now,
+                          const TransitionCells& fresh, const Measured& after);
   // The cells of `after` (a diagram of the same sites, so the same cell per site) that fail a
   // shape check while the same site's cell in `before` did not.
   static std::vector<char> new_failures(const TransitionCells& t_before, const Measured& before,
@@ -589,24 +597,12 @@ bool SiteOptimizer::trial_step(int s, int other, bool away, int size, Move* m) {
   return ok;
 }
 
-bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only) {
-  slab_.reset(set_);
-  number_images();
-  // The diagram's measurement: the one the previous round took of the diagram it left, if any.
-  Measured now = next_ ? std::move(*next_) : measure(out);
-  next_.reset();
+std::vector<Move> SiteOptimizer::propose(const TransitionCells& out, const Measured& now,
+                                         const std::vector<int>& cell_of_site, bool skew_only) {
   const std::vector<int32_t>& global = now.global;
   const PolyMesh& sub = now.sub;
-  const std::vector<double>& qs = now.qs;
   const std::vector<int>& skewed_faces = now.skewed_faces;
-  const std::vector<double>& max_skew = now.max_skew;
   const std::vector<int>& skewed = now.skewed;
-  // `out` unchanged on return: its measurement serves the next round.
-  auto unchanged = [&] {
-    next_ = std::move(now);
-    return false;
-  };
-  skewed_left_ = static_cast<int>(skewed_faces.size());
   const int nc = sub.n_cells();
   const Incidence inc = incidence_of(sub);
   const std::vector<std::array<int32_t, 3>>& edge_cell = inc.edge_cell;
@@ -614,8 +610,6 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     return std::vector<int>(inc.node_cells.begin() + inc.node_ptr[v], inc.node_cells.begin() + inc.node_ptr[v + 1]);
   };
   const int ns = static_cast<int>(set_.sites.size());
-  std::vector<int> cell_of_site(ns, -1);
-  for (int c = 0; c < nc; ++c) cell_of_site[out.cell_site[c]] = c;
   // The cells whose geometry a move of `site` changes: its own and its face neighbours.
   auto region_of = [&](int site) {
     std::vector<int> r;
@@ -796,31 +790,16 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
       }
     if (best.site >= 0) admit(best);
   }
-  rep.proposed += static_cast<int>(moves.size());
-  proposed_last_ = static_cast<int>(moves.size());
-  if (moves.empty()) return unchanged();
+  return moves;
+}
 
-  // Rebuild with the moves; an invalid diagram keeps the first half of them, down to none.
-  TransitionCells fresh;
-  size_t keep = moves.size();
-  diagram_.save();  // the diagram of `out`: the rebuild with the kept moves alone starts from it
-  while (!rebuild(fresh, out.base_node_id)) {
-    const size_t half = keep / 2;
-    for (size_t i = half; i < keep; ++i) restore(moves[i].site, moves[i].before);
-    if (keep == 1) refused_.insert(moves[0].tag);
-    rep.invalid += static_cast<int>(keep - half);
-    keep = half;
-    if (keep == 0) {
-      moves.clear();
-      return unchanged();
-    }
-  }
-  moves.resize(keep);
-  // Keep a move by what it did to the cells around it (move_is_kept), its neighbours before and
-  // after the move (a diagram of the same sites: cell c is the same site's in both).
-  Measured after = measure(fresh);
-  for (Move& m : moves)
-    if (cell_of_site[m.site] >= 0) add_cell_and_neighbours(after.sub, cell_of_site[m.site], m.region);
+std::vector<Move> SiteOptimizer::judge(const std::vector<Move>& moves, const TransitionCells& out, const Measured& now,
+                                       const TransitionCells& fresh, const Measured& after) {
+  const int nc = now.sub.n_cells();
+  const int ns = static_cast<int>(set_.sites.size());
+  const std::vector<double>& qs = now.qs;
+  const std::vector<double>& max_skew = now.max_skew;
+  const std::vector<int>& skewed = now.skewed;
   const std::vector<double>& qs2 = after.qs;
   const std::vector<int>& skewed2 = after.skewed;
   const std::vector<double>& max_skew2 = after.max_skew;
@@ -861,6 +840,50 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     if (move_is_kept(e, m.kind)) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
+  return kept;
+}
+
+bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only) {
+  slab_.reset(set_);
+  number_images();
+  // The diagram's measurement: the one the previous round took of the diagram it left, if any.
+  Measured now = next_ ? std::move(*next_) : measure(out);
+  next_.reset();
+  // `out` unchanged on return: its measurement serves the next round.
+  auto unchanged = [&] {
+    next_ = std::move(now);
+    return false;
+  };
+  skewed_left_ = static_cast<int>(now.skewed_faces.size());
+  std::vector<int> cell_of_site(set_.sites.size(), -1);
+  for (int c = 0; c < now.sub.n_cells(); ++c) cell_of_site[out.cell_site[c]] = c;
+  std::vector<Move> moves = propose(out, now, cell_of_site, skew_only);
+  rep.proposed += static_cast<int>(moves.size());
+  proposed_last_ = static_cast<int>(moves.size());
+  if (moves.empty()) return unchanged();
+
+  // Rebuild with the moves; an invalid diagram keeps the first half of them, down to none.
+  TransitionCells fresh;
+  size_t keep = moves.size();
+  diagram_.save();  // the diagram of `out`: the rebuild with the kept moves alone starts from it
+  while (!rebuild(fresh, out.base_node_id)) {
+    const size_t half = keep / 2;
+    for (size_t i = half; i < keep; ++i) restore(moves[i].site, moves[i].before);
+    if (keep == 1) refused_.insert(moves[0].tag);
+    rep.invalid += static_cast<int>(keep - half);
+    keep = half;
+    if (keep == 0) {
+      moves.clear();
+      return unchanged();
+    }
+  }
+  moves.resize(keep);
+  // Keep a move by what it did to the cells around it (move_is_kept), its neighbours before and
+  // after the move (a diagram of the same sites: cell c is the same site's in both).
+  Measured after = measure(fresh);
+  for (Move& m : moves)
+    if (cell_of_site[m.site] >= 0) add_cell_and_neighbours(after.sub, cell_of_site[m.site], m.region);
+  const std::vector<Move> kept = judge(moves, out, now, fresh, after);
   rep.refused += static_cast<int>(moves.size() - kept.size());
   if (kept.empty()) {
     return unchanged();
