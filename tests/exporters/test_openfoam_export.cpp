@@ -322,6 +322,7 @@ TEST_P(CheckMeshExampleInPermeabilityFrame, HybridMeshPasses) {
   REQUIRE_CHECKMESH();
   const std::string name = GetParam(), dir = std::string(HM_SOURCE_DIR) + "/examples";
   std::ifstream in(dir + "/" + name + ".yaml");
+  ASSERT_TRUE(in.good()) << name;
   std::stringstream text;
   text << "metric: permeability\n" << in.rdbuf();
   const hm::CaseSpec cs = hm::parse_case(text.str(), dir);

@@ -435,9 +435,8 @@ TEST(RealisticSweep, RawDiagramsLeaveNoFaceAboveCheckMeshLimit) {
 
 // A skewed face whose own two sites had no step left that lowered it stayed as it was: seeds 3182
 // (optimisation asked; its cavity reaches the boundary and is not optimised), 3140 (optimised) and
-// 3196 (no optimisation) were
-// written with faces at 12.0, 4.37 and 4.08. Such a face now gets steps of its cells' face neighbours
-// (docs/optimization.md, "Steps of a skewed face's neighbours").
+// 3196 (no optimisation) were written with faces at 12.0, 4.37 and 4.08. Such a face now gets steps
+// of its cells' face neighbours (docs/optimization.md, "Steps of a skewed face's neighbours").
 TEST(RealisticSweep, SkewedFacesWithoutOwnStepsGetTheirNeighboursSteps) {
   for (const uint32_t seed : {3182u, 3140u, 3196u}) {
     const RealisticOptions o = sweep_options(seed);
