@@ -809,22 +809,22 @@ std::vector<Move> SiteOptimizer::judge(const std::vector<Move>& moves, const Tra
   // through a power vertex it shares with a moved site's cell: the moves whose cells share a node
   // with it are refused, and all of them only when no moved site's cell does.
   const std::vector<char> worse = new_failures(out, now, fresh, after);
-  std::vector<char> stray(worse);
-  for (const Move& m : moves)
-    for (int c : m.region) stray[c] = 0;
   std::vector<char> applied(ns, 0);  // the moves in this rebuild (the halving may have undone some)
   for (const Move& m : moves) applied[m.site] = 1;
+  // The moved sites to blame for the flagged cells outside every move's region.
+  auto blame_strays = [&](std::vector<char> cells, bool* unattributed) {
+    for (const Move& m : moves)
+      for (int c : m.region) cells[c] = 0;
+    return moved_sites_sharing_a_node(cells, now.sub, after.sub, out.cell_site, applied, unattributed);
+  };
   bool unattributed = false;
-  const std::vector<char> blamed = moved_sites_sharing_a_node(stray, now.sub, after.sub, out.cell_site, applied, &unattributed);
+  const std::vector<char> blamed = blame_strays(worse, &unattributed);
   // Likewise a cell with more faces above checkMesh's limit in no move's region: a step against
   // skewness is refused when its site's cell shares a node with one.
-  std::vector<char> stray_skewed(nc, 0);
-  for (int c = 0; c < nc; ++c) stray_skewed[c] = skewed2[c] > skewed[c];
-  for (const Move& m : moves)
-    for (int c : m.region) stray_skewed[c] = 0;
+  std::vector<char> more_skewed(nc, 0);
+  for (int c = 0; c < nc; ++c) more_skewed[c] = skewed2[c] > skewed[c];
   bool skew_unattributed = false;
-  const std::vector<char> skew_blamed =
-      moved_sites_sharing_a_node(stray_skewed, now.sub, after.sub, out.cell_site, applied, &skew_unattributed);
+  const std::vector<char> skew_blamed = blame_strays(std::move(more_skewed), &skew_unattributed);
   std::vector<Move> kept;
   for (const Move& m : moves) {
     MoveEffect e;
