@@ -493,7 +493,9 @@ class SiteOptimizer {
   // factor 0.95 (size 2: 0.8), a free site toward (or away from) `other` by a tenth (a fifth)
   // of their distance. Small steps first: sites left by the correction at the edge of
   // condition (6) only allow those.
-  bool trial_step(int s, int other, bool away, int size, Move* m);
+  // `level` > 0: a streak's step (SkewStreak), the polygon factor raised to the power 2^level, the
+  // free site's fraction times 2^level (at most 0.4).
+  bool trial_step(int s, int other, bool away, int size, Move* m, int level = 0);
 
   SiteSet& set_;
   const Cavity& cavity_;
@@ -517,6 +519,20 @@ class SiteOptimizer {
   std::set<std::array<int, 9>> refused_;
   SiteSlab slab_;  // the sites by x, for centred(): reset at each round's start
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
+  // A site's run of kept steps against skewed faces (its own face's or a neighbour's; the same other
+  // site, direction and size): each one kept doubles the next step's exponent, up to kMaxStreak; a
+  // refused one ends the run (docs/optimization.md, "Streaks").
+  struct SkewStreak {
+    int other = -1, k = 0, level = 0;
+  };
+  static constexpr int kMaxStreak = 4;
+  std::vector<SkewStreak> streak_;
+  SkewStreak streak_of(int s) const { return static_cast<size_t>(s) < streak_.size() ? streak_[s] : SkewStreak{}; }
+  void record_streak(const Move& m, bool kept) {
+    if (m.kind != MoveKind::SkewStep || m.tag[0] != -2) return;  // steps, not removals
+    if (streak_.size() <= static_cast<size_t>(m.site)) streak_.resize(m.site + 1);
+    streak_[m.site] = kept ? SkewStreak{m.tag[2], m.tag[3], std::min(m.tag[4] + 1, kMaxStreak)} : SkewStreak{};
+  }
   int skewed_left_ = 0;
   int proposed_last_ = 0;
   // Pass::Slivers: only removals of sliver edges (below kSliverEdge h), kept unless a cell newly
@@ -575,19 +591,19 @@ bool SiteOptimizer::trial_move(int d, int a, Vec3 x, double max_shift, double ra
   return ok;
 }
 
-bool SiteOptimizer::trial_step(int s, int other, bool away, int size, Move* m) {
+bool SiteOptimizer::trial_step(int s, int other, bool away, int size, Move* m, int level) {
   const Site& site = set_.sites[s];
   m->site = s;
   m->before = state(s);
   if (site.kind == SiteKind::InternalPolygon) {
     const int q = site.polygon;
-    const double kStep = size == 1 ? 0.95 : 0.8;
+    const double kStep = std::pow(size == 1 ? 0.95 : 0.8, 1 << level);
     const double t = away ? std::min(site.t / kStep, max_t(set_, q, frames_)) : std::max(site.t * kStep, min_t(frames_, q));
     if (!(std::abs(t - site.t) > 1e-3 * site.t)) return false;
     place_polygon_site(set_, s, t, cavity_, coords_, frames_);
   } else if (site.kind == SiteKind::Free) {
     const Vec3 d = site.p - set_.sites[other].p;
-    set_.sites[s].p = site.p + (away ? 0.1 : -0.1) * size * d;
+    set_.sites[s].p = site.p + (away ? 0.1 : -0.1) * std::min(size * (1 << level), 4) * d;
   } else {
     return false;
   }
@@ -688,6 +704,16 @@ std::vector<Move> SiteOptimizer::propose(const TransitionCells& out, const Measu
     const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
     if (moved[s1] || moved[s2] || locked[s1] || locked[s2]) continue;
     Move best;
+    // A site on a streak against this face first: its last kept step, with the exponent doubled.
+    for (int s : {s1, s2}) {
+      const int other = s == s1 ? s2 : s1;
+      const SkewStreak st = streak_of(s);
+      if (best.site >= 0 || st.level == 0 || st.k >= 8 || st.other != other) continue;
+      Move m;
+      m.tag = {-2, s, other, st.k, st.level, 0, 0, 0, 0};
+      m.kind = MoveKind::SkewStep;
+      if (!refused_.count(m.tag) && trial_step(s, other, st.k % 2 == 1, st.k < 4 ? 1 : 2, &m, st.level)) best = m;
+    }
     // Small steps of either site in either direction first, then larger ones.
     for (int k = 0; k < 8 && best.site < 0; ++k) {
       const int s = k % 4 < 2 ? s1 : s2, other = k % 4 < 2 ? s2 : s1;
@@ -746,22 +772,33 @@ std::vector<Move> SiteOptimizer::propose(const TransitionCells& out, const Measu
     if (!skew_only && pass_ != Pass::Skewness) break;
     const int s1 = out.cell_site[sub.face_owner[f]], s2 = out.cell_site[sub.face_neighbour[f]];
     if (moved[s1] || moved[s2] || locked[s1] || locked[s2]) continue;
+    // A neighbour on a streak against this face first (its last kept step, the exponent doubled),
+    // then the neighbours' small steps, then their larger ones.
+    auto neighbour_step = [&](int mover, int s, bool streak) {
+      const bool polygon = set_.sites[mover].kind == SiteKind::InternalPolygon;
+      const int other = polygon ? -1 : s;
+      const SkewStreak st = streak_of(mover);
+      const int first = streak ? st.k - 8 : 0, last = streak ? first + 1 : 4;
+      if (streak && !(st.level > 0 && st.k >= 8 && st.other == other)) return Move{};
+      for (int k = first; k < last; ++k) {
+        Move m;
+        m.tag = {-2, mover, other, 8 + k, streak ? st.level : 0, 0, 0, 0, 0};
+        m.kind = MoveKind::SkewStep;
+        if (!refused_.count(m.tag) && trial_step(mover, s, k % 2 == 1, k < 2 ? 1 : 2, &m, m.tag[4])) return m;
+      }
+      return Move{};
+    };
     Move best;
-    for (int s : {s1, s2}) {
-      for (int n : region_of(s)) {
-        const int mover = out.cell_site[n];
-        if (mover == s1 || mover == s2 || moved[mover] || locked[mover]) continue;
-        const bool polygon = set_.sites[mover].kind == SiteKind::InternalPolygon;
-        for (int k = 0; k < 4 && best.site < 0; ++k) {
-          Move m;
-          m.tag = {-2, mover, polygon ? -1 : s, 8 + k, 0, 0, 0, 0, 0};
-          m.kind = MoveKind::SkewStep;
-          if (!refused_.count(m.tag) && trial_step(mover, s, k % 2 == 1, k < 2 ? 1 : 2, &m)) best = m;
+    for (int streak = 1; streak >= 0 && best.site < 0; --streak)
+      for (int s : {s1, s2}) {
+        for (int n : region_of(s)) {
+          const int mover = out.cell_site[n];
+          if (mover == s1 || mover == s2 || moved[mover] || locked[mover]) continue;
+          best = neighbour_step(mover, s, streak == 1);
+          if (best.site >= 0) break;
         }
         if (best.site >= 0) break;
       }
-      if (best.site >= 0) break;
-    }
     if (best.site >= 0) admit(best);
   }
   // Cells failing a shape check that no move above touches: a step of the cell's site or of a face
@@ -837,7 +874,9 @@ std::vector<Move> SiteOptimizer::judge(const std::vector<Move>& moves, const Tra
       e.worst_skew_after = std::max(e.worst_skew_after, max_skew2[c]);
       e.failing_before += now.failing.cell[c], e.failing_after += failing2[c];
     }
-    if (move_is_kept(e, m.kind)) kept.push_back(m);
+    const bool keep = move_is_kept(e, m.kind);
+    record_streak(m, keep);
+    if (keep) kept.push_back(m);
     else restore(m.site, m.before), refused_.insert(m.tag);
   }
   return kept;
