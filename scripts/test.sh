@@ -40,8 +40,14 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
   # Also left out here, run in the Release pass: the slowest tests under ASan (13-94 s each, 4.5 min of the
   # pass's 17 min of test time: Reek and thin-layer refinement meshes of ~100k cells, a K-orthogonal case
   # meshed in two metrics; and the sliver test's 545k-cell benchmark grid, 7 s in Release), whose code paths the smaller corner-point, refinement and permeability-
-  # frame tests that stay here exercise too.
+  # frame tests that stay here exercise too. Since session 45 also the next five (50-180 s each under
+  # ASan, 464 s of the pass's 1600 s of test time): the corner-point sweep's CI subset (its cases' paths:
+  # CornerPointSweep.CiThreeWellCase, .CiHorizontalSurvey, .FrameSplit*, CornerPointSurface.*), the
+  # shrink wave along a long well (the correction's loop, which every realistic case runs), the fault of
+  # ten metres and the second well beside the first's children (CornerPointSurface.WellReachingTheTopAcross*,
+  # CiThreeWellCase), and the flat ends of a large ring ratio (RealisticSweep.CiSubsetWellsThroughTopAndBottom*).
   asan_long='CornerPointSweep\.CiHorizontalSeed2.*|SiteOptimizer\.SliverPass.*|NearWellRefinement\.(ThinLayersInCoarseCellsMesh|Reek.*)|PermeabilityFrameMesh\.KOrthogonalNearTheWell.*|MeshgenReekExample\..*|CornerPointWells\.Reek.*|LocalFrame\.Optimised.*'
+  asan_long+='|CornerPointSweep\.CiSubsetMeshesSoundly|RealisticSweep\.ShrinkWaveAlongALongWellConverges|CornerPointWells\.(WellAcrossAFaultOfTenMetres|SecondWellBesideTheFirstOnesChildren)MeshesSoundly|RealisticSweep\.FlatEndsWithLargeRingRatio.*'
   (cd build-asan && ctest --output-on-failure -j"$jobs" \
     -E "^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation|MeshPictures|Examples/VtkAgreement|VtkAgreement|$asan_long)")
 fi
