@@ -496,6 +496,15 @@ class SiteOptimizer {
   // `level` > 0: a streak's step (SkewStreak), the polygon factor raised to the power 2^level, the
   // free site's fraction times 2^level (at most 0.4).
   bool trial_step(int s, int other, bool away, int size, Move* m, int level = 0);
+  // That step as a move against skewness, tagged {-2, s, tag_other, k, level}; none (site -1) if that
+  // tag was refused before or the step leaves condition (6).
+  Move skew_step(int s, int other, int tag_other, int k, bool away, int size, int level) {
+    Move m;
+    m.tag = {-2, s, tag_other, k, level, 0, 0, 0, 0};
+    m.kind = MoveKind::SkewStep;
+    if (refused_.count(m.tag) || !trial_step(s, other, away, size, &m, level)) return Move{};
+    return m;
+  }
 
   SiteSet& set_;
   const Cavity& cavity_;
@@ -709,18 +718,12 @@ std::vector<Move> SiteOptimizer::propose(const TransitionCells& out, const Measu
       const int other = s == s1 ? s2 : s1;
       const SkewStreak st = streak_of(s);
       if (best.site >= 0 || st.level == 0 || st.k >= 8 || st.other != other) continue;
-      Move m;
-      m.tag = {-2, s, other, st.k, st.level, 0, 0, 0, 0};
-      m.kind = MoveKind::SkewStep;
-      if (!refused_.count(m.tag) && trial_step(s, other, st.k % 2 == 1, st.k < 4 ? 1 : 2, &m, st.level)) best = m;
+      best = skew_step(s, other, other, st.k, st.k % 2 == 1, st.k < 4 ? 1 : 2, st.level);
     }
     // Small steps of either site in either direction first, then larger ones.
     for (int k = 0; k < 8 && best.site < 0; ++k) {
       const int s = k % 4 < 2 ? s1 : s2, other = k % 4 < 2 ? s2 : s1;
-      Move m;
-      m.tag = {-2, s, other, k, 0, 0, 0, 0, 0};
-      m.kind = MoveKind::SkewStep;
-      if (!refused_.count(m.tag) && trial_step(s, other, k % 2 == 1, k < 4 ? 1 : 2, &m)) best = m;
+      best = skew_step(s, other, other, k, k % 2 == 1, k < 4 ? 1 : 2, 0);
     }
     if (best.site >= 0) admit(best);
     else unstepped.push_back(f);
@@ -781,10 +784,8 @@ std::vector<Move> SiteOptimizer::propose(const TransitionCells& out, const Measu
       const int first = streak ? st.k - 8 : 0, last = streak ? first + 1 : 4;
       if (streak && !(st.level > 0 && st.k >= 8 && st.other == other)) return Move{};
       for (int k = first; k < last; ++k) {
-        Move m;
-        m.tag = {-2, mover, other, 8 + k, streak ? st.level : 0, 0, 0, 0, 0};
-        m.kind = MoveKind::SkewStep;
-        if (!refused_.count(m.tag) && trial_step(mover, s, k % 2 == 1, k < 2 ? 1 : 2, &m, m.tag[4])) return m;
+        const Move m = skew_step(mover, s, other, 8 + k, k % 2 == 1, k < 2 ? 1 : 2, streak ? st.level : 0);
+        if (m.site >= 0) return m;
       }
       return Move{};
     };
