@@ -85,12 +85,18 @@ std::vector<VtuCellArray> mesh_cell_arrays(const PolyMesh& m) {
     a.name = f.name;
     a.components = f.components;
     a.integer = f.integer;
-    for (size_t c = 0; c < nc; ++c)
-      for (int d = 0; d < f.components; ++d) {
-        const double v = f.get(m, c, d);
-        if (f.integer) a.ints.push_back(static_cast<int32_t>(v));
-        else a.values.push_back(v);
-      }
+    const size_t n = nc * static_cast<size_t>(f.components);
+    if (f.integer) a.ints.resize(n);
+    else a.values.resize(n);
+    parallel_ranges(static_cast<int64_t>(nc), [&](int64_t begin, int64_t end) {
+      for (size_t c = static_cast<size_t>(begin); c < static_cast<size_t>(end); ++c)
+        for (int d = 0; d < f.components; ++d) {
+          const double v = f.get(m, c, d);
+          const size_t i = c * static_cast<size_t>(f.components) + static_cast<size_t>(d);
+          if (f.integer) a.ints[i] = static_cast<int32_t>(v);
+          else a.values[i] = v;
+        }
+    });
     out.push_back(std::move(a));
   }
   return out;

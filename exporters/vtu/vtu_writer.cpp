@@ -13,6 +13,7 @@
 #include "exporters/vtu/vtu_mesh_arrays.hpp"
 #include "meshgen/core/fv_quality.hpp"
 #include "meshgen/core/mesh_builder.hpp"
+#include "meshgen/core/parallel.hpp"
 #include "meshgen/core/text_file.hpp"
 
 namespace hm {
@@ -26,14 +27,20 @@ bool host_is_little_endian() {
   return b == 1;
 }
 
-// One appended block: the DataArray header line and a view of the raw bytes (without the
-// UInt64 count); the bytes stay in the arrays they come from (no copy of the mesh).
+// One appended block: the DataArray header line and views of the raw bytes (without the UInt64
+// count), written one after the other; the bytes stay in the arrays they come from (no copy of the
+// mesh, nor of the chunks the topology is built in).
 struct Block {
   std::string type, name;
   int components = 1;
   int64_t tuples = -1;  // NumberOfTuples (field data only)
-  const char* data = nullptr;
+  std::vector<std::pair<const char*, size_t>> pieces;
   size_t size = 0;
+  template <class T>
+  void append(const std::vector<T>& v) {
+    pieces.push_back({reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T)});
+    size += v.size() * sizeof(T);
+  }
 };
 
 template <class T>
@@ -42,8 +49,7 @@ Block make_block(const std::string& type, const std::string& name, int component
   b.type = type;
   b.name = name;
   b.components = components;
-  b.data = reinterpret_cast<const char*>(v.data());
-  b.size = v.size() * sizeof(T);
+  b.append(v);
   return b;
 }
 
@@ -143,6 +149,74 @@ bool as_standard_cell(const StandardCell& type, const std::vector<int32_t>& node
   return true;
 }
 
+// The topology arrays of a run of consecutive cells: offsets and faceoffsets from the run's start
+// until write_vtu shifts them.
+struct TopologyChunk {
+  std::vector<int64_t> connectivity, offsets, faces, faceoffsets;
+  std::vector<int32_t> face_patch;
+  std::vector<double> face_mult;  // PolyMesh::face_trans_mult, in face_patch's order
+};
+constexpr size_t kCellsPerChunk = 16384;  // a fixed partition: the file does not depend on the threads
+
+// A cell's outward cycles, flat (reused from cell to cell).
+struct CellScratch {
+  std::vector<int32_t> local;
+  std::vector<int> local_off;
+  std::vector<int32_t> local_patch;
+  std::vector<double> local_mult;
+};
+
+// Appends cell c to `out` and sets its VTK type.
+void append_cell_topology(const PolyMesh& m, int c, bool has_mult, CellScratch& s, TopologyChunk& out,
+                          uint8_t& type) {
+  s.local.clear();
+  s.local_off.assign(1, 0);
+  s.local_patch.clear();
+  s.local_mult.clear();
+  for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+    const int f = *fp, k = m.face_size(f);
+    const int32_t* v = m.face_begin(f);
+    const bool own = m.face_owner[f] == c;
+    // The neighbour sees the face reversed: v0, v_{k-1}, ..., v1.
+    for (int i = 0; i < k; ++i) s.local.push_back(own ? v[i] : v[(k - i) % k]);
+    s.local_off.push_back(static_cast<int>(s.local.size()));
+    s.local_patch.push_back(m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f]);
+    if (has_mult) s.local_mult.push_back(m.face_trans_mult[f]);
+  }
+  std::array<int32_t, 8> pts{};
+  std::array<int, 6> which{};
+  const StandardCell* standard = nullptr;
+  for (const StandardCell* t : {&kHexahedron, &kWedge})
+    if (!standard && as_standard_cell(*t, s.local, s.local_off, &pts, &which)) standard = t;
+  if (standard) {
+    type = standard->vtk_type;
+    out.connectivity.insert(out.connectivity.end(), pts.begin(), pts.begin() + standard->n_points);
+    for (int k = 0; k < standard->n_faces; ++k) out.face_patch.push_back(s.local_patch[which[k]]);
+    if (has_mult)
+      for (int k = 0; k < standard->n_faces; ++k) out.face_mult.push_back(s.local_mult[which[k]]);
+  } else {
+    type = 42;
+    const size_t first_point = out.connectivity.size();
+    const size_t n_local = s.local_off.size() - 1;
+    out.faces.push_back(static_cast<int64_t>(n_local));
+    for (size_t q = 0; q < n_local; ++q) {
+      out.faces.push_back(static_cast<int64_t>(s.local_off[q + 1] - s.local_off[q]));
+      for (int i = s.local_off[q]; i < s.local_off[q + 1]; ++i) {
+        const int32_t id = s.local[i];
+        out.faces.push_back(id);
+        // The cell's distinct nodes in first-use order: a few dozen at most, searched in place.
+        if (std::find(out.connectivity.begin() + first_point, out.connectivity.end(), id) == out.connectivity.end())
+          out.connectivity.push_back(id);
+      }
+      out.face_patch.push_back(s.local_patch[q]);
+      if (has_mult) out.face_mult.push_back(s.local_mult[q]);
+    }
+  }
+  out.offsets.push_back(static_cast<int64_t>(out.connectivity.size()));
+  // VTK's faceoffsets: end of the cell's face stream, -1 for a cell that is not a polyhedron.
+  out.faceoffsets.push_back(type == 42 ? static_cast<int64_t>(out.faces.size()) : -1);
+}
+
 }  // namespace
 
 WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vector<VtuCellArray>& extra) {
@@ -166,83 +240,49 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   // Topology: hexahedra as VTK_HEXAHEDRON (12), triangular prisms as VTK_WEDGE (13); every other cell
   // as VTK_POLYHEDRON (42) with its distinct nodes in first-use order and its outward faces. face_patch
   // follows the faces as a reader sees them: the face stream of a polyhedron, VTK's face order otherwise.
-  std::vector<int64_t> connectivity, offsets, faces, faceoffsets;
+  // Built in chunks of cells in parallel, each chunk's offsets then shifted by the chunks before it.
   std::vector<uint8_t> types(nc, 42);
-  std::vector<int32_t> face_patch;
-  // The faces' transmissibility multipliers (PolyMesh::face_trans_mult), in face_patch's order.
   const bool has_mult = !m.face_trans_mult.empty();
-  std::vector<double> face_mult;
-  std::vector<int64_t> stamp(m.nodes.size(), -1);
-  // The cell's outward cycles, flat (reused from cell to cell).
-  std::vector<int32_t> local;
-  std::vector<int> local_off;
-  std::vector<int32_t> local_patch;
-  std::vector<double> local_mult;
-  bool any_polyhedron = false;
-  connectivity.reserve(8 * nc);
-  offsets.reserve(nc);
-  faceoffsets.reserve(nc);
-  face_patch.reserve(m.cell_faces.size());
-  for (size_t c = 0; c < nc; ++c) {
-    const int ci = static_cast<int>(c);
-    local.clear();
-    local_off.assign(1, 0);
-    local_patch.clear();
-    local_mult.clear();
-    for (const int32_t* fp = m.cell_begin(ci); fp != m.cell_end(ci); ++fp) {
-      const int f = *fp, k = m.face_size(f);
-      const int32_t* v = m.face_begin(f);
-      const bool own = m.face_owner[f] == ci;
-      // The neighbour sees the face reversed: v0, v_{k-1}, ..., v1.
-      for (int i = 0; i < k; ++i) local.push_back(own ? v[i] : v[(k - i) % k]);
-      local_off.push_back(static_cast<int>(local.size()));
-      local_patch.push_back(m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f]);
-      if (has_mult) local_mult.push_back(m.face_trans_mult[f]);
-    }
-    std::array<int32_t, 8> pts{};
-    std::array<int, 6> which{};
-    const StandardCell* standard = nullptr;
-    for (const StandardCell* type : {&kHexahedron, &kWedge})
-      if (!standard && as_standard_cell(*type, local, local_off, &pts, &which)) standard = type;
-    if (standard) {
-      types[c] = standard->vtk_type;
-      connectivity.insert(connectivity.end(), pts.begin(), pts.begin() + standard->n_points);
-      for (int k = 0; k < standard->n_faces; ++k) face_patch.push_back(local_patch[which[k]]);
-      if (has_mult)
-        for (int k = 0; k < standard->n_faces; ++k) face_mult.push_back(local_mult[which[k]]);
-    } else {
-      any_polyhedron = true;
-      const size_t n_local = local_off.size() - 1;
-      faces.push_back(static_cast<int64_t>(n_local));
-      for (size_t q = 0; q < n_local; ++q) {
-        faces.push_back(static_cast<int64_t>(local_off[q + 1] - local_off[q]));
-        for (int i = local_off[q]; i < local_off[q + 1]; ++i) {
-          const int32_t id = local[i];
-          faces.push_back(id);
-          if (stamp[id] != static_cast<int64_t>(c)) {
-            stamp[id] = static_cast<int64_t>(c);
-            connectivity.push_back(id);
-          }
+  const int64_t n_chunks = static_cast<int64_t>((nc + kCellsPerChunk - 1) / kCellsPerChunk);
+  std::vector<TopologyChunk> chunks(static_cast<size_t>(n_chunks));
+  parallel_ranges(
+      n_chunks,
+      [&](int64_t first, int64_t last) {
+        CellScratch scratch;
+        for (int64_t k = first; k < last; ++k) {
+          const size_t begin = static_cast<size_t>(k) * kCellsPerChunk, end = std::min(nc, begin + kCellsPerChunk);
+          for (size_t c = begin; c < end; ++c)
+            append_cell_topology(m, static_cast<int>(c), has_mult, scratch, chunks[k], types[c]);
         }
-        face_patch.push_back(local_patch[q]);
-        if (has_mult) face_mult.push_back(local_mult[q]);
-      }
-    }
-    offsets.push_back(static_cast<int64_t>(connectivity.size()));
-    // VTK's faceoffsets: end of the cell's face stream, -1 for a cell that is not a polyhedron.
-    faceoffsets.push_back(types[c] == 42 ? static_cast<int64_t>(faces.size()) : -1);
+      },
+      1);
+  bool any_polyhedron = false;
+  int64_t connectivity_base = 0, faces_base = 0;
+  for (TopologyChunk& t : chunks) {
+    for (int64_t& o : t.offsets) o += connectivity_base;
+    for (int64_t& o : t.faceoffsets)
+      if (o >= 0) o += faces_base;
+    connectivity_base += static_cast<int64_t>(t.connectivity.size());
+    faces_base += static_cast<int64_t>(t.faces.size());
+    any_polyhedron = any_polyhedron || !t.faces.empty();
   }
-  stamp = {};
+  auto chunked_block = [&](const std::string& type, const std::string& name, auto member) {
+    Block b;
+    b.type = type;
+    b.name = name;
+    for (const TopologyChunk& t : chunks) b.append(t.*member);
+    return b;
+  };
   std::vector<double> points(3 * m.nodes.size());
   for (size_t i = 0; i < m.nodes.size(); ++i) {
     points[3 * i] = m.nodes[i].x;
     points[3 * i + 1] = m.nodes[i].y;
     points[3 * i + 2] = m.nodes[i].z;
   }
-  Block field = make_block("Int32", "face_patch", 1, face_patch);
-  field.tuples = static_cast<int64_t>(face_patch.size());
-  Block mult_field = make_block("Float64", "face_trans_mult", 1, face_mult);
-  mult_field.tuples = static_cast<int64_t>(face_mult.size());
+  Block field = chunked_block("Int32", "face_patch", &TopologyChunk::face_patch);
+  field.tuples = static_cast<int64_t>(field.size / sizeof(int32_t));
+  Block mult_field = chunked_block("Float64", "face_trans_mult", &TopologyChunk::face_mult);
+  mult_field.tuples = static_cast<int64_t>(mult_field.size / sizeof(double));
   // The mesh's reservoir cells are a corner-point model's (PolyMesh::reservoir_cells_are_model).
   const std::vector<int32_t> one{1};
   Block model_field = make_block("Int32", "reservoir_cells_are_model", 1, one);
@@ -256,11 +296,12 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   Block nnc_trans_field = make_block("Float64", "nnc_trans", 1, m.nnc_trans);
   nnc_trans_field.tuples = m.n_nncs();
   std::vector<Block> point_blocks{make_block("Float64", "Points", 3, points)};
-  std::vector<Block> cell_blocks{make_block("Int64", "connectivity", 1, connectivity),
-                                 make_block("Int64", "offsets", 1, offsets), make_block("UInt8", "types", 1, types)};
+  std::vector<Block> cell_blocks{chunked_block("Int64", "connectivity", &TopologyChunk::connectivity),
+                                 chunked_block("Int64", "offsets", &TopologyChunk::offsets),
+                                 make_block("UInt8", "types", 1, types)};
   if (any_polyhedron) {
-    cell_blocks.push_back(make_block("Int64", "faces", 1, faces));
-    cell_blocks.push_back(make_block("Int64", "faceoffsets", 1, faceoffsets));
+    cell_blocks.push_back(chunked_block("Int64", "faces", &TopologyChunk::faces));
+    cell_blocks.push_back(chunked_block("Int64", "faceoffsets", &TopologyChunk::faceoffsets));
   }
   std::vector<Block> data_blocks;
   const std::vector<VtuCellArray> own_arrays = mesh_cell_arrays(m);
@@ -302,7 +343,7 @@ WriteStatus write_vtu(const std::string& path, const PolyMesh& m, const std::vec
   auto emit = [&](const Block& b) {
     const uint64_t n = b.size;
     out.write(reinterpret_cast<const char*>(&n), sizeof n);
-    out.write(b.data, static_cast<std::streamsize>(b.size));
+    for (const auto& [data, size] : b.pieces) out.write(data, static_cast<std::streamsize>(size));
   };
   emit(field);
   if (has_mult) emit(mult_field);

@@ -9,7 +9,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "exporters/vtu/vtu_reader.hpp"
@@ -256,6 +258,37 @@ void expect_same_mesh(const PolyMesh& q, const PolyMesh& m) {
   }
 }
 
+// The cells of m in a builder, those in `split` with their first outer-boundary quad cut in two
+// triangles (one of them a wellbore face): polyhedra of seven faces, hanging-node free.
+// Attributes: region and FV centre as in m, radial.well = the cell's index.
+MeshBuilder with_a_boundary_face_split(const PolyMesh& m, const std::set<int>& split) {
+  MeshBuilder mb;
+  for (const Vec3& p : m.nodes) mb.add_node(p);
+  for (int c = 0; c < m.n_cells(); ++c) {
+    std::vector<CellFace> faces;
+    bool cut = false;
+    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
+      const int f = *fp, k = m.face_size(f);
+      CellFace cf;
+      for (int i = 0; i < k; ++i) cf.nodes.push_back(m.face_owner[f] == c ? m.face_begin(f)[i] : m.face_begin(f)[(k - i) % k]);
+      cf.patch = m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f];
+      if (!cut && split.count(c) && m.face_neighbour[f] < 0 && k == 4 && cf.patch == kOuterBoundary) {
+        faces.push_back({{cf.nodes[0], cf.nodes[1], cf.nodes[2]}, wellbore_patch(1)});
+        faces.push_back({{cf.nodes[0], cf.nodes[2], cf.nodes[3]}, kOuterBoundary});
+        cut = true;
+        continue;
+      }
+      faces.push_back(cf);
+    }
+    CellAttributes at;
+    at.region = m.cell_region[c];
+    at.fv_center = m.cell_fv_center[c];
+    at.radial.well = c;
+    mb.add_cell(faces, at);
+  }
+  return mb;
+}
+
 }  // namespace
 
 // ------------------------------------------------------------ writer + reader round trip
@@ -312,29 +345,7 @@ TEST(VtuRoundTrip, PolyhedraAndHexahedraTogether) {
     if (m.face_neighbour[f] < 0 && f % 3 == 0) m.face_patch[f] = wellbore_patch(f % 2);
   // Turn cell 0 into a polyhedron by rotating one face's cycle: still a hexahedron for VTK. So
   // instead give it a seventh face by cutting a boundary face in two (a hanging-free split).
-  MeshBuilder mb;
-  for (const Vec3& p : m.nodes) mb.add_node(p);
-  for (int c = 0; c < m.n_cells(); ++c) {
-    std::vector<CellFace> faces;
-    for (const int32_t* fp = m.cell_begin(c); fp != m.cell_end(c); ++fp) {
-      const int f = *fp, k = m.face_size(f);
-      CellFace cf;
-      for (int i = 0; i < k; ++i) cf.nodes.push_back(m.face_owner[f] == c ? m.face_begin(f)[i] : m.face_begin(f)[(k - i) % k]);
-      cf.patch = m.face_neighbour[f] >= 0 ? kInteriorFace : m.face_patch[f];
-      if (c == 0 && m.face_neighbour[f] < 0 && k == 4 && faces.size() < 7 && cf.patch == kOuterBoundary &&
-          std::none_of(faces.begin(), faces.end(), [](const CellFace& x) { return x.nodes.size() == 3; })) {
-        faces.push_back({{cf.nodes[0], cf.nodes[1], cf.nodes[2]}, wellbore_patch(1)});
-        faces.push_back({{cf.nodes[0], cf.nodes[2], cf.nodes[3]}, kOuterBoundary});
-        continue;
-      }
-      faces.push_back(cf);
-    }
-    CellAttributes at;
-    at.region = m.cell_region[c];
-    at.fv_center = m.cell_fv_center[c];
-    at.radial.well = c;
-    mb.add_cell(faces, at);
-  }
+  MeshBuilder mb = with_a_boundary_face_split(m, {0});
   BuildReport br;
   const PolyMesh q = mb.finish(&br);
   ASSERT_TRUE(br.ok);
@@ -347,6 +358,40 @@ TEST(VtuRoundTrip, PolyhedraAndHexahedraTogether) {
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_TRUE(r.build.ok);
   expect_same_mesh(r.mesh, q);
+  fs::remove_all(d);
+}
+
+// The writer builds the topology in chunks of cells in parallel (16384 cells each) and shifts each
+// chunk's offsets by the chunks before it: a mesh of several chunks with polyhedra in the first, a
+// middle and the last one, between hexahedra, and a multiplier on every face; read back, the same
+// mesh and multipliers.
+TEST(VtuRoundTrip, CellsInSeveralChunksKeepTheirOffsets) {
+  const PolyMesh grid = box_grid(40, 30, 30, true);
+  ASSERT_GT(grid.n_cells(), 2 * 16384);
+  BuildReport br;
+  PolyMesh q = with_a_boundary_face_split(grid, {0, 20000, grid.n_cells() - 1}).finish(&br);
+  ASSERT_TRUE(br.ok);
+  q.face_trans_mult.resize(q.n_faces());
+  for (int f = 0; f < q.n_faces(); ++f) q.face_trans_mult[f] = 1.0 + f / 3.0;
+  const fs::path d = temp_dir("chunks");
+  const std::string path = (d / "mesh.vtu").string();
+  ASSERT_TRUE(write_vtu(path, q).ok);
+  const ReadResult r = read_vtu(path);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_TRUE(r.build.ok);
+  expect_same_mesh(r.mesh, q);
+  // Each face's multiplier, matched by its nodes.
+  std::map<std::vector<int32_t>, double> mult;
+  auto key_of = [](const PolyMesh& m, int f) {
+    std::vector<int32_t> k(m.face_begin(f), m.face_end(f));
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  for (int f = 0; f < q.n_faces(); ++f) mult[key_of(q, f)] = q.face_trans_mult[f];
+  ASSERT_EQ(r.mesh.face_trans_mult.size(), static_cast<size_t>(r.mesh.n_faces()));
+  int differ = 0;
+  for (int f = 0; f < r.mesh.n_faces(); ++f) differ += mult.at(key_of(r.mesh, f)) != r.mesh.face_trans_mult[f];
+  EXPECT_EQ(differ, 0);
   fs::remove_all(d);
 }
 
