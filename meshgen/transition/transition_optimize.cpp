@@ -379,6 +379,7 @@ class SiteOptimizer {
   // entry, proposed_last() to the moves proposed.
   bool round(TransitionCells& out, SiteOptimizeReport& rep, bool skew_only);
   int skewed_left() const { return skewed_left_; }
+  double worst_skew_left() const { return worst_skew_left_; }  // the worst of them (0 if none)
   int proposed_last() const { return proposed_last_; }
   // Cells of the diagram a round left that fail a shape check (-1 before the first round).
   int64_t failing_now() const { return next_ ? next_->failing.count : -1; }
@@ -543,6 +544,7 @@ class SiteOptimizer {
     streak_[m.site] = kept ? SkewStreak{m.tag[2], m.tag[3], std::min(m.tag[4] + 1, kMaxStreak)} : SkewStreak{};
   }
   int skewed_left_ = 0;
+  double worst_skew_left_ = 0;
   int proposed_last_ = 0;
   // Pass::Slivers: only removals of sliver edges (below kSliverEdge h), kept unless a cell newly
   // fails a shape check: the pass run on a diagram that is not optimised (remove_sliver_edges).
@@ -895,6 +897,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
     return false;
   };
   skewed_left_ = static_cast<int>(now.skewed_faces.size());
+  worst_skew_left_ = now.max_skew.empty() ? 0.0 : *std::max_element(now.max_skew.begin(), now.max_skew.end());
   std::vector<int> cell_of_site(set_.sites.size(), -1);
   for (int c = 0; c < now.sub.n_cells(); ++c) cell_of_site[out.cell_site[c]] = c;
   std::vector<Move> moves = propose(out, now, cell_of_site, skew_only);
@@ -963,12 +966,35 @@ bool move_is_kept(const MoveEffect& e, MoveKind kind) {
 
 // Rounds against checkMesh's skewness, with and without optimisation: a round keeps about one step per
 // skewed face, and some faces need a dozen or more (docs/optimization.md, "Steps of a skewed face's
-// neighbours").
+// neighbours"). After kSkewRounds, more while they make progress (SkewRoundBudget).
 constexpr int kSkewRounds = 24;
 constexpr int kSliverRounds = 4;
 constexpr int kRepairRounds = 16;
 
 namespace {
+// The rounds against skewness: kSkewRounds, then up to kMaxSkewRounds as long as the faces above
+// checkMesh's limit reached a new low (fewer of them, or the same count with a lower worst) within
+// the last kSkewPatience rounds: faces a little above the limit that neighbours' steps lower by
+// hundredths a round (docs/optimization.md, "More rounds while they make progress").
+constexpr int kMaxSkewRounds = 64;
+constexpr int kSkewPatience = 8;
+class SkewRoundBudget {
+ public:
+  // Whether another round may run after `rounds` rounds.
+  bool more(int rounds) const {
+    return rounds < kSkewRounds || (rounds < kMaxSkewRounds && rounds - last_low_ <= kSkewPatience);
+  }
+  // The state a round started from (SiteOptimizer::skewed_left, worst_skew_left).
+  void record(int round, int faces, double worst) {
+    if (faces < faces_ || (faces == faces_ && worst < worst_)) faces_ = faces, worst_ = worst, last_low_ = round;
+  }
+
+ private:
+  int faces_ = std::numeric_limits<int>::max();
+  double worst_ = std::numeric_limits<double>::infinity();
+  int last_low_ = 0;
+};
+
 // An edge between two free vertices shorter than kSliverEdge x the h_ref of a cell it bounds.
 bool has_sliver_edge(const TransitionCells& t) {
   auto at = [&](int32_t v) { return t.new_nodes[v - t.base_node_id]; };
@@ -983,17 +1009,17 @@ bool has_sliver_edge(const TransitionCells& t) {
 }  // namespace
 
 namespace {
-// Up to max_rounds rounds of one pass without optimisation on `out`, until done(optimizer) after a
-// round or a round proposes nothing: a round whose moves were all refused has tagged them, and the
+// Rounds of one pass without optimisation on `out` while more(rounds done, optimizer), until
+// done(optimizer) after a round or a round proposes nothing: a round whose moves were all refused has tagged them, and the
 // next tries each one's next option. The first round measures the diagram. Returns the moves kept.
-template <class Done>
-int run_pass(Pass pass, int max_rounds, Done done, SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
+template <class More, class Done>
+int run_pass(Pass pass, More more, Done done, SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
              const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
              const std::vector<Vec3>& outside_centres, const BoundaryImages& images, TransitionCells& out) {
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;
   SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, pass);
-  while (rep.rounds < max_rounds) {
+  while (more(rep.rounds, optimizer)) {
     ++rep.rounds;
     if (!optimizer.round(out, rep, pass != Pass::Slivers) && optimizer.proposed_last() == 0) break;
     if (done(optimizer)) break;
@@ -1007,16 +1033,24 @@ int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Ve
                         const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                         const std::vector<Vec3>& outside_centres, TransitionCells& out) {
   if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
-  return run_pass(Pass::Slivers, kSliverRounds, [](const SiteOptimizer&) { return false; }, set, cavity, coords,
-                  frames, opt, outside_centres, kNoImages, out);
+  return run_pass(Pass::Slivers, [](int rounds, const SiteOptimizer&) { return rounds < kSliverRounds; },
+                  [](const SiteOptimizer&) { return false; }, set, cavity, coords, frames, opt, outside_centres,
+                  kNoImages, out);
 }
 
 int reduce_skewness(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
                     const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
                     const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
                     TransitionCells& out) {
-  return run_pass(Pass::Skewness, kSkewRounds, [](const SiteOptimizer& o) { return o.skewed_left() == 0; }, set,
-                  cavity, coords, frames, opt, outside_centres, images, out);
+  SkewRoundBudget budget;
+  return run_pass(
+      Pass::Skewness,
+      [&](int rounds, const SiteOptimizer& o) {
+        if (rounds > 0) budget.record(rounds, o.skewed_left(), o.worst_skew_left());
+        return budget.more(rounds);
+      },
+      [](const SiteOptimizer& o) { return o.skewed_left() == 0; }, set, cavity, coords, frames, opt, outside_centres,
+      images, out);
 }
 
 int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -1024,8 +1058,9 @@ int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<V
                          const std::vector<Vec3>& outside_centres, const BoundaryImages& images,
                          TransitionCells& out) {
   // It proposes nothing when no cell fails, the common case.
-  return run_pass(Pass::Repairs, kRepairRounds, [](const SiteOptimizer& o) { return o.failing_now() == 0; }, set,
-                  cavity, coords, frames, opt, outside_centres, images, out);
+  return run_pass(Pass::Repairs, [](int rounds, const SiteOptimizer&) { return rounds < kRepairRounds; },
+                  [](const SiteOptimizer& o) { return o.failing_now() == 0; }, set, cavity, coords, frames, opt,
+                  outside_centres, images, out);
 }
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -1039,11 +1074,13 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
     if (!optimizer.round(out, rep, false)) break;
   }
   // Faces above checkMesh's skewness limit left: a few more rounds against them alone.
-  for (int extra = 0; extra < kSkewRounds; ++extra) {
+  SkewRoundBudget budget;
+  for (int extra = 0; budget.more(extra); ++extra) {
     ++rep.rounds;
     // A round whose steps were all refused has tagged them: the next tries each face's next step.
     if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
     if (optimizer.skewed_left() == 0) break;
+    budget.record(extra + 1, optimizer.skewed_left(), optimizer.worst_skew_left());
   }
   // Cells failing a shape check left: rounds of repairs while untried options remain.
   for (int extra = 0; extra < kRepairRounds && optimizer.failing_now() != 0; ++extra) {

@@ -433,19 +433,23 @@ TEST(RealisticSweep, RawDiagramsLeaveNoFaceAboveCheckMeshLimit) {
   }
 }
 
+// The sweep case of `seed` (optimised as `optimized` says, which is asserted) meshes with no face
+// above checkMesh's skewness limit.
+void expect_within_check_mesh_skewness(uint32_t seed, bool optimized) {
+  const RealisticOptions o = sweep_options(seed);
+  ASSERT_EQ(o.optimize, optimized) << seed;
+  const RealisticCase rc = make_realistic_case(seed, o);
+  const CaseResult r = mesh_and_check(rc);
+  EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << ": " << r.reason;
+  EXPECT_LE(reported_skewness(r.reason), 4.0) << rc.label << ": " << r.reason;
+}
+
 // A skewed face whose own two sites had no step left that lowered it stayed as it was: seeds 3182
 // (optimisation asked; its cavity reaches the boundary and is not optimised), 3140 (optimised) and
 // 3196 (no optimisation) were written with faces at 12.0, 4.37 and 4.08. Such a face now gets steps
 // of its cells' face neighbours (docs/optimization.md, "Steps of a skewed face's neighbours").
 TEST(RealisticSweep, SkewedFacesWithoutOwnStepsGetTheirNeighboursSteps) {
-  for (const uint32_t seed : {3182u, 3140u, 3196u}) {
-    const RealisticOptions o = sweep_options(seed);
-    ASSERT_EQ(o.optimize, seed != 3196) << seed;
-    const RealisticCase rc = make_realistic_case(seed, o);
-    const CaseResult r = mesh_and_check(rc);
-    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << ": " << r.reason;
-    EXPECT_LE(reported_skewness(r.reason), 4.0) << rc.label << ": " << r.reason;
-  }
+  for (const uint32_t seed : {3182u, 3140u, 3196u}) expect_within_check_mesh_skewness(seed, seed != 3196);
 }
 
 // A skewed face whose step was kept took the same small step again the next round: seed 3203 (no
@@ -453,14 +457,15 @@ TEST(RealisticSweep, SkewedFacesWithoutOwnStepsGetTheirNeighboursSteps) {
 // face's skewness by 0.1 a round, written at 4.85 when the rounds ran out; 3278 (no optimisation) at 4.16. A kept
 // step is now followed by one with its exponent doubled (docs/optimization.md, "Streaks").
 TEST(RealisticSweep, KeptSkewnessStepsLengthen) {
-  for (const uint32_t seed : {3203u, 3278u}) {
-    const RealisticOptions o = sweep_options(seed);
-    ASSERT_FALSE(o.optimize) << seed;
-    const RealisticCase rc = make_realistic_case(seed, o);
-    const CaseResult r = mesh_and_check(rc);
-    EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << ": " << r.reason;
-    EXPECT_LE(reported_skewness(r.reason), 4.0) << rc.label << ": " << r.reason;
-  }
+  for (const uint32_t seed : {3203u, 3278u}) expect_within_check_mesh_skewness(seed, false);
+}
+
+// Faces a little above checkMesh's limit, which neighbours' steps lower by hundredths a round, were
+// written when the 24 rounds against skewness ran out: seed 3109 (no optimisation) at 4.02, 3204
+// (optimised) at 4.23. The rounds now go on while the faces above the limit reach a new low within 8
+// rounds, up to 64 (docs/optimization.md, "More rounds while they make progress").
+TEST(RealisticSweep, SkewnessRoundsGoOnWhileTheyMakeProgress) {
+  for (const uint32_t seed : {3109u, 3204u}) expect_within_check_mesh_skewness(seed, seed == 3204);
 }
 
 // In a permeability frame the passes measured skewness in the frame, where the mesh is built; checkMesh
