@@ -980,13 +980,14 @@ constexpr int kMaxSkewRounds = 64;
 constexpr int kSkewPatience = 8;
 class SkewRoundBudget {
  public:
-  // Whether another round may run after `rounds` rounds.
-  bool more(int rounds) const {
+  // Whether another round may run after `rounds` rounds of `o`; the state the last of them started
+  // from (SiteOptimizer::skewed_left, worst_skew_left) counts toward the progress.
+  bool more(int rounds, const SiteOptimizer& o) {
+    const int faces = o.skewed_left();
+    const double worst = o.worst_skew_left();
+    if (rounds > 0 && (faces < faces_ || (faces == faces_ && worst < worst_)))
+      faces_ = faces, worst_ = worst, last_low_ = rounds;
     return rounds < kSkewRounds || (rounds < kMaxSkewRounds && rounds - last_low_ <= kSkewPatience);
-  }
-  // The state a round started from (SiteOptimizer::skewed_left, worst_skew_left).
-  void record(int round, int faces, double worst) {
-    if (faces < faces_ || (faces == faces_ && worst < worst_)) faces_ = faces, worst_ = worst, last_low_ = round;
   }
 
  private:
@@ -1010,8 +1011,9 @@ bool has_sliver_edge(const TransitionCells& t) {
 
 namespace {
 // Rounds of one pass without optimisation on `out` while more(rounds done, optimizer), until
-// done(optimizer) after a round or a round proposes nothing: a round whose moves were all refused has tagged them, and the
-// next tries each one's next option. The first round measures the diagram. Returns the moves kept.
+// done(optimizer) after a round or a round proposes nothing: a round whose moves were all refused
+// has tagged them, and the next tries each one's next option. The first round measures the diagram.
+// Returns the moves kept.
 template <class More, class Done>
 int run_pass(Pass pass, More more, Done done, SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
              const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
@@ -1044,11 +1046,7 @@ int reduce_skewness(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
                     TransitionCells& out) {
   SkewRoundBudget budget;
   return run_pass(
-      Pass::Skewness,
-      [&](int rounds, const SiteOptimizer& o) {
-        if (rounds > 0) budget.record(rounds, o.skewed_left(), o.worst_skew_left());
-        return budget.more(rounds);
-      },
+      Pass::Skewness, [&](int rounds, const SiteOptimizer& o) { return budget.more(rounds, o); },
       [](const SiteOptimizer& o) { return o.skewed_left() == 0; }, set, cavity, coords, frames, opt, outside_centres,
       images, out);
 }
@@ -1075,12 +1073,11 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
   }
   // Faces above checkMesh's skewness limit left: a few more rounds against them alone.
   SkewRoundBudget budget;
-  for (int extra = 0; budget.more(extra); ++extra) {
+  for (int extra = 0; budget.more(extra, optimizer); ++extra) {
     ++rep.rounds;
     // A round whose steps were all refused has tagged them: the next tries each face's next step.
     if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
     if (optimizer.skewed_left() == 0) break;
-    budget.record(extra + 1, optimizer.skewed_left(), optimizer.worst_skew_left());
   }
   // Cells failing a shape check left: rounds of repairs while untried options remain.
   for (int extra = 0; extra < kRepairRounds && optimizer.failing_now() != 0; ++extra) {
