@@ -81,6 +81,7 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   r.q_o_all = stats_of(r.q_o_cell);
   r.q_p_all = stats_of(r.q_p_cell);
   r.by_region = quality_by_region(mesh, r.q_s, r.q_o_cell, r.q_p_cell, r.k_angle_cell, r.k_angle_interior_cell);
+  r.openfoam_skewness = summarize_skewness(openfoam_face_skewness(mesh));
   if (geometry_out) *geometry_out = std::move(geo);
   return r;
 }
@@ -102,6 +103,16 @@ TransmissibilitySummary summarize_transmissibilities(const std::vector<double>& 
     first = false;
   }
   return s;
+}
+
+std::string openfoam_skewness_text(const SkewnessSummary& s) {
+  std::ostringstream os;
+  os << "checkMesh skewness: max " << s.max;
+  if (s.above_limit == 0) return os.str() + ", no face above checkMesh's limit of 4";
+  const bool one = s.above_limit == 1;
+  os << ", " << s.above_limit << (one ? " face" : " faces") << " above checkMesh's limit of 4: checkMesh reports "
+     << (one ? "it" : "them") << " (\"Failed 1 mesh checks\") on the OpenFOAM export";
+  return os.str();
 }
 
 std::string report_summary_text(const FvReport& r) {
@@ -133,6 +144,7 @@ std::string report_summary_text(const FvReport& r) {
                   r.q_s_all.min, r.q_s_all.max, r.q_s_all.mean, r.q_o_all.min, r.q_o_all.max, r.q_o_all.mean,
                   r.q_p_all.min, r.q_p_all.max, r.q_p_all.mean);
     os << line;
+    os << "  " << openfoam_skewness_text(r.openfoam_skewness) << "\n";
   }
   if (!r.k_angle_cell.empty()) {
     os << "  K-non-orthogonality (deg, max/mean):";

@@ -56,6 +56,9 @@ struct FvReport {
   bool k_metric = false;
   std::vector<int32_t> cell_region;          ///< copy of the mesh's regions (histograms per region)
   Stats q_s_all, q_o_all, q_p_all;           ///< over all cells
+  /// OpenFOAM's face skewness over every face, as checkMesh measures it (not an FV property: a
+  /// quality figure of the OpenFOAM export, which checkMesh fails above its limit of 4).
+  SkewnessSummary openfoam_skewness;
   std::vector<RegionQuality> by_region;
   TransmissibilitySummary transmissibility;
   std::vector<std::string> notes;            ///< reader warnings etc., shown in the reports
@@ -75,6 +78,10 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
 
 /// A few lines for a terminal.
 std::string report_summary_text(const FvReport& r);
+
+/// One line on checkMesh's skewness (its maximum, the faces above checkMesh's limit): fvcheck's
+/// summary and meshgen's OpenFOAM export say it in the same words.
+std::string openfoam_skewness_text(const SkewnessSummary& s);
 
 /// Self-contained HTML page (inline CSS and SVG).
 std::string report_html(const FvReport& r);

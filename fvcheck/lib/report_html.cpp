@@ -71,7 +71,7 @@ h1{font-size:22px;margin:0 0 4px 0} h2{font-size:17px;border-bottom:1px solid #9
 table{border-collapse:collapse;margin:8px 0;font-size:13px}
 th,td{border-top:1px solid #444;border-bottom:1px solid #444;padding:4px 10px;text-align:right}
 th{background:#f0f0f0} td.l,th.l{text-align:left}
-tr.bad td{color:#c62828;font-weight:bold}
+tr.bad td,p.bad{color:#c62828;font-weight:bold}
 .grid{display:flex;flex-wrap:wrap;gap:8px}
 svg{border:1px solid #ddd;background:#fff}
 svg .t{font-size:13px;text-anchor:middle;font-weight:bold}
@@ -192,6 +192,11 @@ std::string report_html(const FvReport& r) {
          "K n and the centre-to-centre line (docs/fvcheck.md)"
       << (r.k_metric ? "; this mesh was built in a permeability frame, its orthogonality check is in the K metric" : "")
       << ".</p>\n";
+    const SkewnessSummary& sk = r.openfoam_skewness;
+    h << "<p" << (sk.above_limit > 0 ? " class='bad'" : "") << ">checkMesh skewness (OpenFOAM's measure, every face): max "
+      << fmt(sk.max, "%.4g") << (sk.worst_face >= 0 ? " (face " + std::to_string(sk.worst_face) + ")" : std::string()) << "; "
+      << sk.above_limit << (sk.above_limit == 1 ? " face" : " faces") << " above checkMesh's limit of " << fmt(kCheckMeshSkewnessLimit, "%.0f")
+      << (sk.above_limit > 0 ? ": checkMesh reports them on the OpenFOAM export (not an FV check)" : "") << ".</p>\n";
 
     // Histograms per region (paper Figure 19 style), at most 6 regions.
     h << "<h2>Histograms</h2>";

@@ -70,6 +70,10 @@ json report_json(const FvReport& r) {
       q["by_region"][rq.name]["K_nonorthogonality_interior_deg"] = stats_json(rq.k_angle_interior);
     }
   }
+  q["openfoam_skewness"] = {{"max", num(r.openfoam_skewness.max)},
+                            {"worst_face", r.openfoam_skewness.worst_face},
+                            {"faces_above_checkmesh_limit", r.openfoam_skewness.above_limit},
+                            {"checkmesh_limit", kCheckMeshSkewnessLimit}};
   j["quality"] = q;
   if (r.transmissibility.present)
     j["transmissibility"] = {{"count", r.transmissibility.count},

@@ -15,6 +15,7 @@
 #include "exporters/png/offscreen_display.hpp"
 #include "exporters/vtu/vtu_writer.hpp"
 #include "fvcheck/lib/quality.hpp"
+#include "fvcheck/lib/report.hpp"
 #include "fvcheck/lib/transmissibility.hpp"
 #include "meshgen/core/cli.hpp"
 #include "meshgen/core/malloc_tunables.hpp"
@@ -28,6 +29,16 @@
 namespace fs = std::filesystem;
 
 namespace {
+
+// checkMesh's view of the mesh's skewness, and the two cells of its worst face.
+std::string skewed_face_text(const hm::PolyMesh& mesh, const hm::SkewnessSummary& skew) {
+  std::string text = hm::openfoam_skewness_text(skew);
+  if (skew.worst_face < 0) return text;
+  const int32_t a = mesh.face_owner[skew.worst_face], b = mesh.face_neighbour[skew.worst_face];
+  text += "; the worst face is cell " + std::to_string(a) + "'s (" + hm::region_name(mesh.cell_region[a]) + ")";
+  if (b >= 0) text += " toward cell " + std::to_string(b) + " (" + hm::region_name(mesh.cell_region[b]) + ")";
+  return text + ", cells numbered as in mesh.vtu and the polyMesh";
+}
 
 int usage(const std::string& why) {
   std::cerr << "meshgen: " << why << "\n"
@@ -146,7 +157,7 @@ int main(int argc, char** argv) {
   // The deck's transmissibilities are the ones solver_demo solves with (deck_transmissibility_options).
   if (export_eclipse)
     trans = hm::compute_transmissibilities(result.mesh, result.geometry, hm::deck_transmissibility_options());
-  const nlohmann::json summary = hm::make_summary(cs, result);
+  nlohmann::json summary = hm::make_summary(cs, result);
   hm::translate_mesh(result.mesh, origin);
 
   const fs::path out(out_dir);
@@ -199,6 +210,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     written.push_back((out / "openfoam").string() + "/");
+    // checkMesh fails faces above its skewness limit; the files are right, but the user is told,
+    // from the points as written (checkMesh's own view).
+    const hm::SkewnessSummary skew = hm::summarize_skewness(hm::openfoam_face_skewness(result.mesh));
+    summary["openfoam"] = {{"max_skewness", skew.max}, {"faces_above_checkmesh_skewness_limit", skew.above_limit}};
+    if (skew.above_limit > 0) std::cerr << "meshgen: warning: openfoam: " << skewed_face_text(result.mesh, skew) << "\n";
   }
   double picture_seconds = -1;
   if (pictures) {

@@ -367,4 +367,15 @@ std::vector<double> openfoam_face_skewness(const PolyMesh& mesh) {
   return skew;
 }
 
+SkewnessSummary summarize_skewness(const std::vector<double>& face_skewness) {
+  SkewnessSummary s;
+  for (size_t f = 0; f < face_skewness.size(); ++f) {
+    const double v = face_skewness[f];
+    if (std::isnan(v)) continue;
+    if (v > s.max || s.worst_face < 0) s.max = v, s.worst_face = static_cast<int32_t>(f);
+    s.above_limit += v > kCheckMeshSkewnessLimit;
+  }
+  return s;
+}
+
 }  // namespace hm

@@ -91,8 +91,18 @@ Stats stats_of(const std::vector<double>& values, const std::vector<bool>& mask 
 /// (primitiveMeshTools::faceSkewness), so that it reproduces checkMesh's figures.
 std::vector<double> openfoam_face_skewness(const PolyMesh& mesh);
 
-/// Skewness above which a face counts as skewed: OpenFOAM's 4, less a margin for the
-/// precision of the written points.
-inline constexpr double kOpenFoamSkewnessLimit = 3.95;
+/// checkMesh's limit: a face above it is "highly skew" and checkMesh ends with "Failed 1 mesh checks".
+inline constexpr double kCheckMeshSkewnessLimit = 4.0;
+/// Skewness above which the optimiser counts a face as skewed: checkMesh's limit, less a margin for
+/// the precision of the written points.
+inline constexpr double kOpenFoamSkewnessLimit = kCheckMeshSkewnessLimit - 0.05;
+
+/// What checkMesh would say of a mesh's face skewness (openfoam_face_skewness, every face).
+struct SkewnessSummary {
+  double max = 0;           ///< the largest value (0 for a mesh without faces)
+  int32_t worst_face = -1;  ///< the face that has it
+  int64_t above_limit = 0;  ///< faces above kCheckMeshSkewnessLimit: checkMesh's "highly skew faces"
+};
+SkewnessSummary summarize_skewness(const std::vector<double>& face_skewness);
 
 }  // namespace hm

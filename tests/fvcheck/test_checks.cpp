@@ -596,6 +596,40 @@ TEST(RunFvcheck, CentreOutsideFailsOnlyAutoCentering) {
   EXPECT_NE(report_summary_text(r).find("FAILED"), std::string::npos);
 }
 
+// checkMesh's view of a mesh's skewness: the largest value and its face, and the faces strictly above 4
+// (checkMesh's test is `> 4`); a NaN is no value.
+TEST(SkewnessSummary, CountsFacesAboveCheckMeshLimit) {
+  const SkewnessSummary s = summarize_skewness({1.0, 4.0, 4.5, NAN, 9.0, 0.2});
+  EXPECT_EQ(s.max, 9.0);
+  EXPECT_EQ(s.worst_face, 4);
+  EXPECT_EQ(s.above_limit, 2);
+  const SkewnessSummary none = summarize_skewness({});
+  EXPECT_EQ(none.worst_face, -1);
+  EXPECT_EQ(none.above_limit, 0);
+}
+
+// fvcheck reports checkMesh's skewness beside the FV checks (it does not fail the report): a Cartesian
+// grid's faces have none; one node moved skews the faces around it, as openfoam_face_skewness says.
+TEST(RunFvcheck, ReportsCheckMeshSkewness) {
+  PolyMesh m = box_grid(3, 2, 2);
+  const FvReport straight = run_fvcheck(m, {});
+  EXPECT_NEAR(straight.openfoam_skewness.max, 0.0, 1e-12);
+  EXPECT_EQ(straight.openfoam_skewness.above_limit, 0);
+  EXPECT_NE(report_summary_text(straight).find("no face above checkMesh's limit of 4"), std::string::npos);
+  m.nodes[5] = m.nodes[5] + Vec3{0.3, 0.2, 0.1};
+  const FvReport moved = run_fvcheck(m, {});
+  const std::vector<double> skew = openfoam_face_skewness(m);
+  const double worst = *std::max_element(skew.begin(), skew.end());
+  EXPECT_GT(worst, 0.01);
+  EXPECT_EQ(moved.openfoam_skewness.max, worst);
+  EXPECT_EQ(skew[moved.openfoam_skewness.worst_face], worst);
+  const nlohmann::json j = report_json(moved);
+  EXPECT_EQ(j["quality"]["openfoam_skewness"]["max"].get<double>(), worst);
+  EXPECT_EQ(j["quality"]["openfoam_skewness"]["faces_above_checkmesh_limit"].get<int64_t>(), 0);
+  EXPECT_EQ(j["quality"]["openfoam_skewness"]["checkmesh_limit"].get<double>(), 4.0);
+  EXPECT_NE(report_html(moved).find("checkMesh skewness"), std::string::npos);
+}
+
 TEST(TransmissibilitySummary, CountsNegativeAndNonFinite) {
   const TransmissibilitySummary s = summarize_transmissibilities({0.0, 2.0, -1.0, 5.0, NAN});
   EXPECT_TRUE(s.present);

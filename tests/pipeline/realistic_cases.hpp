@@ -82,6 +82,21 @@ inline void yaml_axis(std::ostringstream& os, const char* key, const std::vector
 }
 }  // namespace detail
 
+// The mode of case `seed` in the realistic sweep (test_realistic_sweep.cpp): requested end caps (2/3
+// hemispherical, 1/3 flat, both strict), optimisation on for a quarter (it dominates the time), field
+// coordinates for a quarter, wells through the top for a quarter.
+inline RealisticOptions sweep_mode(uint32_t seed) {
+  std::mt19937 m(seed ^ 0x9e3779b9u);
+  std::uniform_int_distribution<int> d(0, 11);
+  RealisticOptions o;
+  o.caps = d(m) % 3 == 2 ? RealisticOptions::Caps::Flat : RealisticOptions::Caps::Hemisphere;
+  o.optimize = d(m) % 4 == 1;
+  o.field_origin = d(m) % 4 == 3;
+  o.cross_top_bottom = d(m) % 4 == 2;  // wells through the top (half of them also the bottom), flat ends
+  o.max_cavity_layers = 40;
+  return o;
+}
+
 /// The case of `seed`. Throws InputError only if the generator itself made an invalid case (a bug).
 inline RealisticCase make_realistic_case(uint32_t seed, const RealisticOptions& opt = {}) {
   using detail::num;

@@ -27,17 +27,10 @@ int env_int(const char* name, int fallback) {
   return v ? std::atoi(v) : fallback;
 }
 
-// The mode of sweep case `seed`: requested end caps (2/3 hemispherical, 1/3 flat, both strict),
-// optimisation on for a quarter (it dominates the time), field coordinates for a quarter.
+// The mode of sweep case `seed` (sweep_mode), with the sweep's environment's permeability metric
+// and layer aspect.
 RealisticOptions sweep_options(uint32_t seed) {
-  std::mt19937 m(seed ^ 0x9e3779b9u);
-  std::uniform_int_distribution<int> d(0, 11);
-  RealisticOptions o;
-  o.caps = d(m) % 3 == 2 ? RealisticOptions::Caps::Flat : RealisticOptions::Caps::Hemisphere;
-  o.optimize = d(m) % 4 == 1;
-  o.field_origin = d(m) % 4 == 3;
-  o.cross_top_bottom = d(m) % 4 == 2;  // wells through the top (half of them also the bottom), flat ends
-  o.max_cavity_layers = 40;
+  RealisticOptions o = sweep_mode(seed);
   if (const char* v = std::getenv("HM_SWEEP_KVKH")) o.kv_kh = std::atof(v);  // the permeability metric
   if (const char* v = std::getenv("HM_SWEEP_LAYER_ASPECT")) o.layer_aspect = std::atof(v);
   return o;
