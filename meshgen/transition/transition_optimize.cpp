@@ -383,6 +383,17 @@ class SiteOptimizer {
   int proposed_last() const { return proposed_last_; }
   // Cells of the diagram a round left that fail a shape check (-1 before the first round).
   int64_t failing_now() const { return next_ ? next_->failing.count : -1; }
+  // Faces above checkMesh's limit in the diagram a round left (-1 before the first round).
+  int64_t skewed_now() const { return next_ ? static_cast<int64_t>(next_->skewed_faces.size()) : -1; }
+  // Lets the moves against skewness refused so far be tried again: each was judged on the diagram of
+  // its round, and the moves kept since have reshaped the cells around many of them. Returns how many.
+  int forget_refused_skew_moves() {
+    int n = 0;
+    for (auto it = refused_.begin(); it != refused_.end();)
+      if (it->second == MoveKind::SkewStep) it = refused_.erase(it), ++n;
+      else ++it;
+    return n;
+  }
 
  private:
   Vec3 node(const TransitionCells& t, int32_t v) const {
@@ -503,7 +514,7 @@ class SiteOptimizer {
     Move m;
     m.tag = {-2, s, tag_other, k, level, 0, 0, 0, 0};
     m.kind = MoveKind::SkewStep;
-    if (refused_.count(m.tag) || !trial_step(s, other, away, size, &m, level)) return Move{};
+    if (refused(m.tag) || !trial_step(s, other, away, size, &m, level)) return Move{};
     return m;
   }
 
@@ -526,7 +537,11 @@ class SiteOptimizer {
         if (set_.sites[s].alive && plane_side(set_.sites[s].p, images_.planes[k]) != side_[k * n + s]) return false;
     return true;
   }
-  std::set<std::array<int, 9>> refused_;
+  // Moves refused (by tag, with their kind): not tried again, unless the rounds against skewness stall
+  // (forget_refused_skew_moves).
+  std::map<std::array<int, 9>, MoveKind> refused_;
+  bool refused(const std::array<int, 9>& tag) const { return refused_.count(tag) > 0; }
+  void refuse(const Move& m) { refused_.emplace(m.tag, m.kind); }
   SiteSlab slab_;  // the sites by x, for centred(): reset at each round's start
   PowerDiagram diagram_;  // the cavity's regular triangulation, kept across rounds and rebuilds
   // A site's run of kept steps against skewed faces (its own face's or a neighbour's; the same other
@@ -756,7 +771,7 @@ std::vector<Move> SiteOptimizer::propose(const TransitionCells& out, const Measu
         Move m;
         const std::array<int, 4> ku = key_of(out, global[u]), kv = key_of(out, global[v]);
         m.tag = {ku[0], ku[1], ku[2], ku[3], kv[0], kv[1], kv[2], kv[3], d};
-        if (refused_.count(m.tag)) continue;
+        if (refused(m.tag)) continue;
         // A sliver's sites may sit at a bound of their range (an end face's height cap): the
         // co-spherical position is then beyond it by rounding, the size of the edge itself.
         const double range_slack = pass_ == Pass::Slivers ? kSliverEdge * e.h : 0.0;
@@ -824,7 +839,7 @@ std::vector<Move> SiteOptimizer::propose(const TransitionCells& out, const Measu
           m.kind = MoveKind::Repair;
           const bool polygon = set_.sites[mover].kind == SiteKind::InternalPolygon;
           m.tag = {-3, mover, polygon ? -1 : from, away, size, 0, 0, 0, 0};
-          if (!refused_.count(m.tag) && trial_step(mover, from, away, size, &m)) best = m;
+          if (!refused(m.tag) && trial_step(mover, from, away, size, &m)) best = m;
         }
         if (best.site >= 0) break;
       }
@@ -880,7 +895,7 @@ std::vector<Move> SiteOptimizer::judge(const std::vector<Move>& moves, const Tra
     const bool keep = move_is_kept(e, m.kind);
     record_streak(m, keep);
     if (keep) kept.push_back(m);
-    else restore(m.site, m.before), refused_.insert(m.tag);
+    else restore(m.site, m.before), refuse(m);
   }
   return kept;
 }
@@ -912,7 +927,7 @@ bool SiteOptimizer::round(TransitionCells& out, SiteOptimizeReport& rep, bool sk
   while (!rebuild(fresh, out.base_node_id)) {
     const size_t half = keep / 2;
     for (size_t i = half; i < keep; ++i) restore(moves[i].site, moves[i].before);
-    if (keep == 1) refused_.insert(moves[0].tag);
+    if (keep == 1) refuse(moves[0]);
     rep.invalid += static_cast<int>(keep - half);
     keep = half;
     if (keep == 0) {
@@ -975,25 +990,40 @@ namespace {
 // The rounds against skewness: kSkewRounds, then up to kMaxSkewRounds as long as the faces above
 // checkMesh's limit reached a new low (fewer of them, or the same count with a lower worst) within
 // the last kSkewPatience rounds: faces a little above the limit that neighbours' steps lower by
-// hundredths a round (docs/optimization.md, "More rounds while they make progress").
+// hundredths a round (docs/optimization.md, "More rounds while they make progress"). When they stall
+// (no new low within the patience, or a round with nothing left to propose) with faces still above
+// the limit, up to kSkewRetries second chances: the refused moves against skewness may be tried again
+// (docs/optimization.md, "A second chance after a stall"). A case whose faces all pass never stalls
+// with faces left, so it meshes as without the second chances.
 constexpr int kMaxSkewRounds = 64;
 constexpr int kSkewPatience = 8;
+constexpr int kSkewRetries = 2;
 class SkewRoundBudget {
  public:
   // Whether another round may run after `rounds` rounds of `o`; the state the last of them started
   // from (SiteOptimizer::skewed_left, worst_skew_left) counts toward the progress.
-  bool more(int rounds, const SiteOptimizer& o) {
+  bool more(int rounds, SiteOptimizer& o) {
     const int faces = o.skewed_left();
     const double worst = o.worst_skew_left();
     if (rounds > 0 && (faces < faces_ || (faces == faces_ && worst < worst_)))
       faces_ = faces, worst_ = worst, last_low_ = rounds;
-    return rounds < kSkewRounds || (rounds < kMaxSkewRounds && rounds - last_low_ <= kSkewPatience);
+    if (rounds < kSkewRounds || (rounds < kMaxSkewRounds && rounds - last_low_ <= kSkewPatience)) return true;
+    return second_chance(rounds, o);
+  }
+  // After `rounds` rounds the rounds stalled: whether they go on, with the refused moves forgotten.
+  bool second_chance(int rounds, SiteOptimizer& o) {
+    if (rounds >= kMaxSkewRounds || retries_ == kSkewRetries || o.skewed_now() <= 0) return false;
+    if (o.forget_refused_skew_moves() == 0) return false;
+    ++retries_;
+    last_low_ = rounds;
+    return true;
   }
 
  private:
   int faces_ = std::numeric_limits<int>::max();
   double worst_ = std::numeric_limits<double>::infinity();
   int last_low_ = 0;
+  int retries_ = 0;
 };
 
 // An edge between two free vertices shorter than kSliverEdge x the h_ref of a cell it bounds.
@@ -1010,20 +1040,25 @@ bool has_sliver_edge(const TransitionCells& t) {
 }  // namespace
 
 namespace {
+// The passes other than skewness's stop when a round has nothing left to propose.
+bool no_second_chance(int, const SiteOptimizer&) { return false; }
+
 // Rounds of one pass without optimisation on `out` while more(rounds done, optimizer), until
-// done(optimizer) after a round or a round proposes nothing: a round whose moves were all refused
-// has tagged them, and the next tries each one's next option. The first round measures the diagram.
-// Returns the moves kept.
-template <class More, class Done>
-int run_pass(Pass pass, More more, Done done, SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
-             const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
+// done(optimizer) after a round or a round proposes nothing and stalled(rounds done, optimizer) gives
+// no second chance: a round whose moves were all refused has tagged them, and the next tries each
+// one's next option. The first round measures the diagram. Returns the moves kept.
+template <class More, class Done, class Stalled>
+int run_pass(Pass pass, More more, Done done, Stalled stalled, SiteSet& set, const Cavity& cavity,
+             const std::vector<Vec3>& coords, const std::vector<PolygonFrame>& frames, const TransitionOptions& opt,
              const std::vector<Vec3>& outside_centres, const BoundaryImages& images, TransitionCells& out) {
   SiteOptimizeReport rep;
   const std::vector<double> h_ref = out.h_ref;
   SiteOptimizer optimizer(set, cavity, coords, frames, h_ref, opt, outside_centres, images, pass);
   while (more(rep.rounds, optimizer)) {
     ++rep.rounds;
-    if (!optimizer.round(out, rep, pass != Pass::Slivers) && optimizer.proposed_last() == 0) break;
+    if (!optimizer.round(out, rep, pass != Pass::Slivers) && optimizer.proposed_last() == 0 &&
+        !stalled(rep.rounds, optimizer))
+      break;
     if (done(optimizer)) break;
   }
   out.h_ref = h_ref;
@@ -1036,8 +1071,8 @@ int remove_sliver_edges(SiteSet& set, const Cavity& cavity, const std::vector<Ve
                         const std::vector<Vec3>& outside_centres, TransitionCells& out) {
   if (!has_sliver_edge(out)) return 0;  // the common case: no submesh to measure
   return run_pass(Pass::Slivers, [](int rounds, const SiteOptimizer&) { return rounds < kSliverRounds; },
-                  [](const SiteOptimizer&) { return false; }, set, cavity, coords, frames, opt, outside_centres,
-                  kNoImages, out);
+                  [](const SiteOptimizer&) { return false; }, no_second_chance, set, cavity, coords, frames, opt,
+                  outside_centres, kNoImages, out);
 }
 
 int reduce_skewness(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -1046,9 +1081,10 @@ int reduce_skewness(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>&
                     TransitionCells& out) {
   SkewRoundBudget budget;
   return run_pass(
-      Pass::Skewness, [&](int rounds, const SiteOptimizer& o) { return budget.more(rounds, o); },
-      [](const SiteOptimizer& o) { return o.skewed_left() == 0; }, set, cavity, coords, frames, opt, outside_centres,
-      images, out);
+      Pass::Skewness, [&](int rounds, SiteOptimizer& o) { return budget.more(rounds, o); },
+      [](const SiteOptimizer& o) { return o.skewed_left() == 0; },
+      [&](int rounds, SiteOptimizer& o) { return budget.second_chance(rounds, o); }, set, cavity, coords, frames, opt,
+      outside_centres, images, out);
 }
 
 int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -1057,8 +1093,8 @@ int repair_failing_cells(SiteSet& set, const Cavity& cavity, const std::vector<V
                          TransitionCells& out) {
   // It proposes nothing when no cell fails, the common case.
   return run_pass(Pass::Repairs, [](int rounds, const SiteOptimizer&) { return rounds < kRepairRounds; },
-                  [](const SiteOptimizer& o) { return o.failing_now() == 0; }, set, cavity, coords, frames, opt,
-                  outside_centres, images, out);
+                  [](const SiteOptimizer& o) { return o.failing_now() == 0; }, no_second_chance, set, cavity, coords,
+                  frames, opt, outside_centres, images, out);
 }
 
 SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std::vector<Vec3>& coords,
@@ -1076,7 +1112,8 @@ SiteOptimizeReport optimize_sites(SiteSet& set, const Cavity& cavity, const std:
   for (int extra = 0; budget.more(extra, optimizer); ++extra) {
     ++rep.rounds;
     // A round whose steps were all refused has tagged them: the next tries each face's next step.
-    if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0) break;
+    if (!optimizer.round(out, rep, true) && optimizer.proposed_last() == 0 && !budget.second_chance(extra + 1, optimizer))
+      break;
     if (optimizer.skewed_left() == 0) break;
   }
   // Cells failing a shape check left: rounds of repairs while untried options remain.
