@@ -97,6 +97,11 @@ class BuiltMesh(unittest.TestCase):
     def test_check_and_transmissibilities(self):
         report = hybridmesh.check(self.mesh)
         self.assertTrue(report["ok"], report)
+        # checkMesh's skewness (docs/fvcheck.md): the example passes checkMesh, no face above its 4.
+        skew = report["quality"]["openfoam_skewness"]
+        self.assertEqual(skew["faces_above_checkmesh_limit"], 0, skew)
+        self.assertGreater(skew["max"], 0.0)
+        self.assertLess(skew["max"], skew["checkmesh_limit"])
         t = self.mesh.transmissibilities
         interior = self.mesh.face_neighbour >= 0
         self.assertTrue(np.all(np.isfinite(t)))
