@@ -993,8 +993,8 @@ namespace {
 // hundredths a round (docs/optimization.md, "More rounds while they make progress"). When they stall
 // (no new low within the patience, or a round with nothing left to propose) with faces still above
 // the limit, up to kSkewRetries second chances: the refused moves against skewness may be tried again
-// (docs/optimization.md, "A second chance after a stall"). A case whose faces all pass never stalls
-// with faces left, so it meshes as without the second chances.
+// (docs/optimization.md, "A second chance after a stall"). A case left with no face above
+// kOpenFoamSkewnessLimit never stalls with faces left, so it meshes as without the second chances.
 constexpr int kMaxSkewRounds = 64;
 constexpr int kSkewPatience = 8;
 constexpr int kSkewRetries = 2;
