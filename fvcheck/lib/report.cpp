@@ -81,7 +81,9 @@ FvReport run_fvcheck(const PolyMesh& mesh, const CheckOptions& opt, const std::v
   r.q_o_all = stats_of(r.q_o_cell);
   r.q_p_all = stats_of(r.q_p_cell);
   r.by_region = quality_by_region(mesh, r.q_s, r.q_o_cell, r.q_p_cell, r.k_angle_cell, r.k_angle_interior_cell);
-  r.openfoam_skewness = summarize_skewness(openfoam_face_skewness(mesh));
+  const CheckMeshFigures foam = checkmesh_figures(mesh);
+  r.openfoam_skewness = foam.skewness;
+  r.openfoam_nonorthogonality = foam.nonorthogonality;
   if (geometry_out) *geometry_out = std::move(geo);
   return r;
 }
@@ -111,6 +113,21 @@ std::string openfoam_skewness_text(const SkewnessSummary& s) {
   if (s.above_limit == 0) return os.str() + ", no face above checkMesh's limit of 4";
   const bool one = s.above_limit == 1;
   os << ", " << s.above_limit << (one ? " face" : " faces") << " above checkMesh's limit of 4: checkMesh reports "
+     << (one ? "it" : "them") << " (\"Failed 1 mesh checks\") on the OpenFOAM export";
+  return os.str();
+}
+
+std::string openfoam_nonorthogonality_text(const NonOrthogonalitySummary& s) {
+  char line[160];
+  std::snprintf(line, sizeof line, "checkMesh non-orthogonality: max %.6g, average %.6g deg", s.max, s.average);
+  std::ostringstream os;
+  os << line;
+  if (s.severe > 0)
+    os << ", " << s.severe << (s.severe == 1 ? " face" : " faces") << " above its warning threshold of "
+       << kCheckMeshSevereNonOrthogonality;
+  if (s.errors == 0) return os.str();
+  const bool one = s.errors == 1;
+  os << ", " << s.errors << (one ? " face" : " faces") << " at 90 deg or more: checkMesh reports "
      << (one ? "it" : "them") << " (\"Failed 1 mesh checks\") on the OpenFOAM export";
   return os.str();
 }
@@ -145,6 +162,7 @@ std::string report_summary_text(const FvReport& r) {
                   r.q_p_all.min, r.q_p_all.max, r.q_p_all.mean);
     os << line;
     os << "  " << openfoam_skewness_text(r.openfoam_skewness) << "\n";
+    os << "  " << openfoam_nonorthogonality_text(r.openfoam_nonorthogonality) << "\n";
   }
   if (!r.k_angle_cell.empty()) {
     os << "  K-non-orthogonality (deg, max/mean):";

@@ -59,6 +59,9 @@ struct FvReport {
   /// OpenFOAM's face skewness over every face, as checkMesh measures it (not an FV property: a
   /// quality figure of the OpenFOAM export, which checkMesh fails above its limit of 4).
   SkewnessSummary openfoam_skewness;
+  /// checkMesh's non-orthogonality (between the face normal and the line between the cells'
+  /// centroids, not their FV centres), likewise a figure of the OpenFOAM export.
+  NonOrthogonalitySummary openfoam_nonorthogonality;
   std::vector<RegionQuality> by_region;
   TransmissibilitySummary transmissibility;
   std::vector<std::string> notes;            ///< reader warnings etc., shown in the reports
@@ -82,6 +85,8 @@ std::string report_summary_text(const FvReport& r);
 /// One line on checkMesh's skewness (its maximum, the faces above checkMesh's limit): fvcheck's
 /// summary and meshgen's OpenFOAM export say it in the same words.
 std::string openfoam_skewness_text(const SkewnessSummary& s);
+/// The same for checkMesh's non-orthogonality (its maximum and average, its severe faces and errors).
+std::string openfoam_nonorthogonality_text(const NonOrthogonalitySummary& s);
 
 /// Self-contained HTML page (inline CSS and SVG).
 std::string report_html(const FvReport& r);

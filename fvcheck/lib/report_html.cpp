@@ -197,6 +197,13 @@ std::string report_html(const FvReport& r) {
       << fmt(sk.max, "%.4g") << (sk.worst_face >= 0 ? " (face " + std::to_string(sk.worst_face) + ")" : std::string()) << "; "
       << sk.above_limit << (sk.above_limit == 1 ? " face" : " faces") << " above checkMesh's limit of " << fmt(kCheckMeshSkewnessLimit, "%.0f")
       << (sk.above_limit > 0 ? ": checkMesh reports them on the OpenFOAM export (not an FV check)" : "") << ".</p>\n";
+    const NonOrthogonalitySummary& no = r.openfoam_nonorthogonality;
+    h << "<p" << (no.errors > 0 ? " class='bad'" : "") << ">checkMesh non-orthogonality (OpenFOAM's measure, between "
+      << "cell centroids): max " << fmt(no.max, "%.4g") << " deg"
+      << (no.worst_face >= 0 ? " (face " + std::to_string(no.worst_face) + ")" : std::string()) << ", average "
+      << fmt(no.average, "%.4g") << " deg; " << no.severe << " severe (above " << fmt(kCheckMeshSevereNonOrthogonality, "%.0f")
+      << " deg, a warning); " << no.errors << " at 90 deg or more"
+      << (no.errors > 0 ? ": checkMesh fails them on the OpenFOAM export (not an FV check)" : "") << ".</p>\n";
 
     // Histograms per region (paper Figure 19 style), at most 6 regions.
     h << "<h2>Histograms</h2>";

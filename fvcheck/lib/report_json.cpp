@@ -74,6 +74,13 @@ json report_json(const FvReport& r) {
                             {"worst_face", r.openfoam_skewness.worst_face},
                             {"faces_above_checkmesh_limit", r.openfoam_skewness.above_limit},
                             {"checkmesh_limit", kCheckMeshSkewnessLimit}};
+  const NonOrthogonalitySummary& no = r.openfoam_nonorthogonality;
+  q["openfoam_nonorthogonality_deg"] = {{"max", num(no.max)},
+                                        {"average", num(no.average)},
+                                        {"worst_face", no.worst_face},
+                                        {"severe_faces", no.severe},
+                                        {"checkmesh_severe_threshold", kCheckMeshSevereNonOrthogonality},
+                                        {"error_faces", no.errors}};
   j["quality"] = q;
   if (r.transmissibility.present)
     j["transmissibility"] = {{"count", r.transmissibility.count},

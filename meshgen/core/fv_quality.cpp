@@ -337,7 +337,7 @@ Stats stats_of(const std::vector<double>& values, const std::vector<bool>& mask)
   return s;
 }
 
-std::vector<double> openfoam_face_skewness(const PolyMesh& mesh) {
+std::vector<Vec3> openfoam_cell_centres(const PolyMesh& mesh) {
   std::vector<Vec3> centre(mesh.n_cells());
   parallel_ranges(mesh.n_cells(), [&](int64_t cb, int64_t ce) {
     std::vector<int32_t> outward;
@@ -354,17 +354,48 @@ std::vector<double> openfoam_face_skewness(const PolyMesh& mesh) {
       centre[c] = foam_cell_centre(mesh.nodes, outward, off, fc, fa);
     }
   });
-  std::vector<double> skew(mesh.n_faces());
+  return centre;
+}
+
+namespace {
+// checkMesh's per-face measures from the OpenFOAM centres, one face loop for whichever is asked
+// (a null output is skipped): the skewness and the cosine of the non-orthogonality (1 on the boundary).
+void foam_face_measures(const PolyMesh& mesh, const std::vector<Vec3>& centre, std::vector<double>* skew,
+                        std::vector<double>* cosine) {
+  if (skew) skew->assign(mesh.n_faces(), 0.0);
+  if (cosine) cosine->assign(mesh.n_faces(), 1.0);
   parallel_ranges(mesh.n_faces(), [&](int64_t fb, int64_t fe) {
     for (int f = static_cast<int>(fb); f < fe; ++f) {
       Vec3 fc, fa;
       foam_face(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), &fc, &fa);
       const int32_t n = mesh.face_neighbour[f];
-      skew[f] = foam_skewness(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), fc, fa, centre[mesh.face_owner[f]],
-                              n >= 0 ? &centre[n] : nullptr);
+      const Vec3& own = centre[mesh.face_owner[f]];
+      if (skew)
+        (*skew)[f] = foam_skewness(mesh.nodes, mesh.face_begin(f), mesh.face_end(f), fc, fa, own,
+                                   n >= 0 ? &centre[n] : nullptr);
+      if (cosine && n >= 0) {
+        const Vec3 d = centre[n] - own;
+        (*cosine)[f] = dot(d, fa) / (norm(d) * norm(fa) + 1e-300);
+      }
     }
   });
+}
+}  // namespace
+
+std::vector<double> openfoam_face_skewness(const PolyMesh& mesh, const std::vector<Vec3>& centre) {
+  std::vector<double> skew;
+  foam_face_measures(mesh, centre, &skew, nullptr);
   return skew;
+}
+
+std::vector<double> openfoam_face_skewness(const PolyMesh& mesh) {
+  return openfoam_face_skewness(mesh, openfoam_cell_centres(mesh));
+}
+
+std::vector<double> openfoam_face_nonorthogonality_cosine(const PolyMesh& mesh, const std::vector<Vec3>& centre) {
+  std::vector<double> cosine;
+  foam_face_measures(mesh, centre, nullptr, &cosine);
+  return cosine;
 }
 
 SkewnessSummary summarize_skewness(const std::vector<double>& face_skewness) {
@@ -376,6 +407,32 @@ SkewnessSummary summarize_skewness(const std::vector<double>& face_skewness) {
     s.above_limit += v > kCheckMeshSkewnessLimit;
   }
   return s;
+}
+
+NonOrthogonalitySummary summarize_nonorthogonality(const PolyMesh& mesh, const std::vector<double>& cosine) {
+  NonOrthogonalitySummary s;
+  const double severe = std::cos(kCheckMeshSevereNonOrthogonality / kDeg);
+  double min_cos = 1, sum = 0;
+  int64_t interior = 0;
+  for (size_t f = 0; f < cosine.size(); ++f) {
+    const double c = cosine[f];
+    if (mesh.face_neighbour[f] < 0 || std::isnan(c)) continue;
+    if (c < min_cos || s.worst_face < 0) min_cos = c, s.worst_face = static_cast<int32_t>(f);
+    sum += c;
+    ++interior;
+    s.severe += c < severe && c > kCheckMeshSmall;
+    s.errors += c <= kCheckMeshSmall;
+  }
+  if (interior == 0) return s;
+  s.max = std::acos(clamp_unit(min_cos)) * kDeg;
+  s.average = std::acos(clamp_unit(sum / static_cast<double>(interior))) * kDeg;
+  return s;
+}
+
+CheckMeshFigures checkmesh_figures(const PolyMesh& mesh) {
+  std::vector<double> skew, cosine;
+  foam_face_measures(mesh, openfoam_cell_centres(mesh), &skew, &cosine);
+  return {summarize_skewness(skew), summarize_nonorthogonality(mesh, cosine)};
 }
 
 }  // namespace hm

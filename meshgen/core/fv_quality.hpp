@@ -86,10 +86,23 @@ struct Stats {
 /// Statistics of the values whose mask entry is true (all values when mask is empty).
 Stats stats_of(const std::vector<double>& values, const std::vector<bool>& mask = {});
 
+/// OpenFOAM's cell centres as checkMesh computes them (primitiveMesh cell centres: the
+/// volume-weighted centroids of the pyramids from the mean of the face centres), per cell. Not the
+/// FV centres (cell_fv_center): OpenFOAM's fluxes and checks use these.
+std::vector<Vec3> openfoam_cell_centres(const PolyMesh& mesh);
+
 /// OpenFOAM's face skewness (checkMesh flags faces above 4), per face: cell centres are
 /// geometric centroids and face centres area-weighted, computed as OpenFOAM does
 /// (primitiveMeshTools::faceSkewness), so that it reproduces checkMesh's figures.
 std::vector<double> openfoam_face_skewness(const PolyMesh& mesh);
+/// The same with the cell centres given (openfoam_cell_centres of the mesh).
+std::vector<double> openfoam_face_skewness(const PolyMesh& mesh, const std::vector<Vec3>& centres);
+
+/// checkMesh's face orthogonality (polyMeshTools::faceOrthogonality) per face: the cosine of the
+/// angle between the face's area vector and the line from the owner's to the neighbour's OpenFOAM
+/// centre (openfoam_cell_centres); 1 on a boundary face (checkMesh's summary leaves them out). Its
+/// non-orthogonality is the arccosine. Unlike Q_O it measures from centroids, not from FV centres.
+std::vector<double> openfoam_face_nonorthogonality_cosine(const PolyMesh& mesh, const std::vector<Vec3>& centres);
 
 /// checkMesh's limit: a face above it is "highly skew" and checkMesh ends with "Failed 1 mesh checks".
 inline constexpr double kCheckMeshSkewnessLimit = 4.0;
@@ -104,5 +117,30 @@ struct SkewnessSummary {
   int64_t above_limit = 0;  ///< faces above kCheckMeshSkewnessLimit: checkMesh's "highly skew faces"
 };
 SkewnessSummary summarize_skewness(const std::vector<double>& face_skewness);
+
+/// checkMesh's threshold for "severely non-orthogonal" faces (degrees; a warning, not a failure).
+inline constexpr double kCheckMeshSevereNonOrthogonality = 70.0;
+/// OpenFOAM's SMALL: checkMesh counts a face whose cosine is at most this as a non-orthogonality
+/// error (the line between the centres at 90 degrees or more from the face normal) and fails.
+inline constexpr double kCheckMeshSmall = 1e-15;
+
+/// What checkMesh would say of a mesh's non-orthogonality (openfoam_face_nonorthogonality_cosine
+/// of its interior faces): "Mesh non-orthogonality Max: <max> average: <average>", its severe
+/// faces and errors.
+struct NonOrthogonalitySummary {
+  double max = 0;           ///< degrees: the arccosine of the smallest cosine
+  double average = 0;       ///< degrees: the arccosine of the mean cosine, as checkMesh has it
+  int32_t worst_face = -1;  ///< the face with the largest angle
+  int64_t severe = 0;       ///< faces above kCheckMeshSevereNonOrthogonality with a cosine above kCheckMeshSmall
+  int64_t errors = 0;       ///< faces with a cosine at most kCheckMeshSmall: checkMesh fails
+};
+NonOrthogonalitySummary summarize_nonorthogonality(const PolyMesh& mesh, const std::vector<double>& cosine);
+
+/// checkMesh's skewness and non-orthogonality of a mesh, its OpenFOAM centres computed once.
+struct CheckMeshFigures {
+  SkewnessSummary skewness;
+  NonOrthogonalitySummary nonorthogonality;
+};
+CheckMeshFigures checkmesh_figures(const PolyMesh& mesh);
 
 }  // namespace hm

@@ -630,6 +630,56 @@ TEST(RunFvcheck, ReportsCheckMeshSkewness) {
   EXPECT_NE(report_html(moved).find("checkMesh skewness"), std::string::npos);
 }
 
+// checkMesh's non-orthogonality summary: its maximum is the arccosine of the smallest cosine, its average
+// the arccosine of the mean cosine over the interior faces only (a boundary face's 1 would lower it), a
+// face above 70 degrees is severe (a warning) and one at a cosine of at most OpenFOAM's SMALL an error.
+TEST(NonOrthogonalitySummary, CountsInteriorFacesAsCheckMeshDoes) {
+  const PolyMesh m = box_grid(4, 1, 1);  // three interior faces
+  std::vector<double> cosine(m.n_faces(), 1.0);
+  std::vector<int> interior;
+  for (int f = 0; f < m.n_faces(); ++f)
+    if (m.face_neighbour[f] >= 0) interior.push_back(f);
+  ASSERT_EQ(interior.size(), 3u);
+  const double deg = M_PI / 180;
+  cosine[interior[0]] = std::cos(75 * deg);
+  cosine[interior[1]] = std::cos(20 * deg);
+  cosine[interior[2]] = 1e-16;
+  const NonOrthogonalitySummary s = summarize_nonorthogonality(m, cosine);
+  EXPECT_NEAR(s.max, 90.0, 1e-12);
+  EXPECT_EQ(s.worst_face, interior[2]);
+  const double mean = (std::cos(75 * deg) + std::cos(20 * deg) + 1e-16) / 3;
+  EXPECT_NEAR(s.average, std::acos(mean) / deg, 1e-12);
+  EXPECT_EQ(s.severe, 1);
+  EXPECT_EQ(s.errors, 1);
+  const NonOrthogonalitySummary none = summarize_nonorthogonality(box_grid(1, 1, 1), std::vector<double>(6, 1.0));
+  EXPECT_EQ(none.worst_face, -1);
+  EXPECT_EQ(none.max, 0);
+}
+
+// fvcheck reports checkMesh's non-orthogonality beside the FV checks: two unit cubes, the second sheared
+// along y by s = 1 (its far face moved by s), have centroids (0.5, 0.5, 0.5) and (1.5, 1, 0.5), so their
+// shared face x = 1 is atan(0.5) = 26.565 degrees off the line between them; the one interior face is also
+// the average. Unsheared, both are 0.
+TEST(RunFvcheck, ReportsCheckMeshNonOrthogonality) {
+  PolyMesh m = box_grid(2, 1, 1);
+  EXPECT_NEAR(run_fvcheck(m, {}).openfoam_nonorthogonality.max, 0.0, 1e-12);
+  for (Vec3& p : m.nodes)
+    if (p.x == 2.0) p.y += 1.0;
+  const FvReport r = run_fvcheck(m, {});
+  const double expected = std::atan(0.5) * 180 / M_PI;
+  EXPECT_NEAR(r.openfoam_nonorthogonality.max, expected, 1e-12);
+  EXPECT_NEAR(r.openfoam_nonorthogonality.average, expected, 1e-12);
+  EXPECT_EQ(r.openfoam_nonorthogonality.severe, 0);
+  EXPECT_EQ(r.openfoam_nonorthogonality.errors, 0);
+  EXPECT_NE(report_summary_text(r).find("checkMesh non-orthogonality: max 26.5651, average 26.5651 deg"),
+            std::string::npos)
+      << report_summary_text(r);
+  const nlohmann::json j = report_json(r);
+  EXPECT_NEAR(j["quality"]["openfoam_nonorthogonality_deg"]["max"].get<double>(), expected, 1e-12);
+  EXPECT_EQ(j["quality"]["openfoam_nonorthogonality_deg"]["error_faces"].get<int64_t>(), 0);
+  EXPECT_NE(report_html(r).find("checkMesh non-orthogonality"), std::string::npos);
+}
+
 TEST(TransmissibilitySummary, CountsNegativeAndNonFinite) {
   const TransmissibilitySummary s = summarize_transmissibilities({0.0, 2.0, -1.0, 5.0, NAN});
   EXPECT_TRUE(s.present);

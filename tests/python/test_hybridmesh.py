@@ -102,6 +102,13 @@ class BuiltMesh(unittest.TestCase):
         self.assertEqual(skew["faces_above_checkmesh_limit"], 0, skew)
         self.assertGreater(skew["max"], 0.0)
         self.assertLess(skew["max"], skew["checkmesh_limit"])
+        # checkMesh's non-orthogonality: below 90 degrees on every face (no error), the average of
+        # mostly orthogonal faces a few degrees.
+        ortho = report["quality"]["openfoam_nonorthogonality_deg"]
+        self.assertEqual(ortho["error_faces"], 0, ortho)
+        self.assertGreater(ortho["max"], ortho["average"])
+        self.assertLess(ortho["max"], 90.0)
+        self.assertLess(ortho["average"], 10.0)
         t = self.mesh.transmissibilities
         interior = self.mesh.face_neighbour >= 0
         self.assertTrue(np.all(np.isfinite(t)))
