@@ -210,11 +210,20 @@ int main(int argc, char** argv) {
       return 2;
     }
     written.push_back((out / "openfoam").string() + "/");
-    // checkMesh fails faces above its skewness limit; the files are right, but the user is told,
-    // from the points as written (checkMesh's own view).
-    const hm::SkewnessSummary skew = hm::summarize_skewness(hm::openfoam_face_skewness(result.mesh));
-    summary["openfoam"] = {{"max_skewness", skew.max}, {"faces_above_checkmesh_skewness_limit", skew.above_limit}};
+    // checkMesh fails faces above its skewness limit or at 90 degrees of non-orthogonality; the files
+    // are right, but the user is told, from the points as written (checkMesh's own view).
+    const hm::CheckMeshFigures foam = hm::checkmesh_figures(result.mesh);
+    const hm::SkewnessSummary& skew = foam.skewness;
+    const hm::NonOrthogonalitySummary& ortho = foam.nonorthogonality;
+    summary["openfoam"] = {{"max_skewness", skew.max},
+                           {"faces_above_checkmesh_skewness_limit", skew.above_limit},
+                           {"max_nonorthogonality_deg", ortho.max},
+                           {"average_nonorthogonality_deg", ortho.average},
+                           {"faces_above_checkmesh_severe_nonorthogonality", ortho.severe},
+                           {"checkmesh_nonorthogonality_errors", ortho.errors}};
     if (skew.above_limit > 0) std::cerr << "meshgen: warning: openfoam: " << skewed_face_text(result.mesh, skew) << "\n";
+    if (ortho.errors > 0)
+      std::cerr << "meshgen: warning: openfoam: " << hm::openfoam_nonorthogonality_text(ortho) << "\n";
   }
   double picture_seconds = -1;
   if (pictures) {

@@ -1,6 +1,6 @@
 // End-to-end: `meshgen --export openfoam` writes a case that OpenFOAM's checkMesh reads with the
-// cell count, total volume, maximum skewness and count of faces above its skewness limit of meshgen's
-// summary.json. (The library-level tests in
+// cell count, total volume, maximum skewness and count of faces above its skewness limit, and the
+// non-orthogonality (maximum, average, faces above 70 degrees) of meshgen's summary.json. (The library-level tests in
 // tests/exporters/test_openfoam_export.cpp also cross-check checkMesh's skewness figures.)
 #include <gtest/gtest.h>
 
@@ -35,6 +35,8 @@ struct ExportChecked {
   long long cells = -1;
   double volume = -1, max_skewness = -1;
   long long skewed_faces = 0;         // checkMesh's "N highly skew faces"
+  double max_nonorthogonality = -1, average_nonorthogonality = -1;  // "Mesh non-orthogonality Max: X average: Y"
+  long long severe_nonorthogonal_faces = 0;                          // "*Number of severely non-orthogonal ..."
   std::vector<std::string> failures;  // checkMesh's lines starting with ***
 };
 
@@ -52,7 +54,9 @@ ExportChecked export_and_check(const fs::path& case_file, const fs::path& d) {
   std::string line;
   std::smatch m;
   const std::regex cells_re(R"(^\s*cells:\s+(\d+))"), volume_re(R"(Total volume = ([0-9.eE+-]+))"),
-      skew_re(R"(Max skewness = ([0-9.eE+-]+)(, (\d+) highly skew faces)?)");
+      skew_re(R"(Max skewness = ([0-9.eE+-]+)(, (\d+) highly skew faces)?)"),
+      ortho_re(R"(Mesh non-orthogonality Max: ([0-9.eE+-]+) average: ([0-9.eE+-]+))"),
+      severe_re(R"(Number of severely non-orthogonal \(> 70 degrees\) faces: (\d+))");
   while (std::getline(in, line)) {
     const size_t first = line.find_first_not_of(" \t");
     if (first != std::string::npos && line.compare(first, 3, "***") == 0) r.failures.push_back(line);
@@ -62,18 +66,30 @@ ExportChecked export_and_check(const fs::path& case_file, const fs::path& d) {
       r.max_skewness = std::stod(m[1]);
       if (m[3].matched) r.skewed_faces = std::stoll(m[3]);
     }
+    if (std::regex_search(line, m, ortho_re)) {
+      r.max_nonorthogonality = std::stod(m[1]);
+      r.average_nonorthogonality = std::stod(m[2]);
+    }
+    if (std::regex_search(line, m, severe_re)) r.severe_nonorthogonal_faces = std::stoll(m[1]);
   }
   return r;
 }
 
-// meshgen's summary.json says what checkMesh finds of the skewness: the same maximum (meshgen measures
-// at the written points, as checkMesh does; 1e-6 for the files' precision) and the same count of faces
-// above checkMesh's limit of 4.
-void expect_skewness_as_check_mesh_finds_it(const ExportChecked& r) {
+// meshgen's summary.json says what checkMesh finds of the skewness and the non-orthogonality: the same
+// maxima and average (meshgen measures at the written points, as checkMesh does; 1e-6 for the files'
+// precision, the issue asks 1e-4) and the same counts of faces above checkMesh's skewness limit of 4 and
+// its non-orthogonality warning threshold of 70 degrees.
+void expect_figures_as_check_mesh_finds_them(const ExportChecked& r) {
   ASSERT_TRUE(r.summary.contains("openfoam")) << r.summary.dump(2);
-  const double ours = r.summary["openfoam"]["max_skewness"].get<double>();
-  EXPECT_NEAR(ours, r.max_skewness, 1e-6 * r.max_skewness) << r.check_mesh.out;
-  EXPECT_EQ(r.summary["openfoam"]["faces_above_checkmesh_skewness_limit"].get<long long>(), r.skewed_faces);
+  const nlohmann::json& foam = r.summary["openfoam"];
+  EXPECT_NEAR(foam["max_skewness"].get<double>(), r.max_skewness, 1e-6 * r.max_skewness) << r.check_mesh.out;
+  EXPECT_EQ(foam["faces_above_checkmesh_skewness_limit"].get<long long>(), r.skewed_faces);
+  ASSERT_GE(r.max_nonorthogonality, 0) << "no non-orthogonality line in checkMesh's output\n" << r.check_mesh.out;
+  EXPECT_NEAR(foam["max_nonorthogonality_deg"].get<double>(), r.max_nonorthogonality, 1e-6 * r.max_nonorthogonality);
+  EXPECT_NEAR(foam["average_nonorthogonality_deg"].get<double>(), r.average_nonorthogonality,
+              1e-6 * r.average_nonorthogonality);
+  EXPECT_EQ(foam["faces_above_checkmesh_severe_nonorthogonality"].get<long long>(), r.severe_nonorthogonal_faces);
+  EXPECT_EQ(foam["checkmesh_nonorthogonality_errors"].get<long long>(), 0);
 }
 
 void check_example(const std::string& example) {
@@ -91,11 +107,14 @@ void check_example(const std::string& example) {
   // Issue #6: `Mesh OK.` and no line starting with `***` (skewness included).
   EXPECT_TRUE(r.failures.empty()) << r.failures.front() << "\n" << r.check_mesh.out;
   EXPECT_NE(r.check_mesh.out.find("Mesh OK."), std::string::npos) << r.check_mesh.out;
-  expect_skewness_as_check_mesh_finds_it(r);
+  expect_figures_as_check_mesh_finds_them(r);
   EXPECT_EQ(r.meshgen.err.find("warning"), std::string::npos) << r.meshgen.err;
-  std::printf("[ figures  ] %s: checkMesh cells %lld, total volume %.15g (summary %.15g), max skewness %.6g%s%s\n",
-              example.c_str(), r.cells, r.volume, ours, r.max_skewness, r.failures.empty() ? ", Mesh OK" : ", ",
-              r.failures.empty() ? "" : r.failures[0].c_str());
+  std::printf("[ figures  ] %s: checkMesh cells %lld, total volume %.15g (summary %.15g), max skewness %.6g, "
+              "non-orthogonality max %.6g average %.6g (summary %.6g, %.6g), %lld faces above 70%s%s\n",
+              example.c_str(), r.cells, r.volume, ours, r.max_skewness, r.max_nonorthogonality,
+              r.average_nonorthogonality, r.summary["openfoam"]["max_nonorthogonality_deg"].get<double>(),
+              r.summary["openfoam"]["average_nonorthogonality_deg"].get<double>(), r.severe_nonorthogonal_faces,
+              r.failures.empty() ? ", Mesh OK" : ", ", r.failures.empty() ? "" : r.failures[0].c_str());
 }
 
 TEST(OpenFoamMeshgen, PaperSingleWellCaseReadsInCheckMesh) { check_example("paper_single_well"); }
@@ -121,7 +140,7 @@ TEST(OpenFoamMeshgen, FacesCheckMeshFindsTooSkewedAreReported) {
   }
   const ExportChecked r = export_and_check(d / "case.yaml", d);
   ASSERT_EQ(r.meshgen.exit_code, 0) << r.meshgen.out << r.meshgen.err;
-  expect_skewness_as_check_mesh_finds_it(r);
+  expect_figures_as_check_mesh_finds_them(r);
   if (r.skewed_faces == 0) {
     EXPECT_EQ(r.meshgen.err.find("warning"), std::string::npos) << r.meshgen.err;
     GTEST_SKIP() << "case 3379 no longer has a face above checkMesh's limit: pick another sweep case for this test";
