@@ -36,12 +36,24 @@ inline const char* outcome_name(Outcome o) {
   return "?";
 }
 
-/// How mesh_and_check reports checkMesh's largest face skewness of a meshed case in its reason.
+/// How mesh_and_check reports checkMesh's figures of a meshed case in its reason: the largest face
+/// skewness, the largest non-orthogonality (degrees) and the faces checkMesh fails for it (at 90 or more).
 inline constexpr const char* kSkewnessTag = "checkMesh skewness ";
-/// That skewness, NaN when the reason has none.
-inline double reported_skewness(const std::string& reason) {
-  const size_t at = reason.find(kSkewnessTag);
-  return at == std::string::npos ? std::nan("") : std::atof(reason.c_str() + at + std::string(kSkewnessTag).size());
+inline constexpr const char* kNonOrthogonalityTag = "non-orthogonality ";
+inline constexpr const char* kNonOrthogonalityErrorsTag = "non-orthogonality errors ";
+/// The number after `tag` in a reason, NaN when the reason has none.
+inline double reported_figure(const std::string& reason, const std::string& tag) {
+  const size_t at = reason.find(tag);
+  return at == std::string::npos ? std::nan("") : std::atof(reason.c_str() + at + tag.size());
+}
+inline double reported_skewness(const std::string& reason) { return reported_figure(reason, kSkewnessTag); }
+inline double reported_nonorthogonality(const std::string& reason) {
+  return reported_figure(reason, kNonOrthogonalityTag);
+}
+/// checkMesh's non-orthogonality errors of a meshed case (0 when it has none).
+inline double reported_nonorthogonality_errors(const std::string& reason) {
+  const double v = reported_figure(reason, kNonOrthogonalityErrorsTag);
+  return std::isnan(v) ? 0 : v;
 }
 
 struct CaseResult {
@@ -108,9 +120,14 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
       for (const auto& [k, v] : c.counts)
         if (res.outcome == Outcome::Meshed && k == "boundary_faces_below_threshold_at_centroid" && v > 0)
           res.reason = "passes; the centroid rule would fail " + std::to_string(v) + " boundary faces";
-    // checkMesh's skewness (its limit is 4; fvcheck reproduces it), for the sweep's tally.
-    if (res.outcome == Outcome::Meshed)
-      res.reason += (res.reason.empty() ? "" : "; ") + std::string(kSkewnessTag) + std::to_string(fv.openfoam_skewness.max);
+    // checkMesh's skewness (its limit is 4) and non-orthogonality (it fails a face at 90 degrees or
+    // more), as fvcheck reproduces them, for the sweep's tally.
+    if (res.outcome == Outcome::Meshed) {
+      const NonOrthogonalitySummary& no = fv.openfoam_nonorthogonality;
+      res.reason += (res.reason.empty() ? "" : "; ") + std::string(kSkewnessTag) + std::to_string(fv.openfoam_skewness.max) +
+                    ", " + kNonOrthogonalityTag + std::to_string(no.max);
+      if (no.errors > 0) res.reason += ", " + std::string(kNonOrthogonalityErrorsTag) + std::to_string(no.errors);
+    }
   });
 }
 

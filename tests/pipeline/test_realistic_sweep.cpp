@@ -115,6 +115,8 @@ TEST(RealisticSweep, FullSweepTable) {
   std::map<std::string, Row> rows;
   std::map<std::string, int> reasons;
   std::vector<uint32_t> skewed_seeds;  // meshed, but checkMesh would flag a face above its skewness limit of 4
+  std::vector<uint32_t> nonorthogonal_seeds;  // meshed, but checkMesh would fail a face at 90 degrees or more
+  std::vector<double> max_nonorthogonality;   // per meshed case, degrees
   Row all;
   for (int i = 0; i < n; ++i) {
     const uint32_t seed = static_cast<uint32_t>(first + i);
@@ -144,6 +146,8 @@ TEST(RealisticSweep, FullSweepTable) {
       ++reasons[std::string(outcome_name(r.outcome)) + ": " + key];
     }
     if (reported_skewness(r.reason) > 4) skewed_seeds.push_back(seed);
+    if (reported_nonorthogonality_errors(r.reason) > 0) nonorthogonal_seeds.push_back(seed);
+    if (!std::isnan(reported_nonorthogonality(r.reason))) max_nonorthogonality.push_back(reported_nonorthogonality(r.reason));
     std::printf("[ sweep     ] %s [%s] %s %.2f s %s\n", rc.label.c_str(), mode_label(o).c_str(),
                 outcome_name(r.outcome), r.seconds, r.reason.substr(0, 160).c_str());
     std::fflush(stdout);
@@ -169,6 +173,19 @@ TEST(RealisticSweep, FullSweepTable) {
   std::printf("\nmeshed, with a face above checkMesh's skewness limit (4): %zu", skewed_seeds.size());
   for (size_t k = 0; k < skewed_seeds.size(); ++k) std::printf("%s%u", k ? ", " : " (seeds ", skewed_seeds[k]);
   std::printf("%s\n", skewed_seeds.empty() ? "" : ")");
+  std::printf("meshed, with a face checkMesh fails for non-orthogonality (90 degrees or more): %zu", nonorthogonal_seeds.size());
+  for (size_t k = 0; k < nonorthogonal_seeds.size(); ++k) std::printf("%s%u", k ? ", " : " (seeds ", nonorthogonal_seeds[k]);
+  std::printf("%s\n", nonorthogonal_seeds.empty() ? "" : ")");
+  std::sort(max_nonorthogonality.begin(), max_nonorthogonality.end());
+  if (!max_nonorthogonality.empty()) {
+    const size_t m = max_nonorthogonality.size();
+    const auto above = [&](double deg) {
+      return max_nonorthogonality.end() - std::upper_bound(max_nonorthogonality.begin(), max_nonorthogonality.end(), deg);
+    };
+    std::printf("checkMesh's max non-orthogonality per meshed case (deg): median %.1f, max %.2f; cases above 70: %td, "
+                "above 80: %td, above 85: %td\n",
+                max_nonorthogonality[m / 2], max_nonorthogonality.back(), above(70), above(80), above(85));
+  }
   EXPECT_EQ(all.count[Outcome::Crash], 0);
   EXPECT_EQ(all.count[Outcome::Hang], 0);
   EXPECT_EQ(all.count[Outcome::CheckFailed], 0);
@@ -186,8 +203,9 @@ TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
     const CaseResult r = mesh_and_check(rc);
     ++shapes[shape_class(rc)];
     EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
-    std::printf("[ ci sweep  ] %s [%s] %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
-                r.seconds);
+    EXPECT_EQ(reported_nonorthogonality_errors(r.reason), 0) << rc.label << ": " << r.reason;
+    std::printf("[ ci sweep  ] %s [%s] %s %.2f s, checkMesh non-orthogonality %.1f deg\n", rc.label.c_str(),
+                mode_label(o).c_str(), outcome_name(r.outcome), r.seconds, reported_nonorthogonality(r.reason));
   }
   for (const auto& [k, v] : shapes) std::printf("[ ci sweep  ] %s: %d cases\n", k.c_str(), v);
 }
@@ -207,8 +225,10 @@ TEST(RealisticSweep, CiSubsetInThePermeabilityMetricMeshesAndPassesFvcheck) {
     split += was_split;
     const CaseResult r = mesh_and_check(rc);
     EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
-    std::printf("[ ci sweep  ] %s [%s]%s %s %.2f s\n", rc.label.c_str(), mode_label(o).c_str(),
-                was_split ? " split" : "", outcome_name(r.outcome), r.seconds);
+    EXPECT_EQ(reported_nonorthogonality_errors(r.reason), 0) << rc.label << ": " << r.reason;
+    std::printf("[ ci sweep  ] %s [%s]%s %s %.2f s, checkMesh non-orthogonality %.1f deg\n", rc.label.c_str(),
+                mode_label(o).c_str(), was_split ? " split" : "", outcome_name(r.outcome), r.seconds,
+                reported_nonorthogonality(r.reason));
   }
   EXPECT_GE(split, 3);
 }
@@ -237,6 +257,7 @@ TEST(RealisticSweep, CiSubsetWellsThroughTopAndBottomMeshAndPassFvcheck) {
     const RealisticCase rc = make_realistic_case(seed, o);
     const CaseResult r = mesh_and_check(rc);
     EXPECT_EQ(r.outcome, Outcome::Meshed) << rc.label << " [" << mode_label(o) << "]: " << r.reason;
+    EXPECT_EQ(reported_nonorthogonality_errors(r.reason), 0) << rc.label << ": " << r.reason;
     std::printf("[ ci sweep  ] %s [%s] %s %.2f s %s\n", rc.label.c_str(), mode_label(o).c_str(), outcome_name(r.outcome),
                 r.seconds, r.reason.substr(0, 120).c_str());
   }
