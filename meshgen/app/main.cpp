@@ -221,7 +221,14 @@ int main(int argc, char** argv) {
                            {"average_nonorthogonality_deg", ortho.average},
                            {"faces_above_checkmesh_severe_nonorthogonality", ortho.severe},
                            {"checkmesh_nonorthogonality_errors", ortho.errors}};
-    if (skew.above_limit > 0) std::cerr << "meshgen: warning: openfoam: " << skewed_face_text(result.mesh, skew) << "\n";
+    if (skew.above_limit > 0) {
+      std::cerr << "meshgen: warning: openfoam: " << skewed_face_text(result.mesh, skew);
+      // The common cause in a permeability frame: checkMesh measures in the Euclidean sense.
+      if (cs.metric == hm::MeshMetric::Permeability)
+        std::cerr << " (metric: permeability: K-orthogonal cells are skewed in checkMesh's Euclidean measure, the more "
+                     "so the smaller kv/kh; metric: euclidean builds them orthogonal in it, docs/anisotropy.md)";
+      std::cerr << "\n";
+    }
     if (ortho.errors > 0)
       std::cerr << "meshgen: warning: openfoam: " << hm::openfoam_nonorthogonality_text(ortho) << "\n";
   }

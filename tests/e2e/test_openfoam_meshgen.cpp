@@ -153,4 +153,29 @@ TEST(OpenFoamMeshgen, FacesCheckMeshFindsTooSkewedAreReported) {
               r.summary["openfoam"]["faces_above_checkmesh_skewness_limit"].get<long long>());
 }
 
+// The same in a permeability frame at kv/kh 0.01 (realistic case 2000, faces at skewness 10.7, checkMesh's
+// non-orthogonality up to 89.4 degrees: K-orthogonal cells are oblique in checkMesh's Euclidean measure):
+// the figures are checkMesh's, and the warning says why and names the Euclidean metric.
+TEST(OpenFoamMeshgen, PermeabilityFrameSkewnessIsReportedWithItsCause) {
+  if (!have_check_mesh()) GTEST_SKIP() << "checkMesh (Debian package openfoam) is not installed";
+  const fs::path d = fresh_dir("foam_skewed_k");
+  const RemoveAtExit cleanup{d};
+  hm::testing::RealisticOptions o = hm::testing::sweep_mode(2000);
+  o.kv_kh = 0.01;
+  {
+    std::ofstream f(d / "case.yaml");
+    f << hm::testing::make_realistic_case(2000, o).yaml;
+  }
+  const ExportChecked r = export_and_check(d / "case.yaml", d);
+  ASSERT_EQ(r.meshgen.exit_code, 0) << r.meshgen.out << r.meshgen.err;
+  expect_figures_as_check_mesh_finds_them(r);
+  ASSERT_GT(r.skewed_faces, 0) << "case 2000 at kv/kh 0.01 no longer has a face above checkMesh's limit";
+  EXPECT_NE(r.meshgen.err.find("metric: permeability: K-orthogonal cells are skewed"), std::string::npos)
+      << r.meshgen.err;
+  std::printf("[ figures  ] realistic 2000, kv/kh 0.01: checkMesh max skewness %.6g, %lld faces above 4, "
+              "non-orthogonality max %.6g average %.6g, %lld faces above 70\n",
+              r.max_skewness, r.skewed_faces, r.max_nonorthogonality, r.average_nonorthogonality,
+              r.severe_nonorthogonal_faces);
+}
+
 }  // namespace
