@@ -651,6 +651,10 @@ TEST(NonOrthogonalitySummary, CountsInteriorFacesAsCheckMeshDoes) {
   EXPECT_NEAR(s.average, std::acos(mean) / deg, 1e-12);
   EXPECT_EQ(s.severe, 1);
   EXPECT_EQ(s.errors, 1);
+  // fvcheck's line, and meshgen's warning for the OpenFOAM export, name both counts.
+  const std::string text = openfoam_nonorthogonality_text(s);
+  EXPECT_NE(text.find("1 face above its warning threshold of 70"), std::string::npos) << text;
+  EXPECT_NE(text.find("1 face at 90 deg or more: checkMesh reports it"), std::string::npos) << text;
   const NonOrthogonalitySummary none = summarize_nonorthogonality(box_grid(1, 1, 1), std::vector<double>(6, 1.0));
   EXPECT_EQ(none.worst_face, -1);
   EXPECT_EQ(none.max, 0);
