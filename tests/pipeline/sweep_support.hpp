@@ -41,6 +41,10 @@ inline const char* outcome_name(Outcome o) {
 inline constexpr const char* kSkewnessTag = "checkMesh skewness ";
 inline constexpr const char* kNonOrthogonalityTag = "non-orthogonality ";
 inline constexpr const char* kNonOrthogonalityErrorsTag = "non-orthogonality errors ";
+/// The transition cells' paper figures (issue 13 asks mean Q_S >= 0.3 and Q_O min >= 85 degrees):
+/// their mean Q_S and their smallest Q_O(V) (boundary faces measured to their flux points).
+inline constexpr const char* kTransitionQsTag = "transition Q_S mean ";
+inline constexpr const char* kTransitionQoTag = "transition Q_O min ";
 /// The number after `tag` in a reason, NaN when the reason has none.
 inline double reported_figure(const std::string& reason, const std::string& tag) {
   const size_t at = reason.find(tag);
@@ -127,6 +131,10 @@ inline CaseResult mesh_and_check(const RealisticCase& rc) {
       res.reason += (res.reason.empty() ? "" : "; ") + std::string(kSkewnessTag) + std::to_string(fv.openfoam_skewness.max) +
                     ", " + kNonOrthogonalityTag + std::to_string(no.max);
       if (no.errors > 0) res.reason += ", " + std::string(kNonOrthogonalityErrorsTag) + std::to_string(no.errors);
+      for (const RegionQuality& rq : fv.by_region)
+        if (rq.region == kTransition && rq.cells > 0)
+          res.reason += ", " + std::string(kTransitionQsTag) + std::to_string(rq.q_s.mean) + ", " + kTransitionQoTag +
+                        std::to_string(rq.q_o.min);
     }
   });
 }

@@ -117,6 +117,7 @@ TEST(RealisticSweep, FullSweepTable) {
   std::vector<uint32_t> skewed_seeds;  // meshed, but checkMesh would flag a face above its skewness limit of 4
   std::vector<uint32_t> nonorthogonal_seeds;  // meshed, but checkMesh would fail a face at 90 degrees or more
   std::vector<double> max_nonorthogonality;   // per meshed case, degrees
+  std::vector<double> transition_qs, transition_qo;  // per meshed case with transition cells
   Row all;
   for (int i = 0; i < n; ++i) {
     const uint32_t seed = static_cast<uint32_t>(first + i);
@@ -148,6 +149,10 @@ TEST(RealisticSweep, FullSweepTable) {
     if (reported_skewness(r.reason) > 4) skewed_seeds.push_back(seed);
     if (reported_nonorthogonality_errors(r.reason) > 0) nonorthogonal_seeds.push_back(seed);
     if (!std::isnan(reported_nonorthogonality(r.reason))) max_nonorthogonality.push_back(reported_nonorthogonality(r.reason));
+    if (!std::isnan(reported_figure(r.reason, kTransitionQsTag))) {
+      transition_qs.push_back(reported_figure(r.reason, kTransitionQsTag));
+      transition_qo.push_back(reported_figure(r.reason, kTransitionQoTag));
+    }
     std::printf("[ sweep     ] %s [%s] %s %.2f s %s\n", rc.label.c_str(), mode_label(o).c_str(),
                 outcome_name(r.outcome), r.seconds, r.reason.substr(0, 160).c_str());
     std::fflush(stdout);
@@ -185,6 +190,17 @@ TEST(RealisticSweep, FullSweepTable) {
     std::printf("checkMesh's max non-orthogonality per meshed case (deg): median %.1f, max %.2f; cases above 70: %td, "
                 "above 80: %td, above 85: %td\n",
                 max_nonorthogonality[m / 2], max_nonorthogonality.back(), above(70), above(80), above(85));
+  }
+  if (!transition_qs.empty()) {
+    const size_t m = transition_qs.size();
+    std::sort(transition_qs.begin(), transition_qs.end());
+    std::sort(transition_qo.begin(), transition_qo.end());
+    const auto below = [](const std::vector<double>& v, double x) { return std::lower_bound(v.begin(), v.end(), x) - v.begin(); };
+    std::printf("transition cells per meshed case: mean Q_S median %.3f, range %.3f-%.3f, cases >= 0.3: %td; Q_O min "
+                "median %.2f, lowest %.2f deg, cases below 85: %td\n",
+                transition_qs[m / 2], transition_qs.front(), transition_qs.back(),
+                static_cast<std::ptrdiff_t>(m) - below(transition_qs, 0.3), transition_qo[m / 2], transition_qo.front(),
+                below(transition_qo, 85.0));
   }
   EXPECT_EQ(all.count[Outcome::Crash], 0);
   EXPECT_EQ(all.count[Outcome::Hang], 0);
