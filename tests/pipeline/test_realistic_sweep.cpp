@@ -118,6 +118,7 @@ TEST(RealisticSweep, FullSweepTable) {
   std::vector<uint32_t> nonorthogonal_seeds;  // meshed, but checkMesh would fail a face at 90 degrees or more
   std::vector<double> max_nonorthogonality;   // per meshed case, degrees
   std::vector<double> transition_qs, transition_qo;  // per meshed case with transition cells
+  std::map<std::string, std::pair<int, int>> qo_below_85_by_ends;  // the wells' ends -> (cases below 85, cases)
   Row all;
   for (int i = 0; i < n; ++i) {
     const uint32_t seed = static_cast<uint32_t>(first + i);
@@ -152,9 +153,14 @@ TEST(RealisticSweep, FullSweepTable) {
     if (!std::isnan(reported_figure(r.reason, kTransitionQsTag))) {
       transition_qs.push_back(reported_figure(r.reason, kTransitionQsTag));
       transition_qo.push_back(reported_figure(r.reason, kTransitionQoTag));
+      std::pair<int, int>& tally = qo_below_85_by_ends[o.cross_top_bottom                        ? "through the top or bottom"
+                                                       : o.caps == RealisticOptions::Caps::Flat ? "flat ends"
+                                                                                                : "hemispherical caps"];
+      tally.first += transition_qo.back() < 85;
+      ++tally.second;
     }
     std::printf("[ sweep     ] %s [%s] %s %.2f s %s\n", rc.label.c_str(), mode_label(o).c_str(),
-                outcome_name(r.outcome), r.seconds, r.reason.substr(0, 160).c_str());
+                outcome_name(r.outcome), r.seconds, r.reason.substr(0, 320).c_str());
     std::fflush(stdout);
     if (log) log << rc.label << "\t" << mode_label(o) << "\t" << outcome_name(r.outcome) << "\t" << r.seconds << "\t"
                  << r.reason << "\n";
@@ -201,6 +207,8 @@ TEST(RealisticSweep, FullSweepTable) {
                 transition_qs[m / 2], transition_qs.front(), transition_qs.back(),
                 static_cast<std::ptrdiff_t>(m) - below(transition_qs, 0.3), transition_qo[m / 2], transition_qo.front(),
                 below(transition_qo, 85.0));
+    for (const auto& [ends, tally] : qo_below_85_by_ends)
+      std::printf("  wells %s: Q_O min below 85 in %d of %d cases\n", ends.c_str(), tally.first, tally.second);
   }
   EXPECT_EQ(all.count[Outcome::Crash], 0);
   EXPECT_EQ(all.count[Outcome::Hang], 0);
