@@ -37,19 +37,11 @@ if [[ "${HM_SKIP_SANITIZE:-0}" != "1" ]]; then
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   export LSAN_OPTIONS=suppressions="$root/tests/lsan.supp":print_suppressions=0  # third-party leaks only
-  # Also left out here, run in the Release pass: the slowest tests under ASan (13-94 s each, 4.5 min of the
-  # pass's 17 min of test time: Reek and thin-layer refinement meshes of ~100k cells, a K-orthogonal case
-  # meshed in two metrics; and the sliver test's 545k-cell benchmark grid, 7 s in Release), whose code paths the smaller corner-point, refinement and permeability-
-  # frame tests that stay here exercise too. Since session 45 also the next five (50-180 s each under
-  # ASan, 464 s of the pass's 1600 s of test time): the corner-point sweep's CI subset (its cases' paths:
-  # CornerPointSweep.CiThreeWellCase, .CiHorizontalSurvey, .FrameSplit*, CornerPointSurface.*), the
-  # shrink wave along a long well (the correction's loop, which every realistic case runs), the fault of
-  # ten metres and the second well beside the first's children (CornerPointSurface.WellReachingTheTopAcross*,
-  # CiThreeWellCase), and the flat ends of a large ring ratio (RealisticSweep.CiSubsetWellsThroughTopAndBottom*).
-  # Since session 46 the skewness rounds beyond 24 (two cases of 64 rounds; every skewness pass runs the
-  # same round budget: RealisticSweep.KeptSkewnessStepsLengthen and the other skewness tests stay here),
-  # and since session 47 the second chance after a stall (the same rounds again, on a case of 64+).
+  # Also left out here, run in the Release pass: the slowest tests under ASan, whose code paths smaller
+  # tests that stay here run (docs/testing.md, "The sanitizer pass", says which and why). The sweeps and
+  # reproducers of several cases mesh a sample of them here (tests/support/sanitizer_build.hpp).
   asan_long='CornerPointSweep\.CiHorizontalSeed2.*|SiteOptimizer\.SliverPass.*|NearWellRefinement\.(ThinLayersInCoarseCellsMesh|Reek.*)|PermeabilityFrameMesh\.KOrthogonalNearTheWell.*|MeshgenReekExample\..*|CornerPointWells\.Reek.*|LocalFrame\.Optimised.*'
+  asan_long+='|PermeabilityFrameMesh\.ReservoirNodesAreTheUsers.*'
   asan_long+='|CornerPointSweep\.CiSubsetMeshesSoundly|RealisticSweep\.ShrinkWaveAlongALongWellConverges|CornerPointWells\.(WellAcrossAFaultOfTenMetres|SecondWellBesideTheFirstOnesChildren)MeshesSoundly|RealisticSweep\.FlatEndsWithLargeRingRatio.*|RealisticSweep\.SkewnessRoundsGoOnWhileTheyMakeProgress|RealisticSweep\.StalledSkewnessRoundsGetASecondChance'
   (cd build-asan && ctest --output-on-failure -j"$jobs" \
     -E "^(Flow|OpenFoamMeshgen|CheckMesh|AsciiAndBinary/CheckMesh|Examples/CheckMesh|VtkValidation|MeshPictures|Examples/VtkAgreement|VtkAgreement|$asan_long)")
