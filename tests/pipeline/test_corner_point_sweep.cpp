@@ -430,7 +430,9 @@ TEST(CornerPointSweep, CiThreeWellCaseMeshesSoundly) {
 // leaning 6 degrees. With columns sized by the layers alone (3.2 m) the next layer's corner on a leaning
 // pillar lay in the diametral sphere of 154 wall triangles (stage transition, exit 1, sessions 28-36);
 // the columns there are now narrowed for the lean (kLeanSphereMargin; docs/corner-point.md, "Thin
-// layers on leaning pillars"). Without the optimiser, whose moves do not bear on it: about 11 s.
+// layers on leaning pillars"). Without the optimiser, whose moves do not bear on it: about 56 s in Release,
+// 57 % of it the 53 rounds against checkMesh's skewness on its 18,598 transition cells (each rebuilds the
+// cavity's diagram; docs/optimization.md, "Session 49").
 TEST(CornerPointSweep, CiHorizontalSeed2ThinStepChildrenOnLeaningPillarsMesh) {
   const CornerPointSweepCase c = make_horizontal_case(2);
   const CaseResult r = mesh_corner_point_case(c, false);
