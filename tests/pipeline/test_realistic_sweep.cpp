@@ -216,9 +216,9 @@ TEST(RealisticSweep, FullSweepTable) {
   EXPECT_EQ(all.count[Outcome::CheckFailed], 0);
 }
 
-// The CI-sized subset (its first six under ASan, sanitizer_build.hpp): straight wells (one or two), strict hemispherical caps or
-// flat ends alternately, local coordinates, no optimisation, cavities at most 48 layers thick and
-// cells at most 20 m wide (time). Every case must mesh with its requested end caps and pass
+// The CI-sized subset (its first six under ASan, sanitizer_build.hpp): straight wells (one or two),
+// strict hemispherical caps or flat ends alternately, local coordinates, no optimisation, cavities at
+// most 48 layers thick and cells at most 20 m wide (time). Every case must mesh with its requested end caps and pass
 // mesh_and_check (builder, every fvcheck check, volume = box minus the exact holes).
 TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
   std::map<std::string, int> shapes;
@@ -237,8 +237,9 @@ TEST(RealisticSweep, CiSubsetMeshesWithTheRequestedEndCapsAndPassesFvcheck) {
 
 // The CI subset in the permeability metric (docs/anisotropy.md, "Layers near the wells"): ten small
 // cases at kv/kh 0.1 and 0.01 alternately (one or two straight wells, caps or flat ends, cells at most
-// 20 m wide; the first four under ASan), their layers near the wells split as load_case splits them. Each must mesh and pass
-// mesh_and_check (fvcheck judges a permeability-frame mesh in the K metric); some must have been split.
+// 20 m wide; the first four under ASan), their layers near the wells split as load_case splits them.
+// Each must mesh and pass mesh_and_check (fvcheck judges a permeability-frame mesh in the K metric);
+// some must have been split.
 TEST(RealisticSweep, CiSubsetInThePermeabilityMetricMeshesAndPassesFvcheck) {
   int split = 0;
   for (const uint32_t seed : hm::test::seed_range(1, 10, 4)) {
